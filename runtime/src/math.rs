@@ -1,0 +1,56 @@
+//! Elementary functions: `std`'s when the `std` feature is on, `libm`'s otherwise.
+//!
+//! Everything in the crate calls these wrappers instead of the inherent float
+//! methods, so the `no_std` build and the `std` build run the same code.
+
+macro_rules! forward {
+    ($($(#[$doc:meta])* $name:ident($($arg:ident),*) -> $ty:ty = $std:ident / $libm:ident;)*) => {
+        $(
+            $(#[$doc])*
+            #[inline(always)]
+            pub fn $name($($arg: $ty),*) -> $ty {
+                #[cfg(feature = "std")]
+                {
+                    <$ty>::$std($($arg),*)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    libm::$libm($($arg),*)
+                }
+            }
+        )*
+    };
+}
+
+forward! {
+    /// e^x (f64).
+    exp(x) -> f64 = exp / exp;
+    /// ln x (f64).
+    ln(x) -> f64 = ln / log;
+    /// √x (f64).
+    sqrt(x) -> f64 = sqrt / sqrt;
+    /// x^y (f64).
+    powf(x, y) -> f64 = powf / pow;
+    /// ⌊x⌋ (f64).
+    floor(x) -> f64 = floor / floor;
+    /// e^x (f32).
+    expf(x) -> f32 = exp / expf;
+    /// ln x (f32).
+    lnf(x) -> f32 = ln / logf;
+    /// √x (f32).
+    sqrtf(x) -> f32 = sqrt / sqrtf;
+    /// x^y (f32).
+    powff(x, y) -> f32 = powf / powf;
+    /// ⌊x⌋ (f32).
+    floorf(x) -> f32 = floor / floorf;
+    /// sin x (f32).
+    sinf(x) -> f32 = sin / sinf;
+    /// cos x (f32).
+    cosf(x) -> f32 = cos / cosf;
+}
+
+/// ln Γ(x) for x > 0 (f64, libm's `lgamma` in both builds: `std` has no lgamma).
+#[inline]
+pub fn ln_gamma(x: f64) -> f64 {
+    libm::lgamma(x)
+}
