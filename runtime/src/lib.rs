@@ -9,4 +9,8 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod format;
+pub mod interp;
 pub mod math;
+
+pub use format::{AlignedBytes, FormatError, Table, TableId};

@@ -1,0 +1,837 @@
+//! The table file format: defined here, once, and used by the generator to write.
+//!
+//! A table file is a fixed-size [`Header`] followed by a 64-byte-aligned payload
+//! of little-endian `f32` values:
+//!
+//! ```text
+//! offset 0                         Header (HEADER_SIZE bytes, #[repr(C)], read in place)
+//! offset HEADER_SIZE .. 64k        zero padding
+//! offset payload_offset            grid values, row-major (last axis fastest), channels innermost
+//!                                  then `aux_count` auxiliary values (meaning fixed per table id)
+//! end = payload_offset + payload_len   (nothing may follow)
+//! ```
+//!
+//! Every field is validated by [`Table::from_bytes`]; any malformed input returns a
+//! [`FormatError`] that says what is wrong, and no input can make it panic.
+//! The checksum ([`checksum`], FNV-1a 64) covers every byte of the file except
+//! the checksum field itself, so a flipped bit in the header or in the padding is
+//! caught, not only one in the payload.
+//!
+//! Byte order: the format is little-endian and the crate reads it in place, so
+//! the crate refuses to compile for big-endian targets (every renderer target we
+//! know of — x86-64, AArch64, wasm32 — is little-endian).
+
+use core::fmt;
+use core::mem::{offset_of, size_of};
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, TryFromBytes};
+
+#[cfg(target_endian = "big")]
+compile_error!(
+    "twoscale table files are little-endian and read in place; big-endian targets are not supported"
+);
+
+/// The eight bytes every table file starts with.
+pub const MAGIC: [u8; 8] = *b"TWOSCALE";
+/// The format version this crate reads and writes.
+pub const FORMAT_VERSION: u32 = 1;
+/// The largest number of axes a table may have (T3 is four-dimensional).
+pub const MAX_AXES: usize = 4;
+/// Number of table-specific generation parameters in the header.
+pub const PARAM_COUNT: usize = 8;
+/// Alignment of the payload, and of the start of the file in memory.
+pub const PAYLOAD_ALIGN: usize = 64;
+/// Size of [`Header`] in bytes.
+pub const HEADER_SIZE: usize = size_of::<Header>();
+
+/// Which quantity a table holds. The numeric tags are part of the file format.
+#[derive(
+    TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq, Hash,
+)]
+#[repr(u32)]
+pub enum TableId {
+    /// T1: Smith G1 of the EPD NDF over (p, ã = k_p·a); see [`crate::smith`].
+    SmithG1 = 1,
+}
+
+impl TableId {
+    /// Every table id, in tag order.
+    pub const ALL: [TableId; 1] = [TableId::SmithG1];
+
+    /// The tag stored in the file.
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+
+    /// The id with this tag, if any.
+    pub fn from_tag(tag: u32) -> Option<TableId> {
+        Self::ALL.into_iter().find(|id| id.tag() == tag)
+    }
+
+    /// Short name, used for file names (`<name>.tbl`) and on the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            TableId::SmithG1 => "t1-smith-g1",
+        }
+    }
+
+    /// One-line description of the quantity.
+    pub const fn description(self) -> &'static str {
+        match self {
+            TableId::SmithG1 => {
+                "Smith G1 of the EPD NDF (HP17 36-38), axes p and k_p*beta*tan(theta); aux = k_p per p node"
+            }
+        }
+    }
+
+    /// Names of the axes, in storage order.
+    pub const fn axis_names(self) -> &'static [&'static str] {
+        match self {
+            TableId::SmithG1 => &["p", "a_scaled"],
+        }
+    }
+
+    /// Names of the generation parameters stored in [`Header::params`] (unused
+    /// slots are zero and unnamed).
+    pub const fn param_names(self) -> &'static [&'static str] {
+        match self {
+            TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
+        }
+    }
+}
+
+/// Type of the stored values. Only `f32` is defined: the `f16` round-trip error
+/// (4.9e-4) exceeds every accuracy target of the project.
+#[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ValueType {
+    /// IEEE 754 binary32, little-endian.
+    F32 = 1,
+}
+
+/// How an axis maps a physical value `x` to the coordinate `c(x)` in which its
+/// nodes are evenly spaced. Interpolation is linear in `c`. The numeric tags are
+/// part of the file format; `param` is the mapping's parameter in [`AxisHeader`].
+#[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Mapping {
+    /// `c = x`.
+    Uniform = 1,
+    /// `c = ln x` (requires `lo > 0`).
+    Log = 2,
+    /// `c = ln(x + param)`, `param > 0`: logarithmic for `x ≫ param`, linear near 0,
+    /// and `x = 0` is a node.
+    LogOffset = 3,
+    /// `c = x^param`, `param ≠ 0` (requires `lo > 0`); a negative exponent puts
+    /// more nodes at small `x`.
+    Power = 4,
+}
+
+impl Mapping {
+    /// Every mapping, in tag order.
+    pub const ALL: [Mapping; 4] = [
+        Mapping::Uniform,
+        Mapping::Log,
+        Mapping::LogOffset,
+        Mapping::Power,
+    ];
+
+    /// The mapping with this tag, if any.
+    pub fn from_tag(tag: u32) -> Option<Mapping> {
+        Self::ALL.into_iter().find(|m| *m as u32 == tag)
+    }
+
+    /// Human-readable form, e.g. `ln(x + 0.01)`.
+    pub fn describe(self, param: f64) -> MappingDisplay {
+        MappingDisplay {
+            mapping: self,
+            param,
+        }
+    }
+}
+
+/// Display helper of [`Mapping::describe`].
+pub struct MappingDisplay {
+    mapping: Mapping,
+    param: f64,
+}
+
+impl fmt::Display for MappingDisplay {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.mapping {
+            Mapping::Uniform => write!(f, "x"),
+            Mapping::Log => write!(f, "ln(x)"),
+            Mapping::LogOffset => write!(f, "ln(x + {})", self.param),
+            Mapping::Power => write!(f, "x^{}", self.param),
+        }
+    }
+}
+
+/// One axis of a table, as stored: `nodes` values of the physical variable from
+/// `lo` to `hi`, evenly spaced in the coordinate of `mapping`.
+#[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct AxisHeader {
+    /// Number of nodes (≥ 2 for a used axis, 0 for an unused slot).
+    pub nodes: u32,
+    /// The coordinate mapping.
+    pub mapping: Mapping,
+    /// First node, physical units.
+    pub lo: f64,
+    /// Last node, physical units.
+    pub hi: f64,
+    /// Parameter of the mapping (see [`Mapping`]); 0 when it has none.
+    pub param: f64,
+}
+
+impl AxisHeader {
+    /// The header of an unused axis slot.
+    pub const UNUSED: AxisHeader = AxisHeader {
+        nodes: 0,
+        mapping: Mapping::Uniform,
+        lo: 0.0,
+        hi: 0.0,
+        param: 0.0,
+    };
+}
+
+/// The file header, read in place (zero-copy) from the first [`HEADER_SIZE`] bytes.
+///
+/// zerocopy checks its size, its alignment and its enum tags; `#[repr(C)]`
+/// without padding is enforced by the `IntoBytes` derive.
+#[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Header {
+    /// [`MAGIC`].
+    pub magic: [u8; 8],
+    /// [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// [`HEADER_SIZE`]; lets a reader reject a header of another layout.
+    pub header_size: u32,
+    /// What the table holds.
+    pub table_id: TableId,
+    /// Type of the stored values.
+    pub value_type: ValueType,
+    /// Values per grid node.
+    pub channels: u32,
+    /// Number of used axes (1..=[`MAX_AXES`]); the slots after them are unused.
+    pub axis_count: u32,
+    /// The axes, in storage order (the last varies fastest).
+    pub axes: [AxisHeader; MAX_AXES],
+    /// Number of auxiliary `f32` values after the grid (meaning fixed per table id).
+    pub aux_count: u32,
+    /// Zero.
+    pub reserved: u32,
+    /// Version of the generator that wrote the file, ASCII, NUL-padded.
+    pub generator_version: [u8; 16],
+    /// Generation parameters (names in [`TableId::param_names`]); unused slots zero.
+    pub params: [f64; PARAM_COUNT],
+    /// Byte offset of the payload from the start of the file (a multiple of 64).
+    pub payload_offset: u64,
+    /// Payload length in bytes (grid and aux values).
+    pub payload_len: u64,
+    /// FNV-1a 64 of every byte of the file except this field.
+    pub checksum: u64,
+}
+
+const CHECKSUM_OFFSET: usize = offset_of!(Header, checksum);
+
+impl Header {
+    /// The used axes.
+    pub fn used_axes(&self) -> &[AxisHeader] {
+        let n = (self.axis_count as usize).min(MAX_AXES);
+        &self.axes[..n]
+    }
+
+    /// The generator version as text (invalid UTF-8 shows as `?`).
+    pub fn generator_version_str(&self) -> &str {
+        let end = self
+            .generator_version
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(self.generator_version.len());
+        core::str::from_utf8(&self.generator_version[..end]).unwrap_or("?")
+    }
+
+    /// Number of grid nodes (product of the used axes' node counts), `None` on overflow.
+    pub fn grid_nodes(&self) -> Option<u64> {
+        self.used_axes()
+            .iter()
+            .try_fold(1u64, |acc, axis| acc.checked_mul(u64::from(axis.nodes)))
+    }
+}
+
+/// What is wrong with a table file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FormatError {
+    /// The buffer ends before the header or the payload does.
+    Truncated {
+        /// Bytes the header says the file has (or the header size).
+        needed: u64,
+        /// Bytes present.
+        actual: u64,
+    },
+    /// Bytes follow the end of the payload.
+    TrailingBytes {
+        /// Bytes the header says the file has.
+        expected: u64,
+        /// Bytes present.
+        actual: u64,
+    },
+    /// The file does not start with [`MAGIC`].
+    WrongMagic {
+        /// The first eight bytes.
+        found: [u8; 8],
+    },
+    /// A format version this crate does not read.
+    UnsupportedVersion {
+        /// Version in the file.
+        found: u32,
+    },
+    /// The header size field disagrees with this crate's header layout.
+    HeaderSize {
+        /// Size in the file.
+        found: u32,
+    },
+    /// The buffer does not start on a 64-byte boundary.
+    Misaligned {
+        /// Address of the buffer modulo 64.
+        address_mod_64: usize,
+    },
+    /// An unknown table id tag.
+    UnknownTableId(u32),
+    /// An unknown value type tag.
+    UnknownValueType(u32),
+    /// An unknown axis mapping tag.
+    UnknownMapping {
+        /// Axis index.
+        axis: usize,
+        /// The tag.
+        tag: u32,
+    },
+    /// Axis count outside 1..=4.
+    AxisCount(u32),
+    /// An axis whose fields are inconsistent (see the reason).
+    BadAxis {
+        /// Axis index.
+        axis: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// Some other header field is invalid (see the reason).
+    BadHeader(&'static str),
+    /// `payload_len` disagrees with node counts × channels + aux values.
+    PayloadLength {
+        /// Bytes implied by the node counts, channels and aux count.
+        expected: u64,
+        /// `payload_len` in the header.
+        found: u64,
+    },
+    /// The checksum does not match the contents.
+    ChecksumMismatch {
+        /// Checksum in the header.
+        stored: u64,
+        /// Checksum of the bytes.
+        computed: u64,
+    },
+    /// A payload value is NaN or infinite.
+    NonFinite {
+        /// Index of the value in the payload.
+        index: usize,
+    },
+    /// The file is valid but holds another table than the one asked for.
+    WrongTable {
+        /// The table asked for.
+        expected: TableId,
+        /// The table in the file.
+        found: TableId,
+    },
+    /// The file is valid but its shape is not the one this table kind needs.
+    Shape(&'static str),
+}
+
+impl fmt::Display for FormatError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use FormatError::*;
+        match *self {
+            Truncated { needed, actual } => {
+                write!(f, "truncated table file: {actual} bytes, needs {needed}")
+            }
+            TrailingBytes { expected, actual } => write!(
+                f,
+                "table file has {actual} bytes, but its header describes {expected}"
+            ),
+            WrongMagic { found } => write!(
+                f,
+                "not a twoscale table file: starts with {found:?}, expected {MAGIC:?}"
+            ),
+            UnsupportedVersion { found } => write!(
+                f,
+                "table format version {found} is not supported (this reader knows version {FORMAT_VERSION})"
+            ),
+            HeaderSize { found } => {
+                write!(f, "header size field is {found}, expected {HEADER_SIZE}")
+            }
+            Misaligned { address_mod_64 } => write!(
+                f,
+                "table bytes must start on a {PAYLOAD_ALIGN}-byte boundary (address mod 64 = {address_mod_64}); use twoscale::AlignedBytes"
+            ),
+            UnknownTableId(tag) => write!(f, "unknown table id {tag}"),
+            UnknownValueType(tag) => write!(f, "unknown value type {tag}"),
+            UnknownMapping { axis, tag } => write!(f, "axis {axis}: unknown mapping {tag}"),
+            AxisCount(n) => write!(f, "axis count {n} is outside 1..={MAX_AXES}"),
+            BadAxis { axis, reason } => write!(f, "axis {axis}: {reason}"),
+            BadHeader(reason) => write!(f, "invalid header: {reason}"),
+            PayloadLength { expected, found } => write!(
+                f,
+                "payload length {found} bytes disagrees with the node counts, channels and aux count ({expected} bytes)"
+            ),
+            ChecksumMismatch { stored, computed } => write!(
+                f,
+                "checksum mismatch: header says {stored:#018x}, contents give {computed:#018x}"
+            ),
+            NonFinite { index } => write!(f, "payload value {index} is not finite"),
+            WrongTable { expected, found } => write!(
+                f,
+                "expected table {}, found {}",
+                expected.name(),
+                found.name()
+            ),
+            Shape(reason) => write!(f, "unexpected table shape: {reason}"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for FormatError {}
+
+/// FNV-1a 64 of `bytes`, continuing from `state` (start with [`FNV_OFFSET`]).
+pub const fn fnv1a(mut state: u64, bytes: &[u8]) -> u64 {
+    let mut i = 0;
+    while i < bytes.len() {
+        state ^= bytes[i] as u64;
+        state = state.wrapping_mul(0x0000_0100_0000_01b3);
+        i += 1;
+    }
+    state
+}
+
+/// FNV-1a 64 offset basis.
+pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// The checksum of a whole file image: FNV-1a 64 of every byte except the eight
+/// bytes of [`Header::checksum`]. `file.len()` must be at least [`HEADER_SIZE`].
+pub fn checksum(file: &[u8]) -> u64 {
+    let (before, rest) = file.split_at(CHECKSUM_OFFSET.min(file.len()));
+    let after = rest.get(8..).unwrap_or(&[]);
+    fnv1a(fnv1a(FNV_OFFSET, before), after)
+}
+
+/// Bytes with 64-byte alignment, for embedding a table with `include_bytes!`:
+///
+/// ```ignore
+/// static G1: &twoscale::AlignedBytes<[u8]> =
+///     &twoscale::AlignedBytes(*include_bytes!("../tables/t1-smith-g1.tbl"));
+/// ```
+///
+/// (the [`include_table!`](crate::include_table) macro writes exactly this).
+/// `include_bytes!` alone only guarantees 1-byte alignment, and a table must be
+/// viewable in place as `&[f32]`.
+#[repr(C, align(64))]
+pub struct AlignedBytes<B: ?Sized>(pub B);
+
+impl<B: AsRef<[u8]> + ?Sized> AlignedBytes<B> {
+    /// The wrapped bytes.
+    pub fn bytes(&self) -> &[u8] {
+        self.0.as_ref()
+    }
+}
+
+/// Embeds a table file in the binary with the 64-byte alignment it needs, and
+/// evaluates to a `&'static [u8]` ready for `Table::from_bytes` or a typed table.
+///
+/// ```ignore
+/// let bytes: &'static [u8] = twoscale::include_table!("../tables/t1-smith-g1.tbl");
+/// ```
+#[macro_export]
+macro_rules! include_table {
+    ($path:expr) => {{
+        static TABLE: &$crate::AlignedBytes<[u8]> = &$crate::AlignedBytes(*include_bytes!($path));
+        &TABLE.0
+    }};
+}
+
+/// A validated table file viewed in place: its header, grid and aux values.
+#[derive(Clone, Copy, Debug)]
+pub struct Table<'a> {
+    header: &'a Header,
+    grid: &'a [f32],
+    aux: &'a [f32],
+}
+
+impl<'a> Table<'a> {
+    /// Validates `bytes` as a table file and views it in place. Checks, in order:
+    /// alignment, size, magic, version, header size, enum tags, axes, payload
+    /// offset and length, trailing bytes, checksum, and that every value is finite.
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, FormatError> {
+        let address_mod_64 = bytes.as_ptr() as usize % PAYLOAD_ALIGN;
+        if address_mod_64 != 0 {
+            return Err(FormatError::Misaligned { address_mod_64 });
+        }
+        let actual = bytes.len() as u64;
+        let head = bytes.get(..HEADER_SIZE).ok_or(FormatError::Truncated {
+            needed: HEADER_SIZE as u64,
+            actual,
+        })?;
+        if head[..8] != MAGIC {
+            let mut found = [0; 8];
+            found.copy_from_slice(&head[..8]);
+            return Err(FormatError::WrongMagic { found });
+        }
+        let version = read_u32(head, offset_of!(Header, format_version));
+        if version != FORMAT_VERSION {
+            return Err(FormatError::UnsupportedVersion { found: version });
+        }
+        let header_size = read_u32(head, offset_of!(Header, header_size));
+        if header_size as usize != HEADER_SIZE {
+            return Err(FormatError::HeaderSize { found: header_size });
+        }
+        let header = Header::try_ref_from_bytes(head).map_err(|_| diagnose_tags(head))?;
+        validate_header(header)?;
+
+        let offset = header.payload_offset;
+        let end = offset
+            .checked_add(header.payload_len)
+            .ok_or(FormatError::BadHeader("payload offset + length overflows"))?;
+        if end > actual {
+            return Err(FormatError::Truncated {
+                needed: end,
+                actual,
+            });
+        }
+        if end < actual {
+            return Err(FormatError::TrailingBytes {
+                expected: end,
+                actual,
+            });
+        }
+        let computed = checksum(bytes);
+        if computed != header.checksum {
+            return Err(FormatError::ChecksumMismatch {
+                stored: header.checksum,
+                computed,
+            });
+        }
+        // Bounds and alignment were checked above, so these cannot fail; map the
+        // impossible case to an error rather than panic.
+        let payload = bytes
+            .get(offset as usize..end as usize)
+            .ok_or(FormatError::BadHeader("payload out of bounds"))?;
+        let values = <[f32]>::ref_from_bytes(payload)
+            .map_err(|_| FormatError::BadHeader("payload is not a whole number of aligned f32"))?;
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(FormatError::NonFinite { index });
+        }
+        let grid_len = values.len() - header.aux_count as usize;
+        let (grid, aux) = values.split_at(grid_len);
+        Ok(Table { header, grid, aux })
+    }
+
+    /// Like [`Table::from_bytes`], and also checks the table id.
+    pub fn from_bytes_expecting(bytes: &'a [u8], expected: TableId) -> Result<Self, FormatError> {
+        let table = Self::from_bytes(bytes)?;
+        if table.header.table_id != expected {
+            return Err(FormatError::WrongTable {
+                expected,
+                found: table.header.table_id,
+            });
+        }
+        Ok(table)
+    }
+
+    /// The header.
+    pub fn header(&self) -> &'a Header {
+        self.header
+    }
+
+    /// The grid values, row-major, channels innermost.
+    pub fn grid(&self) -> &'a [f32] {
+        self.grid
+    }
+
+    /// The auxiliary values (meaning fixed per table id).
+    pub fn aux(&self) -> &'a [f32] {
+        self.aux
+    }
+}
+
+fn read_u32(head: &[u8], offset: usize) -> u32 {
+    let mut word = [0u8; 4];
+    if let Some(src) = head.get(offset..offset + 4) {
+        word.copy_from_slice(src);
+    }
+    u32::from_le_bytes(word)
+}
+
+/// zerocopy rejected the header: find which enum tag is invalid.
+fn diagnose_tags(head: &[u8]) -> FormatError {
+    let table_tag = read_u32(head, offset_of!(Header, table_id));
+    if TableId::from_tag(table_tag).is_none() {
+        return FormatError::UnknownTableId(table_tag);
+    }
+    let value_tag = read_u32(head, offset_of!(Header, value_type));
+    if value_tag != ValueType::F32 as u32 {
+        return FormatError::UnknownValueType(value_tag);
+    }
+    for axis in 0..MAX_AXES {
+        let at = offset_of!(Header, axes)
+            + axis * size_of::<AxisHeader>()
+            + offset_of!(AxisHeader, mapping);
+        let tag = read_u32(head, at);
+        if Mapping::from_tag(tag).is_none() {
+            return FormatError::UnknownMapping { axis, tag };
+        }
+    }
+    FormatError::BadHeader("header rejected by layout validation")
+}
+
+/// Checks the fields of a header whose tags are already known to be valid.
+pub fn validate_header(header: &Header) -> Result<(), FormatError> {
+    let count = header.axis_count;
+    if count == 0 || count as usize > MAX_AXES {
+        return Err(FormatError::AxisCount(count));
+    }
+    for (axis, a) in header.axes.iter().enumerate() {
+        if axis >= count as usize {
+            if *a != AxisHeader::UNUSED {
+                return Err(FormatError::BadAxis {
+                    axis,
+                    reason: "unused axis slot is not zeroed",
+                });
+            }
+            continue;
+        }
+        validate_axis(axis, a)?;
+    }
+    if header.channels == 0 {
+        return Err(FormatError::BadHeader("channel count is zero"));
+    }
+    if header.reserved != 0 {
+        return Err(FormatError::BadHeader("reserved field is not zero"));
+    }
+    if header.params.iter().any(|p| !p.is_finite()) {
+        return Err(FormatError::BadHeader(
+            "a generation parameter is not finite",
+        ));
+    }
+    let names = header.table_id.param_names().len();
+    if header.params[names.min(PARAM_COUNT)..]
+        .iter()
+        .any(|&p| p != 0.0)
+    {
+        return Err(FormatError::BadHeader(
+            "an unnamed generation parameter is not zero",
+        ));
+    }
+    if !header.generator_version.is_ascii() {
+        return Err(FormatError::BadHeader("generator version is not ASCII"));
+    }
+    if header.payload_offset % PAYLOAD_ALIGN as u64 != 0
+        || header.payload_offset < HEADER_SIZE as u64
+    {
+        return Err(FormatError::BadHeader(
+            "payload offset is not a multiple of 64 past the header",
+        ));
+    }
+    let expected = header
+        .grid_nodes()
+        .and_then(|n| n.checked_mul(u64::from(header.channels)))
+        .and_then(|n| n.checked_add(u64::from(header.aux_count)))
+        .and_then(|n| n.checked_mul(4))
+        .ok_or(FormatError::BadHeader("node counts overflow"))?;
+    if expected != header.payload_len {
+        return Err(FormatError::PayloadLength {
+            expected,
+            found: header.payload_len,
+        });
+    }
+    Ok(())
+}
+
+fn validate_axis(axis: usize, a: &AxisHeader) -> Result<(), FormatError> {
+    let bad = |reason| Err(FormatError::BadAxis { axis, reason });
+    if a.nodes < 2 {
+        return bad("fewer than 2 nodes");
+    }
+    if !(a.lo.is_finite() && a.hi.is_finite() && a.param.is_finite()) {
+        return bad("non-finite domain or parameter");
+    }
+    if a.lo >= a.hi {
+        return bad("domain is empty (lo >= hi)");
+    }
+    match a.mapping {
+        Mapping::Uniform if a.param != 0.0 => bad("uniform mapping takes no parameter"),
+        Mapping::Log if a.param != 0.0 => bad("log mapping takes no parameter"),
+        Mapping::Log if a.lo <= 0.0 => bad("log mapping needs lo > 0"),
+        Mapping::LogOffset if a.param <= 0.0 => bad("log-offset mapping needs param > 0"),
+        Mapping::LogOffset if a.lo + a.param <= 0.0 => {
+            bad("log-offset mapping needs lo + param > 0")
+        }
+        Mapping::Power if a.param == 0.0 => bad("power mapping needs a non-zero exponent"),
+        Mapping::Power if a.lo <= 0.0 => bad("power mapping needs lo > 0"),
+        _ => Ok(()),
+    }
+}
+
+/// Writing table files (used by the generator).
+#[cfg(feature = "std")]
+pub mod write {
+    use super::*;
+    use std::io::Write;
+    use std::path::Path;
+
+    /// Everything a table file holds, before encoding.
+    #[derive(Clone, Debug)]
+    pub struct TableSpec<'v> {
+        /// What the table holds.
+        pub table_id: TableId,
+        /// Values per node.
+        pub channels: u32,
+        /// Used axes, in storage order.
+        pub axes: &'v [AxisHeader],
+        /// Generation parameters, in the order of [`TableId::param_names`].
+        pub params: &'v [f64],
+        /// Grid values, row-major, channels innermost.
+        pub grid: &'v [f32],
+        /// Auxiliary values.
+        pub aux: &'v [f32],
+        /// Generator version (at most 16 ASCII bytes).
+        pub generator_version: &'v str,
+    }
+
+    /// Encodes a table into the bytes of a file, and validates them by reading
+    /// them back (an encoder bug can never write a file the reader rejects).
+    pub fn encode(spec: &TableSpec<'_>) -> Result<Vec<u8>, FormatError> {
+        if spec.axes.is_empty() || spec.axes.len() > MAX_AXES {
+            return Err(FormatError::AxisCount(spec.axes.len() as u32));
+        }
+        if spec.params.len() != spec.table_id.param_names().len() {
+            return Err(FormatError::BadHeader(
+                "parameter count disagrees with the table's parameter names",
+            ));
+        }
+        let version = spec.generator_version.as_bytes();
+        if version.len() > 16 {
+            return Err(FormatError::BadHeader(
+                "generator version longer than 16 bytes",
+            ));
+        }
+        let mut axes = [AxisHeader::UNUSED; MAX_AXES];
+        axes[..spec.axes.len()].copy_from_slice(spec.axes);
+        let mut params = [0.0; PARAM_COUNT];
+        params[..spec.params.len()].copy_from_slice(spec.params);
+        let mut generator_version = [0u8; 16];
+        generator_version[..version.len()].copy_from_slice(version);
+        let payload_offset = HEADER_SIZE.next_multiple_of(PAYLOAD_ALIGN);
+        let payload_len = (spec.grid.len() + spec.aux.len()) * 4;
+        let mut header = Header {
+            magic: MAGIC,
+            format_version: FORMAT_VERSION,
+            header_size: HEADER_SIZE as u32,
+            table_id: spec.table_id,
+            value_type: ValueType::F32,
+            channels: spec.channels,
+            axis_count: spec.axes.len() as u32,
+            axes,
+            aux_count: spec.aux.len() as u32,
+            reserved: 0,
+            generator_version,
+            params,
+            payload_offset: payload_offset as u64,
+            payload_len: payload_len as u64,
+            checksum: 0,
+        };
+        validate_header(&header)?;
+        let mut file = Vec::with_capacity(payload_offset + payload_len);
+        file.extend_from_slice(header.as_bytes());
+        file.resize(payload_offset, 0);
+        for v in spec.grid.iter().chain(spec.aux) {
+            file.extend_from_slice(&v.to_le_bytes());
+        }
+        header.checksum = checksum(&file);
+        file[..HEADER_SIZE].copy_from_slice(header.as_bytes());
+        // Read it back through the validating reader (from an aligned copy).
+        let aligned = crate::format::aligned_copy(&file);
+        Table::from_bytes(aligned.bytes())?;
+        Ok(file)
+    }
+
+    /// Writes `bytes` to `path` atomically: to a temporary file in the same
+    /// directory, flushed to disk, then renamed over `path`.
+    ///
+    /// Table files are memory-mapped by readers, and a mapped file that is
+    /// truncated or rewritten in place makes every process that maps it crash
+    /// with SIGBUS (or silently see mixed contents). A rename replaces the
+    /// directory entry and leaves any old mapping on the old inode intact, so
+    /// never rewrite a table file in place: always go through this function.
+    pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let name = path
+            .file_name()
+            .ok_or_else(|| std::io::Error::other("table path has no file name"))?;
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".{}.tmp", std::process::id()));
+        let tmp = dir.join(tmp_name);
+        let result = (|| {
+            let mut file = std::fs::File::create(&tmp)?;
+            file.write_all(bytes)?;
+            file.sync_all()?;
+            std::fs::rename(&tmp, path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result
+    }
+}
+
+/// A 64-byte-aligned heap copy of `bytes` (for tests and for reading a file
+/// into memory instead of mapping it).
+#[cfg(feature = "std")]
+pub fn aligned_copy(bytes: &[u8]) -> AlignedBuf {
+    let mut blocks = vec![Block([0; 64]); bytes.len().div_ceil(64)];
+    for (block, chunk) in blocks.iter_mut().zip(bytes.chunks(64)) {
+        block.0[..chunk.len()].copy_from_slice(chunk);
+    }
+    AlignedBuf {
+        blocks,
+        len: bytes.len(),
+    }
+}
+
+#[cfg(feature = "std")]
+#[derive(Clone, Copy, FromBytes, IntoBytes, KnownLayout, Immutable)]
+#[repr(C, align(64))]
+struct Block([u8; 64]);
+
+/// An owned, 64-byte-aligned byte buffer (see [`aligned_copy`]).
+#[cfg(feature = "std")]
+#[derive(Clone)]
+pub struct AlignedBuf {
+    blocks: Vec<Block>,
+    len: usize,
+}
+
+#[cfg(feature = "std")]
+impl AlignedBuf {
+    /// The bytes.
+    pub fn bytes(&self) -> &[u8] {
+        &self.blocks.as_bytes()[..self.len]
+    }
+
+    /// The bytes, mutably (for corruption tests).
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        let len = self.len;
+        &mut self.blocks.as_mut_bytes()[..len]
+    }
+}
