@@ -216,8 +216,13 @@ impl<'a> Grid<'a> {
     /// indices clamp to the last node).
     pub fn node_value(&self, index: [usize; MAX_AXES], channel: usize) -> f32 {
         let mut offset = channel.min(self.channels - 1);
-        for d in 0..self.dims {
-            offset += index[d].min(self.axes[d].nodes() - 1) * self.strides[d];
+        for ((&i, axis), stride) in index
+            .iter()
+            .zip(&self.axes)
+            .zip(&self.strides)
+            .take(self.dims)
+        {
+            offset += i.min(axis.nodes() - 1) * stride;
         }
         self.values.get(offset).copied().unwrap_or(0.0)
     }
@@ -239,18 +244,17 @@ impl<'a> Grid<'a> {
     #[inline]
     pub fn blend<const D: usize>(&self, cells: [(usize, f32); D], channel: usize) -> f32 {
         let mut base = channel;
-        for d in 0..D {
-            base += cells[d].0 * self.strides[d.min(MAX_AXES - 1)];
+        for (&(i, _), stride) in cells.iter().zip(&self.strides) {
+            base += i * stride;
         }
         let mut sum = 0.0f32;
         for corner in 0..(1usize << D) {
             let mut weight = 1.0f32;
             let mut offset = base;
-            for d in 0..D {
-                let (_, t) = cells[d];
+            for (d, (&(_, t), stride)) in cells.iter().zip(&self.strides).enumerate() {
                 if corner >> d & 1 == 1 {
                     weight *= t;
-                    offset += self.strides[d.min(MAX_AXES - 1)];
+                    offset += stride;
                 } else {
                     weight *= 1.0 - t;
                 }
