@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod format;
+pub mod gamma;
 pub mod interp;
 pub mod math;
 

@@ -33,6 +33,12 @@ forward! {
     powf(x, y) -> f64 = powf / pow;
     /// ⌊x⌋ (f64).
     floor(x) -> f64 = floor / floor;
+    /// |x| (f64).
+    abs(x) -> f64 = abs / fabs;
+    /// ∛x (f64).
+    cbrt(x) -> f64 = cbrt / cbrt;
+    /// ln(1 + x) (f64), accurate for small |x|.
+    ln_1p(x) -> f64 = ln_1p / log1p;
     /// e^x (f32).
     expf(x) -> f32 = exp / expf;
     /// ln x (f32).
@@ -53,4 +59,10 @@ forward! {
 #[inline]
 pub fn ln_gamma(x: f64) -> f64 {
     libm::lgamma(x)
+}
+
+/// erfc x = 1 − erf x (f64, libm's in both builds: `std` has no stable erfc).
+#[inline]
+pub fn erfc(x: f64) -> f64 {
+    libm::erfc(x)
 }
