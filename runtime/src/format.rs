@@ -470,18 +470,18 @@ pub struct Table<'a> {
 
 impl<'a> Table<'a> {
     /// Validates `bytes` as a table file and views it in place. Checks, in order:
-    /// alignment, size, magic, version, header size, enum tags, axes, payload
+    /// header size, alignment, magic, version, header size, enum tags, axes, payload
     /// offset and length, trailing bytes, checksum, and that every value is finite.
     pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, FormatError> {
-        let address_mod_64 = bytes.as_ptr() as usize % PAYLOAD_ALIGN;
-        if address_mod_64 != 0 {
-            return Err(FormatError::Misaligned { address_mod_64 });
-        }
         let actual = bytes.len() as u64;
         let head = bytes.get(..HEADER_SIZE).ok_or(FormatError::Truncated {
             needed: HEADER_SIZE as u64,
             actual,
         })?;
+        let address_mod_64 = bytes.as_ptr() as usize % PAYLOAD_ALIGN;
+        if address_mod_64 != 0 {
+            return Err(FormatError::Misaligned { address_mod_64 });
+        }
         if head[..8] != MAGIC {
             let mut found = [0; 8];
             found.copy_from_slice(&head[..8]);

@@ -6,12 +6,21 @@
 //! interpolates them. It is `no_std` unless the `std` feature is enabled, never
 //! allocates, and never panics on a lookup path.
 #![cfg_attr(not(feature = "std"), no_std)]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
+// `!(x > 0.0)` is the guard that also catches NaN, used on purpose throughout.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
+#![allow(clippy::manual_clamp)]
 
+pub mod epd;
 pub mod format;
 pub mod gamma;
 pub mod interp;
 pub mod math;
+#[cfg(feature = "std")]
+pub mod mmap;
+pub mod smith;
 
 pub use format::{AlignedBytes, FormatError, Table, TableId};
+pub use smith::{SmithG1Table, SmithShape};
