@@ -1,5 +1,14 @@
 //! The table generator of the two-scale reflectance model, and the f64
 //! reference implementation every table is measured against.
+//!
+//! - [`quad`]: adaptive quadrature that reports convergence;
+//! - [`reference`]: the f64 reference of SPEC §2 (EPD, Smith Λ, K-correlation, …);
+//! - [`tables`]: one module per table: build (parallel, deterministic) and verify;
+//! - [`query`]: the batch CSV queries of SPEC §6;
+//! - [`rng`]: deterministic random points for verification.
 
 pub mod quad;
+pub mod query;
 pub mod reference;
+pub mod rng;
+pub mod tables;

@@ -59,8 +59,8 @@ pub const P_MIN: f64 = 0.1;
 /// Largest shape parameter `p` accepted by the functions of this module.
 pub const P_MAX: f64 = 10.0;
 
-/// Relative tolerance of the quadrature inside [`lambda`].
-const LAMBDA_TOL: Tolerance = Tolerance::relative(1e-13);
+/// Relative tolerance of the quadrature inside [`lambda`] (recorded in the T1 header).
+pub const LAMBDA_TOL: Tolerance = Tolerance::relative(1e-13);
 
 /// From this `a` on, [`lambda`] uses its three-term asymptotic expansion,
 /// whose relative error there is below `1e-20`.

@@ -1,0 +1,160 @@
+//! Batch queries (SPEC §6): CSV with a header line in, CSV out with the input
+//! columns followed by `table` (the runtime's value from the table files) and
+//! `reference` (the f64 reference).
+//!
+//! Input columns are found by name (any order; extra columns are passed
+//! through). A bad row — wrong field count, a field that is not a number, or a
+//! point where the reference fails — is reported on stderr with its line
+//! number and left out of the output; the other rows are still answered.
+//! Rows are evaluated in parallel and written in input order.
+
+use rayon::prelude::*;
+use std::io::{BufRead, Write};
+use std::path::Path;
+use twoscale::SmithG1Table;
+use twoscale::mmap::MappedFile;
+
+use crate::reference::epd;
+use crate::tables::file_name;
+
+/// Quantities that can be queried, with their input columns.
+pub const QUANTITIES: &[(&str, &[&str])] = &[("g1", &["p", "a"])];
+
+/// Outcome of a query run.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// Rows answered.
+    pub answered: usize,
+    /// Rows reported as bad.
+    pub bad: usize,
+}
+
+/// Evaluates one row's inputs (in the order of the quantity's input columns)
+/// to its output values, or says why it cannot.
+type Evaluator<'t> = Box<dyn Fn(&[f64]) -> Result<Vec<String>, String> + Sync + 't>;
+
+/// Runs query `quantity` over CSV `input`, writing CSV to `output` and one line
+/// per bad row to `errors`. Fails (before reading rows) on an unknown quantity,
+/// a missing table file, or a header without the required columns.
+pub fn run(
+    quantity: &str,
+    tables: &Path,
+    input: impl BufRead,
+    mut output: impl Write,
+    mut errors: impl Write,
+) -> Result<Summary, String> {
+    let (_, columns) = QUANTITIES
+        .iter()
+        .find(|(name, _)| *name == quantity)
+        .ok_or_else(|| {
+            let known: Vec<_> = QUANTITIES.iter().map(|(n, _)| *n).collect();
+            format!(
+                "unknown quantity '{quantity}' (known: {})",
+                known.join(", ")
+            )
+        })?;
+    let mut lines = input.lines().enumerate();
+    let header = loop {
+        match lines.next() {
+            None => return Err("empty input: expected a CSV header line".into()),
+            Some((_, line)) => {
+                let line = line.map_err(|e| format!("reading input: {e}"))?;
+                if !line.trim().is_empty() {
+                    break line;
+                }
+            }
+        }
+    };
+    let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    let positions = columns
+        .iter()
+        .map(|c| {
+            names
+                .iter()
+                .position(|n| n == c)
+                .ok_or_else(|| format!("header lacks column '{c}' (needs {})", columns.join(",")))
+        })
+        .collect::<Result<Vec<usize>, String>>()?;
+
+    // Load the tables before reading rows, so a missing file fails fast.
+    let mapped;
+    let (evaluate, outputs): (Evaluator<'_>, &[&str]) = match quantity {
+        "g1" => {
+            mapped = open(tables, twoscale::TableId::SmithG1)?;
+            let table = SmithG1Table::from_bytes(mapped.bytes())
+                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::SmithG1)))?;
+            (
+                Box::new(move |x: &[f64]| {
+                    let (p, a) = (x[0], x[1]);
+                    let reference = epd::g1(p, a).map_err(|e| format!("reference: {e}"))?;
+                    Ok(vec![
+                        table.g1(p as f32, a as f32).to_string(),
+                        reference.to_string(),
+                    ])
+                }),
+                &["table", "reference"],
+            )
+        }
+        _ => unreachable!("quantity list and dispatch agree"),
+    };
+
+    let rows: Vec<(usize, String)> = lines
+        .map(|(n, line)| (n + 1, line.unwrap_or_default()))
+        .filter(|(_, line)| !line.trim().is_empty())
+        .collect();
+    let results: Vec<Result<String, String>> = rows
+        .par_iter()
+        .map(|(n, line)| {
+            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+            if fields.len() != names.len() {
+                return Err(format!(
+                    "line {n}: {} fields, header has {}",
+                    fields.len(),
+                    names.len()
+                ));
+            }
+            let values = positions
+                .iter()
+                .zip(columns.iter())
+                .map(|(&i, c)| {
+                    fields[i].parse::<f64>().map_err(|_| {
+                        format!("line {n}: column '{c}' is not a number: '{}'", fields[i])
+                    })
+                })
+                .collect::<Result<Vec<f64>, String>>()?;
+            if let Some((c, v)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
+                return Err(format!("line {n}: column '{c}' is not finite: {v}"));
+            }
+            let out = evaluate(&values).map_err(|e| format!("line {n}: {e}"))?;
+            Ok(format!("{},{}", fields.join(","), out.join(",")))
+        })
+        .collect();
+
+    let io = |e: std::io::Error| format!("writing output: {e}");
+    writeln!(output, "{},{}", names.join(","), outputs.join(",")).map_err(io)?;
+    let mut summary = Summary::default();
+    for result in results {
+        match result {
+            Ok(row) => {
+                writeln!(output, "{row}").map_err(io)?;
+                summary.answered += 1;
+            }
+            Err(message) => {
+                writeln!(errors, "{message}").map_err(io)?;
+                summary.bad += 1;
+            }
+        }
+    }
+    Ok(summary)
+}
+
+fn open(dir: &Path, id: twoscale::TableId) -> Result<MappedFile, String> {
+    let path = dir.join(file_name(id));
+    MappedFile::open(&path).map_err(|e| {
+        format!(
+            "cannot open {}: {e} (build it with `generator build {}`)",
+            path.display(),
+            id.name()
+        )
+    })
+}
