@@ -1,0 +1,91 @@
+//! Lookup cost of the tables against their f64 reference and against a
+//! closed-form peer, in one run (compare the ratios; absolute times depend on
+//! the machine). Each iteration evaluates a batch of 1024 pseudo-random inputs.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use std::hint::black_box;
+use twoscale::{SmithG1Table, TableId};
+
+const BATCH: usize = 1024;
+
+/// Beckmann Smith G1 in closed form (the peer T1 must keep up with):
+/// Λ(a) = (erf(μ) − 1)/2 + exp(−μ²)/(2 μ √π), μ = 1/a.
+#[inline]
+fn beckmann_g1(a: f32) -> f32 {
+    if a <= 0.0 {
+        return 1.0;
+    }
+    let mu = 1.0 / a;
+    let lambda = 0.5 * (libm::erff(mu) - 1.0)
+        + libm::expf(-mu * mu) / (2.0 * mu * core::f32::consts::PI.sqrt());
+    1.0 / (1.0 + lambda)
+}
+
+fn inputs(seed: u64) -> Vec<(f32, f32)> {
+    let mut rng = generator::rng::SplitMix64::new(seed);
+    (0..BATCH)
+        .map(|_| {
+            (
+                rng.uniform_in(0.2, 5.0) as f32,
+                rng.log_uniform_in(0.01, 100.0) as f32,
+            )
+        })
+        .collect()
+}
+
+fn smith_g1(c: &mut Criterion) {
+    let buf = suite::read_table(TableId::SmithG1);
+    let table = SmithG1Table::from_bytes(buf.bytes()).expect("valid T1");
+    let points = inputs(1);
+    let shape = table.shape(1.0);
+    let mut group = c.benchmark_group("smith_g1");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    group.bench_function("t1_table_fixed_p", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(_, a) in &points {
+                sum += shape.g1(black_box(a));
+            }
+            sum
+        })
+    });
+    group.bench_function("t1_table_any_p", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(p, a) in &points {
+                sum += table.g1(black_box(p), black_box(a));
+            }
+            sum
+        })
+    });
+    group.bench_function("beckmann_closed_form", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(_, a) in &points {
+                sum += beckmann_g1(black_box(a));
+            }
+            sum
+        })
+    });
+    group.finish();
+
+    // The reference is ~10⁴ times slower: a smaller batch, reported per element.
+    const REFERENCE_BATCH: usize = 64;
+    let mut group = c.benchmark_group("smith_g1");
+    group.throughput(Throughput::Elements(REFERENCE_BATCH as u64));
+    group.sample_size(10);
+    group.bench_function("f64_reference", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f64;
+            for &(p, a) in points.iter().take(REFERENCE_BATCH) {
+                sum += generator::reference::epd::g1(black_box(p as f64), black_box(a as f64))
+                    .unwrap_or(0.0);
+            }
+            sum
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, smith_g1);
+criterion_main!(benches);
