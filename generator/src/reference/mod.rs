@@ -9,3 +9,4 @@
 //!   sampling (HP17 49–50) and its Smith masking term Λ, G1 (HP17 36–38).
 
 pub mod epd;
+pub mod kcorr;
