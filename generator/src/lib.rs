@@ -2,3 +2,4 @@
 //! reference implementation every table is measured against.
 
 pub mod quad;
+pub mod reference;
