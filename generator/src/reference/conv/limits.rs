@@ -45,8 +45,33 @@
 //! `D` (`θh ≲ β`, non-integer `p`), `Δ_S D` does not exist and the error of
 //! (a) is `O((uβ)^(−2p))`. The `D` of small `p` has stretched-exponential
 //! tails, so in (b) the relevant width is `w_D` of [`Params::ndf_width`],
-//! not `β`. The measured thresholds are in the tests (`limits_accuracy_sweep`)
-//! and in the documentation of [`crate::reference::conv::convolution`].
+//! not `β`.
+//!
+//! Measured relative errors against the direct quadrature (test
+//! `limits_accuracy_sweep`):
+//!
+//! * (a), smooth `D` (`p = 1, 5`), `θh ≤ 0.3`, leading / corrected form:
+//!   `c = 10`: `≈ 0.07 (uβ)^(−2)` / `≈ 4e-3 (uβ)^(−4)`, so `1e-6` is reached
+//!   at `uβ ≈ 300` / `uβ ≈ 10–30`; `c = 4`: `≈ 5 (uβ)^(−2)` /
+//!   `≈ 0.06 (uβ)^(−3)`, `1e-6` at `uβ ≈ 2000` / `≈ 50–100`; `c = 2`:
+//!   `≈ 0.3/(uβ)` / `≈ 0.1/(uβ)`, never `1e-6` in the domain; `c = 1.01`:
+//!   1–10% whatever `u`. At larger `θh`, in the tail of `D`, the kernel's
+//!   own tail takes over (`C → W_D K(θh)`) and (a) fails (error → 1 at
+//!   `β = 0.3`, `θh = 0.8`, `c ≤ 2`). At the cusp (`θh = 0`, `p < 1`) the
+//!   leading form errs by `≈ 1e-2 … 1e-4` and there is no correction.
+//! * (b), `u = 0`, `p = 1` or 5: leading `≈ β²` (`4e-6` at `β = 0.002`),
+//!   corrected `≈ 1e-11` at `β = 0.002`, `4e-7` at `β = 0.03`: `1e-6` for
+//!   `β ≲ 0.03`. With a peaked kernel what matters is `u w_D`: the corrected
+//!   form is within `1e-6` for `u w_D ≲ 5e-3` at `θh = 0` (`u = 1`,
+//!   `β ≤ 0.005`), and within `1e-6` at `θh ≥ 0.3` up to `u w_D ≈ 0.05`.
+//!   For `p = 0.2` (b) is never better than a few percent, even at
+//!   `β = 0.002`, `u = 0`: the stretched-exponential tail of `D` reaches
+//!   `tan θ ~ 10³ β`.
+//!
+//! So within the table domain the limiting forms reach the `1e-6` of the
+//! reference only in corners (`c ≳ 4` with `uβ ≳ 100`; `u ≲ 1` with narrow
+//! smooth `D`); they are checks and asymptotes, not a substitute for the
+//! two full methods.
 
 use super::{ConvError, Params, kernel_sc, ndf_peak, ndf_sc};
 use crate::quad::{Tolerance, integrate, integrate_to_infinity};

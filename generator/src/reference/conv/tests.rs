@@ -638,7 +638,10 @@ fn corner_sweep() {
                         }
                         Err(e) => panic!("{label}: {e}"),
                     };
-                    println!("{label} | {zh_part} | {mf:.1e} at {at_f:.4} | {t_n:.1} {t_h:.1}");
+                    let est = zh_band_estimate(&Params::new(u, c, beta, p).unwrap());
+                    println!(
+                        "{label} | est {est:6} | {zh_part} | {mf:.1e} at {at_f:.4} | {t_n:.1} {t_h:.1}"
+                    );
                 }
             }
         }
@@ -743,5 +746,21 @@ fn profile_timings() {
             "u={u} c={c} β={beta} p={p} (L est {}): {m:?} {dt:.2?}; direct {dd:.2?}; max diff {worst:.1e}",
             zh_band_estimate(&Params::new(u, c, beta, p).unwrap())
         );
+    }
+}
+
+/// SPEC §2.5 says `L = 400` leaves `e_L2 ≈ 2e-4` at `p = 0.2, u = 30,
+/// β = 0.5`; prints the measured value for several `c`.
+#[test]
+#[ignore]
+fn spec_claim_l400() {
+    for &c in &[1.01, 2.0, 3.0, 10.0] {
+        let (u, beta, p) = (30.0, 0.5, 0.2);
+        let params = Params::new(u, c, beta, p).unwrap();
+        let (k, d) = (params.kernel(), params.ndf());
+        let a = legendre_moments(|s, co| k.value(s, co), &k.breakpoints(), 400);
+        let b = legendre_moments(|s, co| d.value(s, co), &d.breakpoints(), 400);
+        let e = e_l2_for(|t| zh_series(&a, &b, 400, t), u, c, beta, p).unwrap();
+        println!("c={c}: e_L2(L=400) = {e:.2e}");
     }
 }
