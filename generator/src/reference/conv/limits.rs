@@ -62,8 +62,8 @@
 //! * (b), `u = 0`, `p = 1` or 5: leading `≈ β²` (`4e-6` at `β = 0.002`),
 //!   corrected `≈ 1e-11` at `β = 0.002`, `4e-7` at `β = 0.03`: `1e-6` for
 //!   `β ≲ 0.03`. With a peaked kernel what matters is `u w_D`: the corrected
-//!   form is within `1e-6` for `u w_D ≲ 5e-3` at `θh = 0` (`u = 1`,
-//!   `β ≤ 0.005`), and within `1e-6` at `θh ≥ 0.3` up to `u w_D ≈ 0.05`.
+//!   form is within `1e-6` for `u w_D ≲ 5e-3` (`c = 10`, or `θh = 0`), up
+//!   to `u w_D ≈ 0.04` for `c ≈ 1` away from the peak (`θh ≥ 0.3`).
 //!   For `p = 0.2` (b) is never better than a few percent, even at
 //!   `β = 0.002`, `u = 0`: the stretched-exponential tail of `D` reaches
 //!   `tan θ ~ 10³ β`.
