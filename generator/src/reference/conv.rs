@@ -31,9 +31,10 @@
 //! and the **limiting forms** of module `limits` ([`narrow_kernel_limit`],
 //! [`narrow_ndf_limit`]) for one lobe much narrower than the other.
 //!
-//! [`convolution`] and [`convolution_profile`] choose the method: zonal
-//! harmonics when the band limit it needs is affordable, the direct
-//! quadrature otherwise (see [`Method`]). [`e_l2`] implements the error metric
+//! [`convolution`] (one angle) uses the direct quadrature;
+//! [`convolution_profile`] (many angles at one parameter point) chooses:
+//! zonal harmonics when the band limit they need is affordable, the direct
+//! quadrature otherwise (see [`convolution_profile_with_method`]). [`e_l2`] implements the error metric
 //! of SPEC §2.5 with a quadrature in `θh` graded to the profile's width.
 //!
 //! # Accuracy target
@@ -75,8 +76,8 @@ use crate::quad::{QuadError, gauss_legendre};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 
-/// The accuracy the public entry points aim at (relative, with the absolute
-/// floor `TARGET · C(0)`).
+/// The accuracy the public entry points aim at: relative, with an absolute
+/// floor of `TARGET · TARGET · C(0)` in the deep tails.
 pub const TARGET: f64 = 1e-6;
 
 /// Why a convolution could not be computed.

@@ -832,3 +832,18 @@ fn random_sweep() {
     println!("worst frames {worst_frames:.2e}, worst zh {worst_zh:.2e} over {n_zh} zh points");
     assert!(worst_frames <= TARGET && worst_zh <= TARGET);
 }
+
+#[test]
+fn outside_the_domain_is_finite_or_an_error() {
+    // Beyond the table domain the reference is still defined; it must
+    // return a finite non-negative value or an error, never panic or NaN.
+    for &(t, u, c, beta, p) in &[
+        (0.1, 1e5, 1.001, 1e-4, 0.1),
+        (1.5, 1e-3, 50.0, 3.0, 8.0),
+        (FRAC_PI_2, 5000.0, 1.5, 0.001, 0.15),
+    ] {
+        if let Ok(v) = convolution(t, u, c, beta, p) {
+            assert!(v.is_finite() && v >= 0.0, "{t} {u} {c} {beta} {p}: {v}");
+        }
+    }
+}
