@@ -7,6 +7,12 @@
 //!
 //! * [`epd`]: the Exponential Power Distribution NDF of (HP17 34–35), its
 //!   sampling (HP17 49–50) and its Smith masking term Λ, G1 (HP17 36–38).
+//! * [`kcorr`]: the K-correlation spectrum (HP17 16) and the renormalisation
+//!   σrel/σs (HP17 17–19).
+//! * [`conv`]: the normalised spherical convolution `C(θh; u, c, β, p)` of
+//!   SPEC §2.5 (HP17 32–33, 61–64), by zonal harmonics and by direct 2-D
+//!   quadrature.
 
+pub mod conv;
 pub mod epd;
 pub mod kcorr;
