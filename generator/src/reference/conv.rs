@@ -73,6 +73,7 @@ pub use limits::{
 pub use zh::{ZhOptions, ZhProfile, convolution_zh, legendre_moments, zh_band_estimate, zh_series};
 
 use crate::quad::{QuadError, gauss_legendre};
+pub(crate) use crate::reference::epd::{ndf_peak, ndf_sin_cos as ndf_sc};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 
@@ -216,41 +217,6 @@ impl Params {
             })
         }
     }
-}
-
-/// `p / (π β² Γ(1/p))`, the value of the EPD NDF at the normal (HP17 35).
-fn ndf_peak(beta: f64, p: f64) -> f64 {
-    p / (PI * beta * beta) * (-libm::lgamma(1.0 / p)).exp()
-}
-
-/// The EPD NDF (HP17 34–35) as a function of `cos θ`:
-/// `D = χ(θ < π/2) · p/(π β² Γ(1/p)) · exp(−(tan²θ/β²)^p) / cos⁴θ`.
-///
-/// This duplicates `reference::epd` (written on another branch) and is to be
-/// replaced by it when the branches merge. Internally the module uses
-/// [`ndf_sc`], which takes `sin θ` as well, because `tan θ` from
-/// `√(1 − cos²θ)` loses digits for the narrow lobes (`β = 0.002`).
-#[allow(dead_code)]
-fn ndf(beta: f64, p: f64, cos_theta: f64) -> f64 {
-    let sin_theta = ((1.0 - cos_theta) * (1.0 + cos_theta)).max(0.0).sqrt();
-    ndf_sc(beta, p, ndf_peak(beta, p), sin_theta, cos_theta)
-}
-
-/// The EPD NDF from `sin θ ≥ 0` and `cos θ` (and the precomputed
-/// [`ndf_peak`]). `tan²θ/β² = (sin θ / (β cos θ))²` and the value is
-/// evaluated as `peak · exp(−z − 4 ln cos θ)`, `z = (tan²θ/β²)^p`, so that it
-/// underflows to 0 at the horizon instead of producing `0/0`.
-fn ndf_sc(beta: f64, p: f64, peak: f64, sin_theta: f64, cos_theta: f64) -> f64 {
-    if cos_theta.is_nan() || cos_theta <= 0.0 {
-        return 0.0;
-    }
-    let r = sin_theta / (beta * cos_theta); // tan θ / β
-    let z = if r > 0.0 {
-        (2.0 * p * r.ln()).exp()
-    } else {
-        0.0
-    };
-    peak * (-z - 4.0 * cos_theta.ln()).exp()
 }
 
 /// The kernel `K(γ) = k(2u sin γ) cos²γ` with `k(x) = (1 + x²)^(−q)`,

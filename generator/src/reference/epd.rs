@@ -106,6 +106,30 @@ pub fn p22_unit(p: f64, x: f64) -> f64 {
     unit_norm(p) * libm::exp(-libm::pow(x, p))
 }
 
+/// `p / (π β² Γ(1/p))`, the value of the EPD NDF at the normal (HP17 35).
+pub fn ndf_peak(beta: f64, p: f64) -> f64 {
+    p / (PI * beta * beta) * (-libm::lgamma(1.0 / p)).exp()
+}
+
+/// The EPD NDF (HP17 34–35) from `sin θ ≥ 0`, `cos θ` and the precomputed
+/// [`ndf_peak`]: `tan²θ/β² = (sin θ / (β cos θ))²` and the value is evaluated
+/// as `peak · exp(−z − 4 ln cos θ)`, `z = (tan²θ/β²)^p`, so that it underflows
+/// to 0 at the horizon instead of producing `0/0`. Taking `sin θ` keeps full
+/// precision near the normal, where `√(1 − cos²θ)` loses digits (β = 0.002).
+/// Used by the convolution reference, whose lobes can be that narrow.
+pub fn ndf_sin_cos(beta: f64, p: f64, peak: f64, sin_theta: f64, cos_theta: f64) -> f64 {
+    if cos_theta.is_nan() || cos_theta <= 0.0 {
+        return 0.0;
+    }
+    let r = sin_theta / (beta * cos_theta); // tan θ / β
+    let z = if r > 0.0 {
+        (2.0 * p * r.ln()).exp()
+    } else {
+        0.0
+    };
+    peak * (-z - 4.0 * cos_theta.ln()).exp()
+}
+
 /// An EPD microfacet distribution with width `beta` (β) and shape `p`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Epd {
