@@ -51,11 +51,14 @@ pub const HEADER_SIZE: usize = size_of::<Header>();
 pub enum TableId {
     /// T1: Smith G1 of the EPD NDF over (p, ã = k_p·a); see [`crate::smith`].
     SmithG1 = 1,
+    /// T2: σrel/σs of the K-correlation spectrum over (cos θi, B = b/λ, c);
+    /// see [`crate::kcorr`].
+    SigmaRatio = 2,
 }
 
 impl TableId {
     /// Every table id, in tag order.
-    pub const ALL: [TableId; 1] = [TableId::SmithG1];
+    pub const ALL: [TableId; 2] = [TableId::SmithG1, TableId::SigmaRatio];
 
     /// The tag stored in the file.
     pub const fn tag(self) -> u32 {
@@ -71,6 +74,7 @@ impl TableId {
     pub const fn name(self) -> &'static str {
         match self {
             TableId::SmithG1 => "t1-smith-g1",
+            TableId::SigmaRatio => "t2-sigma-ratio",
         }
     }
 
@@ -80,6 +84,9 @@ impl TableId {
             TableId::SmithG1 => {
                 "Smith G1 of the EPD NDF (HP17 36-38), axes p and k_p*beta*tan(theta); aux = k_p per p node"
             }
+            TableId::SigmaRatio => {
+                "sigma_rel/sigma_s of the K-correlation spectrum (HP17 17-19) divided by its closed form at normal incidence; cubic B-spline coefficients"
+            }
         }
     }
 
@@ -87,6 +94,7 @@ impl TableId {
     pub const fn axis_names(self) -> &'static [&'static str] {
         match self {
             TableId::SmithG1 => &["p", "a_scaled"],
+            TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
         }
     }
 
@@ -95,6 +103,7 @@ impl TableId {
     pub const fn param_names(self) -> &'static [&'static str] {
         match self {
             TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
+            TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
         }
     }
 }
@@ -108,6 +117,36 @@ pub enum ValueType {
     F32 = 1,
 }
 
+/// How the payload is interpolated, which also fixes what it holds.
+#[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Kernel {
+    /// n-linear interpolation of the samples at the nodes: `nodes` values per axis.
+    Multilinear = 1,
+    /// Uniform cubic B-spline in the mapped coordinates: the payload holds the
+    /// spline's coefficients, `nodes + 2` per axis (one beyond each end node),
+    /// prefiltered by the generator so that the spline interpolates the samples.
+    CubicBSpline = 2,
+}
+
+impl Kernel {
+    /// Every kernel, in tag order.
+    pub const ALL: [Kernel; 2] = [Kernel::Multilinear, Kernel::CubicBSpline];
+
+    /// The kernel with this tag, if any.
+    pub fn from_tag(tag: u32) -> Option<Kernel> {
+        Self::ALL.into_iter().find(|k| *k as u32 == tag)
+    }
+
+    /// Stored values along an axis of `nodes` nodes.
+    pub const fn stored_per_axis(self, nodes: u32) -> u64 {
+        match self {
+            Kernel::Multilinear => nodes as u64,
+            Kernel::CubicBSpline => nodes as u64 + 2,
+        }
+    }
+}
+
 /// How an axis maps a physical value `x` to the coordinate `c(x)` in which its
 /// nodes are evenly spaced. Interpolation is linear in `c`. The numeric tags are
 /// part of the file format; `param` is the mapping's parameter in [`AxisHeader`].
@@ -118,8 +157,9 @@ pub enum Mapping {
     Uniform = 1,
     /// `c = ln x` (requires `lo > 0`).
     Log = 2,
-    /// `c = ln(x + param)`, `param > 0`: logarithmic for `x ≫ param`, linear near 0,
-    /// and `x = 0` is a node.
+    /// `c = ln(x + param) + param2·x`, `lo + param > 0`, `param2 ≥ 0`:
+    /// logarithmic for `x ≫ param`, linear near `−param`; the optional linear
+    /// term spreads the nodes again where the logarithm has crowded them out.
     LogOffset = 3,
     /// `c = x^param`, `param ≠ 0` (requires `lo > 0`); a negative exponent puts
     /// more nodes at small `x`.
@@ -141,10 +181,11 @@ impl Mapping {
     }
 
     /// Human-readable form, e.g. `ln(x + 0.01)`.
-    pub fn describe(self, param: f64) -> MappingDisplay {
+    pub fn describe(self, param: f64, param2: f64) -> MappingDisplay {
         MappingDisplay {
             mapping: self,
             param,
+            param2,
         }
     }
 }
@@ -153,6 +194,7 @@ impl Mapping {
 pub struct MappingDisplay {
     mapping: Mapping,
     param: f64,
+    param2: f64,
 }
 
 impl fmt::Display for MappingDisplay {
@@ -160,6 +202,9 @@ impl fmt::Display for MappingDisplay {
         match self.mapping {
             Mapping::Uniform => write!(f, "x"),
             Mapping::Log => write!(f, "ln(x)"),
+            Mapping::LogOffset if self.param2 != 0.0 => {
+                write!(f, "ln(x + {}) + {}·x", self.param, self.param2)
+            }
             Mapping::LogOffset => write!(f, "ln(x + {})", self.param),
             Mapping::Power => write!(f, "x^{}", self.param),
         }
@@ -181,6 +226,8 @@ pub struct AxisHeader {
     pub hi: f64,
     /// Parameter of the mapping (see [`Mapping`]); 0 when it has none.
     pub param: f64,
+    /// Second parameter of the mapping (see [`Mapping`]); 0 when it has none.
+    pub param2: f64,
 }
 
 impl AxisHeader {
@@ -191,6 +238,7 @@ impl AxisHeader {
         lo: 0.0,
         hi: 0.0,
         param: 0.0,
+        param2: 0.0,
     };
 }
 
@@ -219,8 +267,8 @@ pub struct Header {
     pub axes: [AxisHeader; MAX_AXES],
     /// Number of auxiliary `f32` values after the grid (meaning fixed per table id).
     pub aux_count: u32,
-    /// Zero.
-    pub reserved: u32,
+    /// How the grid is interpolated (and so how many values each axis stores).
+    pub kernel: Kernel,
     /// Version of the generator that wrote the file, ASCII, NUL-padded.
     pub generator_version: [u8; 16],
     /// Generation parameters (names in [`TableId::param_names`]); unused slots zero.
@@ -252,11 +300,12 @@ impl Header {
         core::str::from_utf8(&self.generator_version[..end]).unwrap_or("?")
     }
 
-    /// Number of grid nodes (product of the used axes' node counts), `None` on overflow.
-    pub fn grid_nodes(&self) -> Option<u64> {
-        self.used_axes()
-            .iter()
-            .try_fold(1u64, |acc, axis| acc.checked_mul(u64::from(axis.nodes)))
+    /// Number of stored grid values per channel (product over the used axes of
+    /// the values the kernel stores per axis), `None` on overflow.
+    pub fn grid_values(&self) -> Option<u64> {
+        self.used_axes().iter().try_fold(1u64, |acc, axis| {
+            acc.checked_mul(self.kernel.stored_per_axis(axis.nodes))
+        })
     }
 }
 
@@ -301,6 +350,8 @@ pub enum FormatError {
     UnknownTableId(u32),
     /// An unknown value type tag.
     UnknownValueType(u32),
+    /// An unknown interpolation kernel tag.
+    UnknownKernel(u32),
     /// An unknown axis mapping tag.
     UnknownMapping {
         /// Axis index.
@@ -377,6 +428,7 @@ impl fmt::Display for FormatError {
             ),
             UnknownTableId(tag) => write!(f, "unknown table id {tag}"),
             UnknownValueType(tag) => write!(f, "unknown value type {tag}"),
+            UnknownKernel(tag) => write!(f, "unknown interpolation kernel {tag}"),
             UnknownMapping { axis, tag } => write!(f, "axis {axis}: unknown mapping {tag}"),
             AxisCount(n) => write!(f, "axis count {n} is outside 1..={MAX_AXES}"),
             BadAxis { axis, reason } => write!(f, "axis {axis}: {reason}"),
@@ -582,6 +634,10 @@ fn diagnose_tags(head: &[u8]) -> FormatError {
     if value_tag != ValueType::F32 as u32 {
         return FormatError::UnknownValueType(value_tag);
     }
+    let kernel_tag = read_u32(head, offset_of!(Header, kernel));
+    if Kernel::from_tag(kernel_tag).is_none() {
+        return FormatError::UnknownKernel(kernel_tag);
+    }
     for axis in 0..MAX_AXES {
         let at = offset_of!(Header, axes)
             + axis * size_of::<AxisHeader>()
@@ -615,9 +671,6 @@ pub fn validate_header(header: &Header) -> Result<(), FormatError> {
     if header.channels == 0 {
         return Err(FormatError::BadHeader("channel count is zero"));
     }
-    if header.reserved != 0 {
-        return Err(FormatError::BadHeader("reserved field is not zero"));
-    }
     if header.params.iter().any(|p| !p.is_finite()) {
         return Err(FormatError::BadHeader(
             "a generation parameter is not finite",
@@ -643,7 +696,7 @@ pub fn validate_header(header: &Header) -> Result<(), FormatError> {
         ));
     }
     let expected = header
-        .grid_nodes()
+        .grid_values()
         .and_then(|n| n.checked_mul(u64::from(header.channels)))
         .and_then(|n| n.checked_add(u64::from(header.aux_count)))
         .and_then(|n| n.checked_mul(4))
@@ -662,20 +715,23 @@ fn validate_axis(axis: usize, a: &AxisHeader) -> Result<(), FormatError> {
     if a.nodes < 2 {
         return bad("fewer than 2 nodes");
     }
-    if !(a.lo.is_finite() && a.hi.is_finite() && a.param.is_finite()) {
+    if !(a.lo.is_finite() && a.hi.is_finite() && a.param.is_finite() && a.param2.is_finite()) {
         return bad("non-finite domain or parameter");
     }
     if a.lo >= a.hi {
         return bad("domain is empty (lo >= hi)");
     }
+    if a.mapping != Mapping::LogOffset && a.param2 != 0.0 {
+        return bad("only the log-offset mapping takes a second parameter");
+    }
     match a.mapping {
         Mapping::Uniform if a.param != 0.0 => bad("uniform mapping takes no parameter"),
         Mapping::Log if a.param != 0.0 => bad("log mapping takes no parameter"),
         Mapping::Log if a.lo <= 0.0 => bad("log mapping needs lo > 0"),
-        Mapping::LogOffset if a.param <= 0.0 => bad("log-offset mapping needs param > 0"),
         Mapping::LogOffset if a.lo + a.param <= 0.0 => {
             bad("log-offset mapping needs lo + param > 0")
         }
+        Mapping::LogOffset if a.param2 < 0.0 => bad("log-offset mapping needs param2 >= 0"),
         Mapping::Power if a.param == 0.0 => bad("power mapping needs a non-zero exponent"),
         Mapping::Power if a.lo <= 0.0 => bad("power mapping needs lo > 0"),
         _ => Ok(()),
@@ -696,6 +752,8 @@ pub mod write {
         pub table_id: TableId,
         /// Values per node.
         pub channels: u32,
+        /// The interpolation kernel (B-spline grids hold prefiltered coefficients).
+        pub kernel: Kernel,
         /// Used axes, in storage order.
         pub axes: &'v [AxisHeader],
         /// Generation parameters, in the order of [`TableId::param_names`].
@@ -743,7 +801,7 @@ pub mod write {
             axis_count: spec.axes.len() as u32,
             axes,
             aux_count: spec.aux.len() as u32,
-            reserved: 0,
+            kernel: spec.kernel,
             generator_version,
             params,
             payload_offset: payload_offset as u64,

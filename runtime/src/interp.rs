@@ -5,10 +5,15 @@
 //! a cell index `i` and a fraction `t ∈ [0, 1]`, by mapping `x` to the coordinate
 //! `c(x)` of its [`Mapping`] (in which the nodes are evenly spaced). Values
 //! outside `[lo, hi]` clamp to the end nodes; NaN clamps to `lo`. A [`Grid`]
-//! combines up to four axes with a value slice and blends its `2^D` corner values
-//! with the product weights `Π (t_d or 1 − t_d)`.
+//! combines up to four axes with a value slice and, depending on its
+//! [`Kernel`]:
+//! - multilinear: blends its `2^D` corner values with the product weights
+//!   `Π (t_d or 1 − t_d)`;
+//! - cubic B-spline: blends `4^D` coefficients with the product of the uniform
+//!   cubic B-spline weights `(1−t)³/6, (3t³−6t²+4)/6, (−3t³+3t²+3t+1)/6, t³/6`
+//!   on coefficients `i … i+3` of each axis (coefficient `j` sits at node `j − 1`).
 
-use crate::format::{AxisHeader, FormatError, Header, MAX_AXES, Mapping};
+use crate::format::{AxisHeader, FormatError, Header, Kernel, MAX_AXES, Mapping};
 use crate::math;
 
 /// One axis of a grid, ready for lookups.
@@ -16,6 +21,7 @@ use crate::math;
 pub struct Axis {
     mapping: Mapping,
     param: f32,
+    param2: f32,
     lo: f32,
     hi: f32,
     /// `c(lo)`.
@@ -33,8 +39,9 @@ impl Axis {
         let cells = header.nodes.saturating_sub(1);
         let mapping = header.mapping;
         let param = header.param as f32;
-        let c_lo = coordinate(mapping, param, header.lo as f32);
-        let c_hi = coordinate(mapping, param, header.hi as f32);
+        let param2 = header.param2 as f32;
+        let c_lo = coordinate(mapping, param, param2, header.lo as f32);
+        let c_hi = coordinate(mapping, param, param2, header.hi as f32);
         let scale = cells as f32 / (c_hi - c_lo);
         if cells == 0
             || !c_lo.is_finite()
@@ -50,6 +57,7 @@ impl Axis {
         Ok(Axis {
             mapping,
             param,
+            param2,
             lo: header.lo as f32,
             hi: header.hi as f32,
             c_lo,
@@ -79,7 +87,8 @@ impl Axis {
     pub fn locate(&self, x: f32) -> (usize, f32) {
         // `max`/`min` of f32 return the non-NaN operand, so NaN becomes lo.
         let x = x.max(self.lo).min(self.hi);
-        let position = (coordinate(self.mapping, self.param, x) - self.c_lo) * self.scale;
+        let position =
+            (coordinate(self.mapping, self.param, self.param2, x) - self.c_lo) * self.scale;
         self.split(position)
     }
 
@@ -101,32 +110,49 @@ impl Axis {
 
 /// `c(x)` of a mapping, in f32 (lookups).
 #[inline]
-fn coordinate(mapping: Mapping, param: f32, x: f32) -> f32 {
+fn coordinate(mapping: Mapping, param: f32, param2: f32, x: f32) -> f32 {
     match mapping {
         Mapping::Uniform => x,
         Mapping::Log => math::lnf(x),
-        Mapping::LogOffset => math::lnf(x + param),
+        Mapping::LogOffset => math::lnf(x + param) + param2 * x,
         Mapping::Power => math::powff(x, param),
     }
 }
 
-/// `c(x)` of a mapping, in f64 (node placement by the generator).
-pub fn coordinate_f64(mapping: Mapping, param: f64, x: f64) -> f64 {
-    match mapping {
+/// `c(x)` of an axis's mapping, in f64 (node placement by the generator).
+pub fn coordinate_f64(axis: &AxisHeader, x: f64) -> f64 {
+    match axis.mapping {
         Mapping::Uniform => x,
         Mapping::Log => math::ln(x),
-        Mapping::LogOffset => math::ln(x + param),
-        Mapping::Power => math::powf(x, param),
+        Mapping::LogOffset => math::ln(x + axis.param) + axis.param2 * x,
+        Mapping::Power => math::powf(x, axis.param),
     }
 }
 
-/// The inverse of [`coordinate_f64`]: `x(c)`.
-pub fn inverse_coordinate_f64(mapping: Mapping, param: f64, c: f64) -> f64 {
-    match mapping {
+/// The inverse of [`coordinate_f64`]: `x(c)`. Closed form where there is one;
+/// for the log-offset mapping with a linear term, bisection on `[lo, hi]`
+/// (the mapping is increasing), to full f64 precision.
+pub fn inverse_coordinate_f64(axis: &AxisHeader, c: f64) -> f64 {
+    match axis.mapping {
         Mapping::Uniform => c,
         Mapping::Log => math::exp(c),
-        Mapping::LogOffset => math::exp(c) - param,
-        Mapping::Power => math::powf(c, 1.0 / param),
+        Mapping::LogOffset if axis.param2 == 0.0 => math::exp(c) - axis.param,
+        Mapping::LogOffset => {
+            let (mut lo, mut hi) = (axis.lo, axis.hi);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if coordinate_f64(axis, mid) < c {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        }
+        Mapping::Power => math::powf(c, 1.0 / axis.param),
     }
 }
 
@@ -140,10 +166,10 @@ pub fn node_value(header: &AxisHeader, i: usize) -> f64 {
     if i >= cells {
         return header.hi;
     }
-    let c_lo = coordinate_f64(header.mapping, header.param, header.lo);
-    let c_hi = coordinate_f64(header.mapping, header.param, header.hi);
+    let c_lo = coordinate_f64(header, header.lo);
+    let c_hi = coordinate_f64(header, header.hi);
     let c = c_lo + (c_hi - c_lo) * (i as f64 / cells as f64);
-    inverse_coordinate_f64(header.mapping, header.param, c)
+    inverse_coordinate_f64(header, c)
 }
 
 /// An n-dimensional grid of values over up to [`MAX_AXES`] axes.
@@ -153,7 +179,7 @@ pub struct Grid<'a> {
     /// Strides in values (channels included), per axis.
     strides: [usize; MAX_AXES],
     dims: usize,
-    channels: usize,
+    kernel: Kernel,
     values: &'a [f32],
 }
 
@@ -165,6 +191,7 @@ impl<'a> Grid<'a> {
         let placeholder = Axis {
             mapping: Mapping::Uniform,
             param: 0.0,
+            param2: 0.0,
             lo: 0.0,
             hi: 1.0,
             c_lo: 0.0,
@@ -181,9 +208,10 @@ impl<'a> Grid<'a> {
         let channels = header.channels as usize;
         let mut strides = [0; MAX_AXES];
         let mut stride = channels;
+        let kernel = header.kernel;
         for d in (0..used.len()).rev() {
             strides[d] = stride;
-            stride *= axes[d].nodes();
+            stride *= kernel.stored_per_axis(axes[d].cells + 1) as usize;
         }
         if stride != values.len() {
             return Err(FormatError::Shape("grid length disagrees with the axes"));
@@ -192,7 +220,7 @@ impl<'a> Grid<'a> {
             axes,
             strides,
             dims: used.len(),
-            channels,
+            kernel,
             values,
         })
     }
@@ -212,31 +240,48 @@ impl<'a> Grid<'a> {
         self.values
     }
 
-    /// The stored value at integer node indices (for tests; out-of-range
-    /// indices clamp to the last node).
-    pub fn node_value(&self, index: [usize; MAX_AXES], channel: usize) -> f32 {
-        let mut offset = channel.min(self.channels - 1);
-        for ((&i, axis), stride) in index
-            .iter()
-            .zip(&self.axes)
-            .zip(&self.strides)
-            .take(self.dims)
-        {
-            offset += i.min(axis.nodes() - 1) * stride;
-        }
-        self.values.get(offset).copied().unwrap_or(0.0)
+    /// The interpolation kernel.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
     }
 
-    /// n-linear interpolation of channel `channel` at the physical point `x`.
-    /// `D` must equal [`Grid::dims`] (typed tables guarantee it); out-of-domain
-    /// coordinates clamp to the end nodes.
+    /// Interpolation of channel `channel` at the physical point `x` with the
+    /// grid's kernel. `D` must equal [`Grid::dims`] (typed tables guarantee
+    /// it); out-of-domain coordinates clamp to the end nodes.
     #[inline]
     pub fn interpolate<const D: usize>(&self, x: [f32; D], channel: usize) -> f32 {
         let mut cells = [(0usize, 0.0f32); D];
         for d in 0..D {
             cells[d] = self.axes[d.min(MAX_AXES - 1)].locate(x[d]);
         }
-        self.blend(cells, channel)
+        match self.kernel {
+            Kernel::Multilinear => self.blend(cells, channel),
+            Kernel::CubicBSpline => self.blend_cubic(cells, channel),
+        }
+    }
+
+    /// Cubic B-spline blend of the `4^D` coefficients around the cell given
+    /// per axis as `(index, fraction)`: coefficients `i … i+3` of each axis.
+    #[inline]
+    pub fn blend_cubic<const D: usize>(&self, cells: [(usize, f32); D], channel: usize) -> f32 {
+        let mut weights = [[0.0f32; 4]; D];
+        let mut base = channel;
+        for ((&(i, t), stride), w) in cells.iter().zip(&self.strides).zip(weights.iter_mut()) {
+            base += i * stride;
+            *w = bspline_weights(t);
+        }
+        let mut sum = 0.0f32;
+        for corner in 0..(1usize << (2 * D)) {
+            let mut weight = 1.0f32;
+            let mut offset = base;
+            for (d, (w, stride)) in weights.iter().zip(&self.strides).enumerate() {
+                let k = (corner >> (2 * d)) & 3;
+                weight *= w[k];
+                offset += k * stride;
+            }
+            sum += weight * self.values.get(offset).copied().unwrap_or(0.0);
+        }
+        sum
     }
 
     /// n-linear blend of the `2^D` corners of the cell given per axis as
@@ -265,6 +310,21 @@ impl<'a> Grid<'a> {
     }
 }
 
+/// The four uniform cubic B-spline weights at fraction `t ∈ [0, 1]` of a cell,
+/// for the coefficients one before, at, after and two after the cell's start.
+#[inline]
+pub fn bspline_weights(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    let t2 = t * t;
+    let t3 = t2 * t;
+    [
+        s * s * s / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -277,6 +337,7 @@ mod tests {
             lo,
             hi,
             param,
+            param2: 0.0,
         }
     }
 
@@ -293,7 +354,7 @@ mod tests {
             axis_count: axes.len() as u32,
             axes: all,
             aux_count: 0,
-            reserved: 0,
+            kernel: Kernel::Multilinear,
             generator_version: [0; 16],
             params: [0.0; crate::format::PARAM_COUNT],
             payload_offset: 0,
@@ -376,7 +437,7 @@ mod tests {
                 x.iter()
                     .zip(axes)
                     .zip(coef)
-                    .map(|((&x, a), k)| 1.0 + k * coordinate_f64(a.mapping, a.param, x))
+                    .map(|((&x, a), k)| 1.0 + k * coordinate_f64(a, x))
                     .product()
             };
             let values = fill(axes, f);
@@ -387,13 +448,9 @@ mod tests {
                 let x: Vec<f64> = axes
                     .iter()
                     .map(|a| {
-                        let c_lo = coordinate_f64(a.mapping, a.param, a.lo);
-                        let c_hi = coordinate_f64(a.mapping, a.param, a.hi);
-                        inverse_coordinate_f64(
-                            a.mapping,
-                            a.param,
-                            c_lo + (c_hi - c_lo) * uniform(&mut state),
-                        )
+                        let c_lo = coordinate_f64(a, a.lo);
+                        let c_hi = coordinate_f64(a, a.hi);
+                        inverse_coordinate_f64(a, c_lo + (c_hi - c_lo) * uniform(&mut state))
                     })
                     .collect();
                 let want = f(&x);
@@ -460,6 +517,86 @@ mod tests {
         assert_eq!(grid.interpolate([1e30], 0), hi);
         assert_eq!(grid.interpolate([f32::INFINITY], 0), hi);
         assert!((hi - 10.0).abs() < 1e-5 && (lo - 0.1).abs() < 1e-6);
+    }
+
+    /// The B-spline kernel: weights form a partition of unity, and
+    /// coefficients sampled from a function that is linear in each mapped
+    /// coordinate (the B-spline's linear precision) reproduce it exactly.
+    #[test]
+    fn bspline_reproduces_multilinear_functions() {
+        for i in 0..=100 {
+            let w = bspline_weights(i as f32 / 100.0);
+            assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+            assert!(w.iter().all(|&x| x >= 0.0));
+        }
+        let mut shifted = axis(6, Mapping::LogOffset, 0.0, 1.0, 0.003);
+        shifted.param2 = 1.5;
+        let axes = [
+            shifted,
+            axis(5, Mapping::Log, 0.05, 3000.0, 0.0),
+            axis(4, Mapping::LogOffset, 1.0, 100.0, -0.8),
+        ];
+        let coef = [0.3, -0.7, 1.1];
+        // Coefficient j of an axis sits at coordinate c_lo + (j − 1)·h.
+        let coordinate_of = |a: &AxisHeader, j: usize| {
+            let (c_lo, c_hi) = (coordinate_f64(a, a.lo), coordinate_f64(a, a.hi));
+            c_lo + (c_hi - c_lo) * (j as f64 - 1.0) / f64::from(a.nodes - 1)
+        };
+        let mut values = Vec::new();
+        for i in 0..axes[0].nodes as usize + 2 {
+            for j in 0..axes[1].nodes as usize + 2 {
+                for k in 0..axes[2].nodes as usize + 2 {
+                    let c = [
+                        coordinate_of(&axes[0], i),
+                        coordinate_of(&axes[1], j),
+                        coordinate_of(&axes[2], k),
+                    ];
+                    values.push(
+                        (1.0 + coef[0] * c[0]) * (1.0 + coef[1] * c[1]) * (1.0 + coef[2] * c[2]),
+                    );
+                }
+            }
+        }
+        let values: Vec<f32> = values.into_iter().map(|v| v as f32).collect();
+        let mut header = header_with(&axes, 1);
+        header.kernel = Kernel::CubicBSpline;
+        let grid = Grid::new(&header, &values).unwrap();
+        let mut state = 5u64;
+        for _ in 0..3000 {
+            let x: Vec<f64> = axes
+                .iter()
+                .map(|a| {
+                    let (c_lo, c_hi) = (coordinate_f64(a, a.lo), coordinate_f64(a, a.hi));
+                    inverse_coordinate_f64(a, c_lo + (c_hi - c_lo) * uniform(&mut state))
+                })
+                .collect();
+            let c: Vec<f64> = x
+                .iter()
+                .zip(&axes)
+                .map(|(&x, a)| coordinate_f64(a, x))
+                .collect();
+            let want = (1.0 + coef[0] * c[0]) * (1.0 + coef[1] * c[1]) * (1.0 + coef[2] * c[2]);
+            let got = grid.interpolate([x[0] as f32, x[1] as f32, x[2] as f32], 0) as f64;
+            assert!(
+                (got - want).abs() < 1e-4 * want.abs().max(1.0),
+                "{x:?}: {got} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn log_offset_linear_mapping_inverts() {
+        let mut a = axis(72, Mapping::LogOffset, 0.0, 1.0, 0.003);
+        a.param2 = 1.5;
+        for i in 0..72 {
+            let x = node_value(&a, i);
+            assert!((0.0..=1.0).contains(&x));
+            if i > 0 {
+                assert!(x > node_value(&a, i - 1));
+            }
+        }
+        let c = coordinate_f64(&a, 0.37);
+        assert!((inverse_coordinate_f64(&a, c) - 0.37).abs() < 1e-14);
     }
 
     #[test]

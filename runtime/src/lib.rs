@@ -17,10 +17,12 @@ pub mod epd;
 pub mod format;
 pub mod gamma;
 pub mod interp;
+pub mod kcorr;
 pub mod math;
 #[cfg(feature = "std")]
 pub mod mmap;
 pub mod smith;
 
 pub use format::{AlignedBytes, FormatError, Table, TableId};
+pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use smith::{SmithG1Table, SmithShape};

@@ -39,6 +39,8 @@ forward! {
     cbrt(x) -> f64 = cbrt / cbrt;
     /// ln(1 + x) (f64), accurate for small |x|.
     ln_1p(x) -> f64 = ln_1p / log1p;
+    /// e^x − 1 (f64), accurate for small |x|.
+    exp_m1(x) -> f64 = exp_m1 / expm1;
     /// e^x (f32).
     expf(x) -> f32 = exp / expf;
     /// ln x (f32).
