@@ -7,6 +7,7 @@
 //! - [`query`]: the batch CSV queries of SPEC §6;
 //! - [`rng`]: deterministic random points for verification.
 
+pub mod bspline;
 pub mod quad;
 pub mod query;
 pub mod reference;

@@ -67,7 +67,8 @@ enum Command {
         files: Vec<PathBuf>,
     },
     /// Batch query (SPEC §6): CSV on stdin, CSV on stdout with `table` and
-    /// `reference` columns. Quantities: g1 (columns p,a).
+    /// `reference` columns. Quantities: g1 (columns p,a), sigma-ratio
+    /// (columns theta_i,B,c; θi in radians).
     Query {
         /// The quantity.
         quantity: String,
@@ -278,9 +279,10 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
                 axis.nodes,
                 axis.lo,
                 axis.hi,
-                axis.mapping.describe(axis.param)
+                axis.mapping.describe(axis.param, axis.param2)
             );
         }
+        println!("  interpolation      {:?}", header.kernel);
         println!("  aux values         {}", header.aux_count);
         println!("  generator version  {}", header.generator_version_str());
         for (name, value) in id.param_names().iter().zip(header.params) {

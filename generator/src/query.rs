@@ -11,14 +11,15 @@
 use rayon::prelude::*;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use twoscale::SmithG1Table;
 use twoscale::mmap::MappedFile;
+use twoscale::{SigmaRatioTable, SmithG1Table};
 
-use crate::reference::epd;
+use crate::reference::{epd, kcorr};
 use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
-pub const QUANTITIES: &[(&str, &[&str])] = &[("g1", &["p", "a"])];
+pub const QUANTITIES: &[(&str, &[&str])] =
+    &[("g1", &["p", "a"]), ("sigma-ratio", &["theta_i", "B", "c"])];
 
 /// Outcome of a query run.
 #[derive(Debug, Default, PartialEq, Eq)]
@@ -89,6 +90,25 @@ pub fn run(
                     let reference = epd::g1(p, a).map_err(|e| format!("reference: {e}"))?;
                     Ok(vec![
                         table.g1(p as f32, a as f32).to_string(),
+                        reference.to_string(),
+                    ])
+                }),
+                &["table", "reference"],
+            )
+        }
+        "sigma-ratio" => {
+            mapped = open(tables, twoscale::TableId::SigmaRatio)?;
+            let table = SigmaRatioTable::from_bytes(mapped.bytes())
+                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::SigmaRatio)))?;
+            (
+                Box::new(move |x: &[f64]| {
+                    let (theta_i, big_b, c) = (x[0], x[1], x[2]);
+                    let reference = kcorr::sigma_ratio(theta_i, big_b, c)
+                        .map_err(|e| format!("reference: {e}"))?;
+                    Ok(vec![
+                        table
+                            .sigma_ratio(theta_i as f32, big_b as f32, c as f32)
+                            .to_string(),
                         reference.to_string(),
                     ])
                 }),

@@ -8,6 +8,7 @@ use twoscale::{FormatError, TableId};
 use crate::quad::QuadError;
 
 pub mod t1;
+pub mod t2;
 
 /// A table the generator knows how to build and verify.
 pub trait TableKind: Sync {
@@ -28,7 +29,7 @@ pub trait TableKind: Sync {
 
 /// Every table, in build order.
 pub fn all() -> Vec<&'static dyn TableKind> {
-    vec![&t1::SmithG1]
+    vec![&t1::SmithG1, &t2::SigmaRatio]
 }
 
 /// The table with this name ([`TableId::name`]) or a unique prefix of it.

@@ -12,7 +12,7 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Mapping};
+use twoscale::format::{AxisHeader, Kernel, Mapping};
 use twoscale::interp::node_value;
 use twoscale::{SmithG1Table, TableId};
 
@@ -27,6 +27,7 @@ pub const P_AXIS: AxisHeader = AxisHeader {
     lo: 0.2,
     hi: 5.0,
     param: -0.5,
+    param2: 0.0,
 };
 
 /// ã axis: [0, 100], evenly spaced in ln(ã + 0.01).
@@ -36,6 +37,7 @@ pub const SCALED_AXIS: AxisHeader = AxisHeader {
     lo: 0.0,
     hi: 100.0,
     param: 0.01,
+    param2: 0.0,
 };
 
 /// Target of SPEC §3: max |G1 − G1_ref| ≤ 2e-5.
@@ -82,6 +84,7 @@ impl TableKind for SmithG1 {
         Ok(encode(&TableSpec {
             table_id: TableId::SmithG1,
             channels: 1,
+            kernel: Kernel::Multilinear,
             axes: &[P_AXIS, SCALED_AXIS],
             params: &[epd::LAMBDA_TOL.rel, epd::LAMBDA_TOL.abs],
             grid: &grid,
