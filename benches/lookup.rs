@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use twoscale::{SmithG1Table, TableId};
+use twoscale::{SigmaRatioTable, SmithG1Table, TableId};
 
 const BATCH: usize = 1024;
 
@@ -87,5 +87,53 @@ fn smith_g1(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith_g1);
+fn sigma_ratio(c: &mut Criterion) {
+    let buf = suite::read_table(TableId::SigmaRatio);
+    let table = SigmaRatioTable::from_bytes(buf.bytes()).expect("valid T2");
+    let mut rng = generator::rng::SplitMix64::new(2);
+    let points: Vec<(f32, f32, f32)> = (0..BATCH)
+        .map(|_| {
+            (
+                rng.uniform_in(0.0, 1.0) as f32,
+                rng.log_uniform_in(0.1, 3000.0) as f32,
+                (1.0 + rng.log_uniform_in(0.01, 99.0)) as f32,
+            )
+        })
+        .collect();
+    let mut group = c.benchmark_group("sigma_ratio");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    group.bench_function("t2_table", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(cos_theta_i, big_b, c) in &points {
+                sum +=
+                    table.sigma_ratio_cos(black_box(cos_theta_i), black_box(big_b), black_box(c));
+            }
+            sum
+        })
+    });
+    group.finish();
+
+    const REFERENCE_BATCH: usize = 64;
+    let mut group = c.benchmark_group("sigma_ratio");
+    group.throughput(Throughput::Elements(REFERENCE_BATCH as u64));
+    group.sample_size(10);
+    group.bench_function("f64_reference", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f64;
+            for &(cos_theta_i, big_b, c) in points.iter().take(REFERENCE_BATCH) {
+                sum += generator::reference::kcorr::sigma_ratio(
+                    black_box(f64::from(cos_theta_i).acos()),
+                    black_box(f64::from(big_b)),
+                    black_box(f64::from(c)),
+                )
+                .unwrap_or(0.0);
+            }
+            sum
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, smith_g1, sigma_ratio);
 criterion_main!(benches);
