@@ -590,14 +590,18 @@ impl<'a> Table<'a> {
 
     /// Like [`Table::from_bytes`], and also checks the table id.
     pub fn from_bytes_expecting(bytes: &'a [u8], expected: TableId) -> Result<Self, FormatError> {
-        let table = Self::from_bytes(bytes)?;
-        if table.header.table_id != expected {
+        Self::from_bytes(bytes)?.expecting(expected)
+    }
+
+    /// The table itself if it holds `expected`, else [`FormatError::WrongTable`].
+    pub fn expecting(self, expected: TableId) -> Result<Self, FormatError> {
+        if self.header.table_id != expected {
             return Err(FormatError::WrongTable {
                 expected,
-                found: table.header.table_id,
+                found: self.header.table_id,
             });
         }
-        Ok(table)
+        Ok(self)
     }
 
     /// The header.

@@ -64,13 +64,7 @@ impl<'a> SigmaRatioTable<'a> {
 
     /// Checks that a validated table has the shape of T2.
     pub fn from_table(table: Table<'a>) -> Result<Self, FormatError> {
-        let header = table.header();
-        if header.table_id != TableId::SigmaRatio {
-            return Err(FormatError::WrongTable {
-                expected: TableId::SigmaRatio,
-                found: header.table_id,
-            });
-        }
+        let header = table.expecting(TableId::SigmaRatio)?.header();
         let axes = header.used_axes();
         if axes.len() != 3 || header.channels != 1 || header.kernel != Kernel::CubicBSpline {
             return Err(FormatError::Shape(

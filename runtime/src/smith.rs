@@ -50,13 +50,7 @@ impl<'a> SmithG1Table<'a> {
 
     /// Checks that a validated table has the shape of T1.
     pub fn from_table(table: Table<'a>) -> Result<Self, FormatError> {
-        let header = table.header();
-        if header.table_id != TableId::SmithG1 {
-            return Err(FormatError::WrongTable {
-                expected: TableId::SmithG1,
-                found: header.table_id,
-            });
-        }
+        let header = table.expecting(TableId::SmithG1)?.header();
         let axes = header.used_axes();
         if axes.len() != 2 || header.channels != 1 {
             return Err(FormatError::Shape("T1 has two axes (p, ã) and one channel"));
