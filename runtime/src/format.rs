@@ -199,13 +199,15 @@ pub struct MappingDisplay {
 
 impl fmt::Display for MappingDisplay {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let sign = if self.param < 0.0 { '-' } else { '+' };
+        let offset = self.param.abs();
         match self.mapping {
             Mapping::Uniform => write!(f, "x"),
             Mapping::Log => write!(f, "ln(x)"),
             Mapping::LogOffset if self.param2 != 0.0 => {
-                write!(f, "ln(x + {}) + {}·x", self.param, self.param2)
+                write!(f, "ln(x {sign} {offset}) + {}·x", self.param2)
             }
-            Mapping::LogOffset => write!(f, "ln(x + {})", self.param),
+            Mapping::LogOffset => write!(f, "ln(x {sign} {offset})"),
             Mapping::Power => write!(f, "x^{}", self.param),
         }
     }
