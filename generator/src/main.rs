@@ -197,7 +197,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
         }
     }
     println!(
-        "{:<16} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
+        "{:<18} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
         "table", "bytes", "metric", "points", "max", "median", "p99", "target"
     );
     let mut failed = false;
@@ -208,7 +208,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
                     let ok = a.passed();
                     failed |= !ok;
                     println!(
-                        "{:<16} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
+                        "{:<18} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
                         id.name(),
                         size,
                         a.metric,
@@ -224,7 +224,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
             }
             Err(e) => {
                 failed = true;
-                println!("{:<16} {:>9}  FAIL: {e}", id.name(), "-");
+                println!("{:<18} {:>9}  FAIL: {e}", id.name(), "-");
             }
         }
     }

@@ -25,6 +25,6 @@ pub mod mmap;
 pub mod smith;
 
 pub use format::{AlignedBytes, FormatError, Table, TableId};
-pub use fresnel::Complex;
+pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use smith::{SmithG1Table, SmithShape};
