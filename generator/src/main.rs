@@ -68,7 +68,8 @@ enum Command {
     },
     /// Batch query (SPEC §6): CSV on stdin, CSV on stdout with `table` and
     /// `reference` columns. Quantities: g1 (columns p,a), sigma-ratio
-    /// (columns theta_i,B,c; θi in radians).
+    /// (columns theta_i,B,c; θi in radians), fresnel (columns n,k,cos_theta;
+    /// `table` is the runtime's f32 value, which needs no table).
     Query {
         /// The quantity.
         quantity: String,
