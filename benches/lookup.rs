@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use twoscale::{SigmaRatioTable, SmithG1Table, TableId};
+use twoscale::{Complex, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId};
 
 const BATCH: usize = 1024;
 
@@ -135,5 +135,90 @@ fn sigma_ratio(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith_g1, sigma_ratio);
+/// Complex Fresnel and Q̄ (closed forms, f64 inside) against Schlick's
+/// approximation; T5 against its quadrature reference.
+fn fresnel(c: &mut Criterion) {
+    let mut rng = generator::rng::SplitMix64::new(3);
+    let points: Vec<(Complex, f32, [f32; 3])> = (0..BATCH)
+        .map(|_| {
+            let eta = Complex::new(
+                rng.log_uniform_in(0.05, 10.0) as f32,
+                rng.uniform_in(0.0, 20.0) as f32,
+            );
+            let (cos, phi) = (rng.uniform(), rng.uniform_in(0.0, std::f64::consts::TAU));
+            let sin = (1.0 - cos * cos).sqrt();
+            let o = [
+                (sin * phi.cos()) as f32,
+                (sin * phi.sin()) as f32,
+                cos as f32,
+            ];
+            (eta, rng.uniform() as f32, o)
+        })
+        .collect();
+    let mut group = c.benchmark_group("fresnel");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    group.bench_function("complex_fresnel", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(eta, cos, _) in &points {
+                sum += twoscale::fresnel::fresnel(black_box(eta), black_box(cos));
+            }
+            sum
+        })
+    });
+    group.bench_function("schlick", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(eta, cos, _) in &points {
+                let (n, k) = (black_box(eta).re, eta.im);
+                let f0 = ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k);
+                let m = 1.0 - black_box(cos);
+                sum += f0 + (1.0 - f0) * m * m * m * m * m;
+            }
+            sum
+        })
+    });
+    group.bench_function("q_bar", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(eta, _, o) in &points {
+                let i = [0.6, 0.0, 0.8];
+                sum += twoscale::fresnel::q_bar(black_box(eta), black_box(i), black_box(o));
+            }
+            sum
+        })
+    });
+    let buf = suite::read_table(TableId::DiffuseFresnel);
+    let table = DiffuseFresnelTable::from_bytes(buf.bytes()).expect("valid T5");
+    group.bench_function("t5_table", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(_, cos, _) in &points {
+                sum += table.f_dr_int(black_box(1.0 + 2.0 * cos));
+            }
+            sum
+        })
+    });
+    group.finish();
+
+    const REFERENCE_BATCH: usize = 64;
+    let mut group = c.benchmark_group("fresnel");
+    group.throughput(Throughput::Elements(REFERENCE_BATCH as u64));
+    group.sample_size(10);
+    group.bench_function("t5_f64_reference", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f64;
+            for &(_, cos, _) in points.iter().take(REFERENCE_BATCH) {
+                sum += generator::reference::fresnel::diffuse_internal(black_box(
+                    1.0 + 2.0 * f64::from(cos),
+                ))
+                .unwrap_or(0.0);
+            }
+            sum
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, smith_g1, sigma_ratio, fresnel);
 criterion_main!(benches);

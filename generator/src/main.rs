@@ -68,7 +68,8 @@ enum Command {
     },
     /// Batch query (SPEC §6): CSV on stdin, CSV on stdout with `table` and
     /// `reference` columns. Quantities: g1 (columns p,a), sigma-ratio
-    /// (columns theta_i,B,c; θi in radians).
+    /// (columns theta_i,B,c; θi in radians), fresnel (columns n,k,cos_theta;
+    /// `table` is the runtime's f32 value, which needs no table).
     Query {
         /// The quantity.
         quantity: String,
@@ -197,7 +198,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
         }
     }
     println!(
-        "{:<16} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
+        "{:<18} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
         "table", "bytes", "metric", "points", "max", "median", "p99", "target"
     );
     let mut failed = false;
@@ -208,7 +209,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
                     let ok = a.passed();
                     failed |= !ok;
                     println!(
-                        "{:<16} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
+                        "{:<18} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
                         id.name(),
                         size,
                         a.metric,
@@ -224,7 +225,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
             }
             Err(e) => {
                 failed = true;
-                println!("{:<16} {:>9}  FAIL: {e}", id.name(), "-");
+                println!("{:<18} {:>9}  FAIL: {e}", id.name(), "-");
             }
         }
     }

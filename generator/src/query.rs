@@ -14,12 +14,15 @@ use std::path::Path;
 use twoscale::mmap::MappedFile;
 use twoscale::{SigmaRatioTable, SmithG1Table};
 
-use crate::reference::{epd, kcorr};
+use crate::reference::{epd, fresnel, kcorr};
 use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
-pub const QUANTITIES: &[(&str, &[&str])] =
-    &[("g1", &["p", "a"]), ("sigma-ratio", &["theta_i", "B", "c"])];
+pub const QUANTITIES: &[(&str, &[&str])] = &[
+    ("g1", &["p", "a"]),
+    ("sigma-ratio", &["theta_i", "B", "c"]),
+    ("fresnel", &["n", "k", "cos_theta"]),
+];
 
 /// Outcome of a query run.
 #[derive(Debug, Default, PartialEq, Eq)]
@@ -115,6 +118,21 @@ pub fn run(
                 &["table", "reference"],
             )
         }
+        "fresnel" => (
+            // No table: `table` is the runtime's f32 Fresnel (computed in f64
+            // inside), `reference` the f64 reference.
+            Box::new(|x: &[f64]| {
+                let (n, k, cos_theta) = (x[0], x[1], x[2]);
+                let reference = fresnel::fresnel(fresnel::Complex64::new(n, k), cos_theta)
+                    .map_err(|e| format!("reference: {e}"))?;
+                let eta = twoscale::Complex::new(n as f32, k as f32);
+                Ok(vec![
+                    twoscale::fresnel::fresnel(eta, cos_theta as f32).to_string(),
+                    reference.to_string(),
+                ])
+            }),
+            &["table", "reference"],
+        ),
         _ => unreachable!("quantity list and dispatch agree"),
     };
 

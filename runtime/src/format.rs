@@ -54,11 +54,18 @@ pub enum TableId {
     /// T2: σrel/σs of the K-correlation spectrum over (cos θi, B = b/λ, c);
     /// see [`crate::kcorr`].
     SigmaRatio = 2,
+    /// T5: internal diffuse Fresnel reflectance F_dr,int(η) of a dielectric
+    /// over η; see [`crate::fresnel::DiffuseFresnelTable`].
+    DiffuseFresnel = 3,
 }
 
 impl TableId {
     /// Every table id, in tag order.
-    pub const ALL: [TableId; 2] = [TableId::SmithG1, TableId::SigmaRatio];
+    pub const ALL: [TableId; 3] = [
+        TableId::SmithG1,
+        TableId::SigmaRatio,
+        TableId::DiffuseFresnel,
+    ];
 
     /// The tag stored in the file.
     pub const fn tag(self) -> u32 {
@@ -75,6 +82,7 @@ impl TableId {
         match self {
             TableId::SmithG1 => "t1-smith-g1",
             TableId::SigmaRatio => "t2-sigma-ratio",
+            TableId::DiffuseFresnel => "t5-diffuse-fresnel",
         }
     }
 
@@ -87,6 +95,9 @@ impl TableId {
             TableId::SigmaRatio => {
                 "sigma_rel/sigma_s of the K-correlation spectrum (HP17 17-19) divided by its closed form at normal incidence; cubic B-spline coefficients"
             }
+            TableId::DiffuseFresnel => {
+                "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, SPEC 2.6); cubic B-spline coefficients"
+            }
         }
     }
 
@@ -95,6 +106,7 @@ impl TableId {
         match self {
             TableId::SmithG1 => &["p", "a_scaled"],
             TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
+            TableId::DiffuseFresnel => &["eta"],
         }
     }
 
@@ -104,6 +116,7 @@ impl TableId {
         match self {
             TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
             TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
+            TableId::DiffuseFresnel => &["quadrature_rel_tol", "quadrature_abs_tol"],
         }
     }
 }

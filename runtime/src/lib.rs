@@ -15,6 +15,7 @@
 
 pub mod epd;
 pub mod format;
+pub mod fresnel;
 pub mod gamma;
 pub mod interp;
 pub mod kcorr;
@@ -24,5 +25,6 @@ pub mod mmap;
 pub mod smith;
 
 pub use format::{AlignedBytes, FormatError, Table, TableId};
+pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use smith::{SmithG1Table, SmithShape};

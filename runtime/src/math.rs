@@ -37,6 +37,8 @@ forward! {
     abs(x) -> f64 = abs / fabs;
     /// ∛x (f64).
     cbrt(x) -> f64 = cbrt / cbrt;
+    /// √(x² + y²) (f64), without overflow or underflow in the squares.
+    hypot(x, y) -> f64 = hypot / hypot;
     /// ln(1 + x) (f64), accurate for small |x|.
     ln_1p(x) -> f64 = ln_1p / log1p;
     /// e^x − 1 (f64), accurate for small |x|.

@@ -1,9 +1,10 @@
-//! A `no_std` consumer of the runtime: embeds T1, looks up G1 and samples the
-//! EPD, with no standard library linked.
+//! A `no_std` consumer of the runtime: embeds T1 and T5, looks up G1 and
+//! F_dr,int, samples the EPD and evaluates Fresnel and Q̄, with no standard
+//! library linked.
 #![no_std]
 
 use twoscale::epd::Epd;
-use twoscale::SmithG1Table;
+use twoscale::{Complex, DiffuseFresnelTable, SmithG1Table};
 
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
@@ -29,4 +30,29 @@ pub extern "C" fn twoscale_sample_cos(beta: f32, p: f32, u0: f32, u1: f32) -> f3
         Ok(table) => Epd::new(beta, p, &table).sample([u0, u1])[2],
         Err(_) => -1.0,
     }
+}
+
+static T5: &twoscale::AlignedBytes<[u8]> =
+    &twoscale::AlignedBytes(*include_bytes!("../../../tables/t5-diffuse-fresnel.tbl"));
+
+/// F_dr,int(η) from the embedded T5, or −1 if the table does not validate.
+#[unsafe(no_mangle)]
+pub extern "C" fn twoscale_f_dr_int(eta: f32) -> f32 {
+    match DiffuseFresnelTable::from_bytes(T5.bytes()) {
+        Ok(table) => table.f_dr_int(eta),
+        Err(_) => -1.0,
+    }
+}
+
+/// Unpolarised Fresnel reflectance of n + ik at incidence cos θ.
+#[unsafe(no_mangle)]
+pub extern "C" fn twoscale_fresnel(n: f32, k: f32, cos_theta: f32) -> f32 {
+    twoscale::fresnel::fresnel(Complex::new(n, k), cos_theta)
+}
+
+/// Q̄ of n + ik for incidence i = (sin θi, 0, cos θi) and o = (ox, oy, oz).
+#[unsafe(no_mangle)]
+pub extern "C" fn twoscale_q_bar(n: f32, k: f32, cos_i: f32, ox: f32, oy: f32, oz: f32) -> f32 {
+    let sin_i = twoscale::math::sqrtf((1.0 - cos_i * cos_i).max(0.0));
+    twoscale::fresnel::q_bar(Complex::new(n, k), [sin_i, 0.0, cos_i], [ox, oy, oz])
 }

@@ -12,7 +12,11 @@
 //! * [`conv`]: the normalised spherical convolution `C(θh; u, c, β, p)` of
 //!   SPEC §2.5 (HP17 32–33, 61–64), by zonal harmonics and by direct 2-D
 //!   quadrature.
+//! * [`fresnel`]: the Fresnel reflectance of a complex index (HP17 3-4), the
+//!   diffraction colour term Q of (HP17 10), and the diffuse Fresnel
+//!   reflectances of a dielectric (SPEC §2.6).
 
 pub mod conv;
 pub mod epd;
+pub mod fresnel;
 pub mod kcorr;

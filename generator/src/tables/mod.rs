@@ -9,6 +9,7 @@ use crate::quad::QuadError;
 
 pub mod t1;
 pub mod t2;
+pub mod t5;
 
 /// A table the generator knows how to build and verify.
 pub trait TableKind: Sync {
@@ -29,7 +30,7 @@ pub trait TableKind: Sync {
 
 /// Every table, in build order.
 pub fn all() -> Vec<&'static dyn TableKind> {
-    vec![&t1::SmithG1, &t2::SigmaRatio]
+    vec![&t1::SmithG1, &t2::SigmaRatio, &t5::DiffuseFresnel]
 }
 
 /// The table with this name ([`TableId::name`]) or a unique prefix of it.

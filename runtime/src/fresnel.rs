@@ -1,0 +1,572 @@
+//! Fresnel reflectance of a complex index of refraction (HP17 3-4), the colour
+//! term Q̄ of the diffraction lobe (HP17 10), and T5, the internal diffuse
+//! Fresnel reflectance `F_dr,int(η)` of the plastic base layer (HP17 43;
+//! SPEC §2.3, §2.6).
+//!
+//! # The index of refraction
+//!
+//! [`Complex`] holds the relative index `η = n + i k` of the material (outside
+//! medium: index 1). `k = 0` is a dielectric (`η < 1` included, with total
+//! internal reflection), `k > 0` a conductor. Both functions depend on η only
+//! through η² and are unchanged by `η → −η` and by `η → η̄` (every term is then
+//! conjugated), so they use `|n|` and `|k|`; NaN counts as 0, and `|n|`, `|k|`
+//! are capped at 10⁹ (beyond which F differs from 1 by less than 4·10⁻⁹ and
+//! Q̄ ≤ 2|η|⁴ would overflow f32). Two degenerate indices are defined by their
+//! limits: `η = ±1` (no interface) gives F = 0 and Q̄ = 0 at every angle, and
+//! `|η| < 10⁻¹⁰` is evaluated at `η = 10⁻¹⁰` (F → 1 as η → 0).
+//!
+//! # Precision
+//!
+//! The f32 API computes internally in f64: the same formulas evaluated in f32
+//! were measured at 1.9·10⁻⁵ absolute error (n = 0.23, k = 0, near the
+//! critical angle, where `c = √(η² − sin²θ)` vanishes), above the 10⁻⁵ the
+//! project asks for; in f64 the only error left is the final rounding to f32.
+//!
+//! # T5
+//!
+//! [`DiffuseFresnelTable`] reads T5: `F_dr,int(η) = 2 ∫₀¹ F(1/η, μ) μ dμ` for
+//! η ∈ [1, 3], a 1-D cubic B-spline (layout in its documentation).
+
+use core::ops::{Add, Div, Mul, Sub};
+
+use crate::format::{FormatError, Kernel, Mapping, Table, TableId};
+use crate::interp::Grid;
+use crate::math;
+
+/// A complex index of refraction `η = n + i k` relative to the outside medium,
+/// in f32 as renderers store it: `re = n`, `im = k` (k ≥ 0 absorbs; the sign
+/// does not matter, see the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Complex {
+    /// Real part, n.
+    pub re: f32,
+    /// Imaginary part, k (extinction coefficient).
+    pub im: f32,
+}
+
+impl Complex {
+    /// `n + i k`.
+    pub const fn new(re: f32, im: f32) -> Complex {
+        Complex { re, im }
+    }
+
+    /// A real index `n` (a dielectric).
+    pub const fn real(re: f32) -> Complex {
+        Complex { re, im: 0.0 }
+    }
+}
+
+/// Largest |n| and |k| used (larger values are capped).
+const INDEX_MAX: f64 = 1e9;
+/// Smallest |η| used (smaller indices are evaluated at this real index).
+const INDEX_MIN: f64 = 1e-10;
+
+/// f64 complex arithmetic, only what the formulas below need.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct C64 {
+    re: f64,
+    im: f64,
+}
+
+impl C64 {
+    const fn new(re: f64, im: f64) -> C64 {
+        C64 { re, im }
+    }
+
+    const fn real(re: f64) -> C64 {
+        C64 { re, im: 0.0 }
+    }
+
+    /// `|z|²`.
+    fn norm_sqr(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+
+    /// Principal square root (`Re √z ≥ 0`; on the negative real axis the
+    /// result is `+i√|z|`, whatever the sign of a zero imaginary part).
+    ///
+    /// With `r = |z|`: for `Re z ≥ 0`, `t = √((r + Re z)/2)` and
+    /// `√z = t + i Im z/(2t)`; for `Re z < 0`, `t = √((r − Re z)/2)` and
+    /// `√z = |Im z|/(2t) ± i t` (sign of `Im z`). Both forms avoid the
+    /// cancellation of `r − |Re z|`.
+    fn sqrt(self) -> C64 {
+        let (x, y) = (self.re, self.im);
+        if x == 0.0 && y == 0.0 {
+            return C64::real(0.0);
+        }
+        let r = math::hypot(x, y);
+        if x >= 0.0 {
+            let t = math::sqrt(0.5 * (r + x));
+            C64::new(t, y / (2.0 * t))
+        } else {
+            let t = math::sqrt(0.5 * (r - x));
+            C64::new(math::abs(y) / (2.0 * t), if y < 0.0 { -t } else { t })
+        }
+    }
+}
+
+impl Add for C64 {
+    type Output = C64;
+    fn add(self, o: C64) -> C64 {
+        C64::new(self.re + o.re, self.im + o.im)
+    }
+}
+
+impl Sub for C64 {
+    type Output = C64;
+    fn sub(self, o: C64) -> C64 {
+        C64::new(self.re - o.re, self.im - o.im)
+    }
+}
+
+impl Mul for C64 {
+    type Output = C64;
+    fn mul(self, o: C64) -> C64 {
+        C64::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+}
+
+impl Mul<f64> for C64 {
+    type Output = C64;
+    fn mul(self, s: f64) -> C64 {
+        C64::new(self.re * s, self.im * s)
+    }
+}
+
+impl Div for C64 {
+    type Output = C64;
+    /// `a / b = a b̄ / |b|²`; callers guarantee `b ≠ 0` (see [`Index`]).
+    fn div(self, o: C64) -> C64 {
+        let d = o.norm_sqr();
+        C64::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
+    }
+}
+
+/// A sanitised index: `η²` and `e = η² − 1`.
+///
+/// With `n, k ≥ 0` and `η² ≠ 1` no denominator of the formulas vanishes:
+/// `cos θ + c = 0` needs `c = 0 = cos θ`, i.e. `η² = sin²θ = 1`; and
+/// `η² cos θ + c = 0` needs `c² = η⁴ cos²θ`, i.e. `(η² − 1)(η² cos²θ − sin²θ) = 0`,
+/// whose second factor makes `η²` real and positive, where the principal root
+/// is `c = +η² cos θ`, not `−η² cos θ` (η = 0 is excluded by [`INDEX_MIN`]).
+#[derive(Clone, Copy, Debug)]
+struct Index {
+    eta_sq: C64,
+    /// `η² − 1`, as `(n − 1)(n + 1) − k² + 2ink` (no cancellation near η = 1).
+    e: C64,
+}
+
+impl Index {
+    /// The sanitised index (module documentation), or `None` for `η² = 1`.
+    fn new(eta: Complex) -> Option<Index> {
+        let part = |x: f32| f64::from(x).abs().max(0.0).min(INDEX_MAX);
+        let (mut n, k) = (part(eta.re), part(eta.im));
+        if n * n + k * k < INDEX_MIN * INDEX_MIN {
+            n = INDEX_MIN;
+        }
+        let e = C64::new((n - 1.0) * (n + 1.0) - k * k, 2.0 * n * k);
+        if e.re == 0.0 && e.im == 0.0 {
+            return None;
+        }
+        Some(Index {
+            eta_sq: C64::new(n * n - k * k, 2.0 * n * k),
+            e,
+        })
+    }
+
+    /// `c = √(η² − sin²θ)`, principal root, computed as `√(η² − 1 + cos²θ)`.
+    fn c(&self, cos_theta: f64) -> C64 {
+        (self.e + C64::real(cos_theta * cos_theta)).sqrt()
+    }
+}
+
+/// Unpolarised Fresnel reflectance of the interface from outside (index 1)
+/// into a material of complex index `η = n + i k`, at incidence `cos θ`
+/// (HP17 3-4; SPEC §2.3):
+///
+/// ```text
+/// c  = (η² − sin²θ)^½          (principal root)
+/// Fs = |(cos θ − c) / (cos θ + c)|²
+/// Fp = |(η² cos θ − c) / (η² cos θ + c)|²
+/// F  = (Fs + Fp) / 2                                             (HP17 3-4)
+/// ```
+///
+/// A real η is a dielectric; for `η < 1` and `sin θ ≥ η`, c is imaginary and
+/// F = 1 (total internal reflection). F ∈ [0, 1]; F = 1 at grazing incidence
+/// for every η ≠ 1.
+///
+/// Guards: `cos θ` is clamped to [0, 1] (`cos θ ≤ 0` or NaN is grazing
+/// incidence, F = 1; `cos θ > 1` is normal incidence). Index conventions and
+/// the degenerate indices (η = 1 gives 0) are in the module documentation.
+/// Never NaN, never panics; computed in f64.
+pub fn fresnel(eta: Complex, cos_theta: f32) -> f32 {
+    let Some(index) = Index::new(eta) else {
+        return 0.0;
+    };
+    let cos = f64::from(cos_theta.max(0.0).min(1.0));
+    let c = index.c(cos);
+    let cos_c = C64::real(cos);
+    let rs = (cos_c - c) / (cos_c + c);
+    let a = index.eta_sq * cos;
+    let rp = (a - c) / (a + c);
+    let f = 0.5 * (rs.norm_sqr() + rp.norm_sqr());
+    (f as f32).max(0.0).min(1.0)
+}
+
+/// A direction reduced to what eq. 10 needs: `cos θ`, `sin θ` and the unit
+/// tangential direction `(cos φ, sin φ)` scaled by `sin θ`, i.e. `(x, y)`.
+#[derive(Clone, Copy, Debug)]
+struct Direction {
+    cos: f64,
+    sin: f64,
+    x: f64,
+    y: f64,
+}
+
+impl Direction {
+    /// Normalises `v`; a direction below the horizon is moved onto it
+    /// (azimuth kept; straight down becomes `+x`); a zero or non-finite vector
+    /// is taken as the normal.
+    fn new(v: [f32; 3]) -> Direction {
+        let [x, y, z] = v.map(f64::from);
+        let len = math::sqrt(x * x + y * y + z * z);
+        if !(len > 0.0 && len.is_finite()) {
+            return Direction {
+                cos: 1.0,
+                sin: 0.0,
+                x: 0.0,
+                y: 0.0,
+            };
+        }
+        let (x, y, z) = (x / len, y / len, z / len);
+        if z >= 0.0 {
+            return Direction {
+                cos: z.min(1.0),
+                sin: math::hypot(x, y).min(1.0),
+                x,
+                y,
+            };
+        }
+        let t = math::hypot(x, y);
+        let (x, y) = if t > 0.0 { (x / t, y / t) } else { (1.0, 0.0) };
+        Direction {
+            cos: 0.0,
+            sin: 1.0,
+            x,
+            y,
+        }
+    }
+}
+
+/// The colour term of the diffraction lobe for unpolarised light,
+/// `Q̄ = Q / 2`, with Q the Rayleigh–Rice polarisation factor of (HP17 10),
+/// for the incident direction `i` (towards the light) and the outgoing
+/// direction `o` (towards the viewer), unit vectors in the local frame
+/// (normal +z), and the complex index η. With `(θi, φi)`, `(θo, φo)` the
+/// spherical coordinates of i and o, (HP17 10) reads:
+///
+/// ```text
+/// φ   = φo − φi − π,      ci = (η² − sin²θi)^½,      co = (η² − sin²θo)^½
+/// q0  = (η² − 1)(cos θi + ci)⁻¹          q1 = (η² − 1)(η² cos θi + ci)⁻¹
+/// q2  = (cos θo + co)⁻¹                  q3 = (η² cos θo + co)⁻¹
+/// Qss = q0 q2 cos φ                      Qsp = q0 q3 co sin φ
+/// Qps = q1 q2 ci sin φ                   Qpp = q1 q3 (ci co cos φ − η² sin θi sin θo)
+/// Q   = |Qss|² + |Qsp|² + |Qps|² + |Qpp|²                              (HP17 10)
+/// Q̄   = Q / 2
+/// ```
+///
+/// (square roots principal, arithmetic complex). `Q_ab` is the amplitude
+/// factor from incident polarisation a to scattered polarisation b (s or p)
+/// of first-order (Rayleigh–Rice) scattering by a smooth surface; the cross
+/// terms `Qsp`, `Qps` transfer power between polarisations. Q sums the four
+/// channels; unpolarised light carries half its power in each incident
+/// polarisation, hence `Q̄ = Q/2` (SPEC §2.3, §8).
+///
+/// **Specular check**: for `o` the mirror direction of `i` (`θo = θi`,
+/// `φo = φi + π`, so φ = 0) `Qsp = Qps = 0`, `|Qss|² = Fs`, `|Qpp|² = Fp`, so
+/// `Q = 2F` and `Q̄ = F` ([`fresnel`] at `cos θi`). Off the specular direction
+/// Q̄ is not bounded by 1: at double grazing incidence
+/// `Q = cos²φ + 2|η² − 1| sin²φ + |(η² − 1) cos φ − η²|²`, which is
+/// `≈ 2|η|⁴` in the back-scattering direction (φ = π).
+///
+/// φ is never formed: `sin θi sin θo cos φ = −(ix ox + iy oy)` and
+/// `sin θi sin θo sin φ = −(ix oy − iy ox)`, normalised. When `sin θi` or
+/// `sin θo` is 0 the azimuth is undefined and Q does not depend on it; φ = 0
+/// is used.
+///
+/// Guards: `i` and `o` are normalised; a direction below the horizon is moved
+/// onto it (cos θ = 0, azimuth kept), a zero or non-finite vector is taken as
+/// the normal. Index conventions as in the module documentation (η = 1 gives
+/// 0). Finite for every input (at most ≈ 8·10³⁶ with the index cap), never
+/// panics; computed in f64.
+pub fn q_bar(eta: Complex, i: [f32; 3], o: [f32; 3]) -> f32 {
+    let Some(index) = Index::new(eta) else {
+        return 0.0;
+    };
+    let (di, dout) = (Direction::new(i), Direction::new(o));
+    // sin θi sin θo (cos φ, sin φ) with φ = φo − φi − π.
+    let along = -(di.x * dout.x + di.y * dout.y);
+    let across = -(di.x * dout.y - di.y * dout.x);
+    let r = math::hypot(along, across);
+    let (cos_phi, sin_phi) = if r > 0.0 {
+        (along / r, across / r)
+    } else {
+        (1.0, 0.0)
+    };
+    let (ci, co) = (index.c(di.cos), index.c(dout.cos));
+    let one = C64::real(1.0);
+    let q0 = index.e / (C64::real(di.cos) + ci);
+    let q1 = index.e / (index.eta_sq * di.cos + ci);
+    let q2 = one / (C64::real(dout.cos) + co);
+    let q3 = one / (index.eta_sq * dout.cos + co);
+    let qss = q0 * q2 * cos_phi;
+    let qsp = q0 * q3 * co * sin_phi;
+    let qps = q1 * q2 * ci * sin_phi;
+    let qpp = q1 * q3 * (ci * co * cos_phi - index.eta_sq * (di.sin * dout.sin));
+    let q = qss.norm_sqr() + qsp.norm_sqr() + qps.norm_sqr() + qpp.norm_sqr();
+    ((0.5 * q) as f32).max(0.0).min(f32::MAX)
+}
+
+/// First η node of T5.
+const ETA_MIN: f32 = 1.0;
+/// Last η node of T5.
+const ETA_MAX: f32 = 3.0;
+
+/// T5 viewed in place: the internal diffuse Fresnel reflectance of a
+/// dielectric of real index η ∈ [1, 3] (SPEC §2.6, §3),
+///
+/// ```text
+/// F_dr,int(η) = 2 ∫₀¹ F(1/η, μ) μ dμ
+///             = 1 − 1/η² + F_dr,ext(η)/η²,     F_dr,ext(η) = 2 ∫₀¹ F(η, μ) μ dμ
+/// ```
+///
+/// the cosine-weighted hemispherical reflectance seen from inside the
+/// dielectric, total internal reflection (μ < √(1 − 1/η²)) included; it is
+/// the `F_dr` of the plastic base layer (HP17 43; SPEC §2.6, which corrects
+/// the `ρd/π` misprint there).
+///
+/// **Layout**: one axis, `η ∈ [1, 3]`, 48 nodes evenly spaced in
+/// `ln(η − 0.98) + 0.5 η` (the header's log-offset mapping), cubic B-spline
+/// coefficients. `F_dr,ext` contains a term `∝ (η − 1)² ln(η − 1)` whose
+/// second derivative is singular at η = 1: uniform nodes leave 4.7·10⁻⁵ there
+/// even with 64 nodes; the logarithm puts nodes near η = 1 (first cell
+/// 2.5·10⁻³ wide) and the linear term keeps enough of them near η = 3.
+///
+/// **Out of range**: η is clamped to [1, 3]; η < 1 or NaN gives
+/// `F_dr,int(1) = 0`, η > 3 gives `F_dr,int(3) ≈ 0.9196`. The result is
+/// clamped to [0, 1]. Never NaN, never panics.
+#[derive(Clone, Copy, Debug)]
+pub struct DiffuseFresnelTable<'a> {
+    grid: Grid<'a>,
+}
+
+impl<'a> DiffuseFresnelTable<'a> {
+    /// Validates a T5 file (see [`Table::from_bytes`]) and its shape.
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, FormatError> {
+        Self::from_table(Table::from_bytes_expecting(bytes, TableId::DiffuseFresnel)?)
+    }
+
+    /// Checks that a validated table has the shape of T5.
+    pub fn from_table(table: Table<'a>) -> Result<Self, FormatError> {
+        let header = table.expecting(TableId::DiffuseFresnel)?.header();
+        let axes = header.used_axes();
+        if axes.len() != 1 || header.channels != 1 || header.kernel != Kernel::CubicBSpline {
+            return Err(FormatError::Shape(
+                "T5 has one axis (η), one channel and B-spline coefficients",
+            ));
+        }
+        if (axes[0].lo as f32, axes[0].hi as f32) != (ETA_MIN, ETA_MAX)
+            || axes[0].mapping != Mapping::LogOffset
+        {
+            return Err(FormatError::Shape(
+                "T5's axis is η ∈ [1, 3] with a log-offset mapping",
+            ));
+        }
+        // F_dr,int lies in [0, 1]; B-spline coefficients overshoot slightly.
+        if table.grid().iter().any(|&v| !(-0.1..=1.1).contains(&v)) {
+            return Err(FormatError::Shape(
+                "T5's coefficients must lie in [-0.1, 1.1]",
+            ));
+        }
+        Ok(DiffuseFresnelTable {
+            grid: Grid::new(header, table.grid())?,
+        })
+    }
+
+    /// `F_dr,int(η)` (see the type's documentation): the table, with η
+    /// clamped to [1, 3].
+    pub fn f_dr_int(&self, eta: f32) -> f32 {
+        let eta = eta.max(ETA_MIN).min(ETA_MAX);
+        self.grid.interpolate([eta], 0).max(0.0).min(1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol
+    }
+
+    #[test]
+    fn complex_square_root_is_principal() {
+        for (re, im) in [
+            (4.0, 0.0),
+            (-4.0, 0.0),
+            (-4.0, -0.0),
+            (0.0, 2.0),
+            (0.0, -2.0),
+            (3.0, -4.0),
+            (-3.0, 4.0),
+            (-3.0, -4.0),
+            (1e-300, 1e-300),
+            (-1e20, 1e-20),
+        ] {
+            let z = C64::new(re, im);
+            let s = z.sqrt();
+            assert!(s.re >= 0.0, "{z:?} -> {s:?}");
+            let back = s * s;
+            let scale = re.hypot(im);
+            assert!(
+                close(back.re, re, 1e-15 * scale) && close(back.im, im, 1e-15 * scale),
+                "{z:?}: {s:?}² = {back:?}"
+            );
+        }
+        // The negative real axis maps to +i, whatever the zero's sign.
+        assert_eq!(C64::new(-4.0, -0.0).sqrt(), C64::new(0.0, 2.0));
+        assert_eq!(C64::real(0.0).sqrt(), C64::real(0.0));
+    }
+
+    #[test]
+    fn normal_incidence_closed_form() {
+        for (n, k) in [
+            (1.5f32, 0.0f32),
+            (0.2, 3.0),
+            (0.5, 0.0),
+            (2.9, 3.1),
+            (10.0, 20.0),
+        ] {
+            let (n64, k64) = (f64::from(n), f64::from(k));
+            let want = ((n64 - 1.0).powi(2) + k64 * k64) / ((n64 + 1.0).powi(2) + k64 * k64);
+            let got = f64::from(fresnel(Complex::new(n, k), 1.0));
+            assert!(close(got, want, 1e-7), "{n} {k}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn dielectric_limits() {
+        let glass = Complex::real(1.5);
+        // Brewster: tan θB = η, Fp = 0, so F = Fs/2.
+        // There c = √(η² − sin²θB) = η² cos θB, so Fs = ((1 − η²)/(1 + η²))².
+        let cos_b = 1.0 / (1.0f64 + 1.5 * 1.5).sqrt();
+        let fs = ((1.0 - 1.5 * 1.5) / (1.0 + 1.5 * 1.5f64)).powi(2);
+        let got = f64::from(fresnel(glass, cos_b as f32));
+        assert!(close(got, fs / 2.0, 1e-6), "{got} vs {}", fs / 2.0);
+        // Grazing and the guards.
+        assert_eq!(fresnel(glass, 0.0), 1.0);
+        assert_eq!(fresnel(glass, -0.3), 1.0);
+        assert_eq!(fresnel(glass, f32::NAN), 1.0);
+        assert_eq!(fresnel(glass, 2.0), fresnel(glass, 1.0));
+        // Total internal reflection from inside glass.
+        let inside = Complex::real(1.0 / 1.5);
+        let cos_critical = (1.0f32 - 1.0 / 2.25).sqrt();
+        assert_eq!(fresnel(inside, cos_critical * 0.999), 1.0);
+        assert!(fresnel(inside, cos_critical * 1.01) < 1.0);
+        // No interface.
+        assert_eq!(fresnel(Complex::real(1.0), 0.5), 0.0);
+        assert_eq!(fresnel(Complex::real(-1.0), 0.0), 0.0);
+        assert_eq!(
+            q_bar(Complex::real(1.0), [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]),
+            0.0
+        );
+    }
+
+    #[test]
+    fn index_symmetries_and_extremes_stay_finite() {
+        for (n, k) in [(1.3f32, 2.0f32), (0.4, 0.0)] {
+            for cos in [0.0f32, 0.01, 0.5, 1.0] {
+                let f = fresnel(Complex::new(n, k), cos);
+                assert_eq!(f, fresnel(Complex::new(-n, k), cos));
+                assert_eq!(f, fresnel(Complex::new(n, -k), cos));
+            }
+        }
+        let specials = [
+            0.0f32,
+            -0.0,
+            1.0,
+            1e-30,
+            1e-45,
+            f32::MAX,
+            -f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for &n in &specials {
+            for &k in &specials {
+                for cos in [0.0f32, 1e-7, 0.5, 1.0, f32::NAN] {
+                    let f = fresnel(Complex::new(n, k), cos);
+                    assert!((0.0..=1.0).contains(&f), "n {n} k {k} cos {cos}: {f}");
+                }
+                for (i, o) in [
+                    ([0.0f32, 0.0, 1.0], [0.0f32, 0.0, 1.0]),
+                    ([1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+                    ([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+                    ([0.0, 0.0, 0.0], [f32::NAN, 0.0, 1.0]),
+                    ([0.0, 0.0, -1.0], [0.3, 0.4, -0.1]),
+                ] {
+                    let q = q_bar(Complex::new(n, k), i, o);
+                    assert!(q.is_finite() && q >= 0.0, "n {n} k {k} {i:?} {o:?}: {q}");
+                }
+            }
+        }
+        // A zero index behaves as its limit F → 1.
+        assert!(fresnel(Complex::new(0.0, 0.0), 1.0) > 1.0 - 1e-6);
+    }
+
+    #[test]
+    fn q_bar_is_fresnel_in_the_specular_direction() {
+        for (n, k) in [(1.5f32, 0.0f32), (0.2, 3.0), (1.2, 7.0), (0.7, 0.0)] {
+            let eta = Complex::new(n, k);
+            for deg in [0.0f32, 10.0, 45.0, 70.0, 85.0, 89.9] {
+                let (s, c) = deg.to_radians().sin_cos();
+                let phi = 0.7f32;
+                let i = [s * phi.cos(), s * phi.sin(), c];
+                let o = [-i[0], -i[1], i[2]];
+                let (q, f) = (q_bar(eta, i, o), fresnel(eta, c));
+                assert!(
+                    (q - f).abs() <= 2e-6 * f.max(1e-3),
+                    "η = {n}+{k}i, θ = {deg}: Q̄ {q} vs F {f}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn q_bar_at_double_grazing_matches_its_closed_form() {
+        let eta = Complex::new(1.2, 7.0);
+        let (eta_sq, e) = (C64::new(1.44 - 49.0, 16.8), C64::new(0.44 - 49.0, 16.8));
+        for phi in [0.0f64, 0.5, 1.5, 2.5, core::f64::consts::PI] {
+            // φ = φo − φi − π with φi = 0.
+            let po = phi + core::f64::consts::PI;
+            let i = [1.0f32, 0.0, 0.0];
+            let o = [po.cos() as f32, po.sin() as f32, 0.0];
+            // sin θi sin θo (cos φ, sin φ) = −(ix ox + iy oy, ix oy − iy ox).
+            let (cp, sp) = (-f64::from(o[0]), -f64::from(o[1]));
+            let t = e * cp - eta_sq;
+            let want = 0.5 * (cp * cp + 2.0 * e.norm_sqr().sqrt() * sp * sp + t.norm_sqr());
+            let got = f64::from(q_bar(eta, i, o));
+            assert!(
+                ((got - want) / want).abs() < 1e-6,
+                "φ {phi}: {got} vs {want}"
+            );
+        }
+    }
+}
