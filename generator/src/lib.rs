@@ -4,10 +4,13 @@
 //! - [`quad`]: adaptive quadrature that reports convergence;
 //! - [`reference`]: the f64 reference of SPEC §2 (EPD, Smith Λ, K-correlation, …);
 //! - [`tables`]: one module per table: build (parallel, deterministic) and verify;
+//! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
+//!   forms of the convolution, table T3);
 //! - [`query`]: the batch CSV queries of SPEC §6;
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod bspline;
+pub mod fit;
 pub mod quad;
 pub mod query;
 pub mod reference;

@@ -526,6 +526,26 @@ fn e_l2_rule_and_metric() {
     assert!((e - 0.01).abs() < 1e-12, "{e}");
 }
 
+#[test]
+fn profile_rule_orders() {
+    // Lower orders keep the intervals: same node count per interval, ∫ sin = 1
+    // to rounding, and order 16 is `new`.
+    for &w in &[1e-4, 1e-2, 0.5] {
+        assert_eq!(ProfileRule::with_order(w, 16), ProfileRule::new(w));
+        let n16 = ProfileRule::new(w).nodes.len();
+        for (order, tol) in [(1, 1e-2), (4, 1e-9), (8, 1e-14)] {
+            let rule = ProfileRule::with_order(w, order);
+            assert_eq!(rule.nodes.len() * 16, n16 * order);
+            let s: f64 = rule.weights.iter().sum();
+            assert!((s - 1.0).abs() < tol, "{order}: {s}");
+        }
+    }
+    assert_eq!(
+        ProfileRule::with_order(0.1, 0),
+        ProfileRule::with_order(0.1, 1)
+    );
+}
+
 /// The angles of the corner sweep: the peak, the scales of both lobes, the
 /// tails and the horizon.
 const SWEEP_THETAS: [f64; 14] = [
