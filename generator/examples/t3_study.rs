@@ -69,7 +69,7 @@ use std::fs;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
-use twoscale::format::Mapping;
+use twoscale::format::{AxisHeader, Mapping};
 use twoscale::interp::{coordinate_f64, inverse_coordinate_f64};
 
 // ---------------------------------------------------------------------------
@@ -991,8 +991,24 @@ impl AxisMap {
         }
     }
 
+    /// The runtime's axis header for this mapping (shifted domain, no linear term).
+    fn header(&self) -> AxisHeader {
+        AxisHeader {
+            nodes: 2,
+            mapping: self.mapping,
+            lo: self.lo - self.shift,
+            hi: self.hi - self.shift,
+            param: self.param,
+            param2: 0.0,
+        }
+    }
+
     fn coord(&self, x: f64) -> f64 {
-        coordinate_f64(self.mapping, self.param, x - self.shift)
+        coordinate_f64(&self.header(), x - self.shift)
+    }
+
+    fn inverse(&self, c: f64) -> f64 {
+        inverse_coordinate_f64(&self.header(), c) + self.shift
     }
 
     /// Node `i` of `n` (physical value).
@@ -1004,11 +1020,7 @@ impl AxisMap {
             return self.hi;
         }
         let (a, b) = (self.coord(self.lo), self.coord(self.hi));
-        inverse_coordinate_f64(
-            self.mapping,
-            self.param,
-            a + (b - a) * i as f64 / (n - 1) as f64,
-        ) + self.shift
+        self.inverse(a + (b - a) * i as f64 / (n - 1) as f64)
     }
 
     /// Cell and fraction of `x` on an `n`-node axis (clamped).
@@ -2161,7 +2173,7 @@ fn cell_points(layout: &Layout) -> Vec<Cell> {
             for (k, (m, _)) in layout.axes.iter().enumerate() {
                 let (a, b) = (m.coord(m.lo), m.coord(m.hi));
                 let y = rng.uniform_in(a, b);
-                x[k] = (inverse_coordinate_f64(m.mapping, m.param, y) + m.shift).clamp(m.lo, m.hi);
+                x[k] = m.inverse(y).clamp(m.lo, m.hi);
             }
             let pt = Pt::new(x[0], x[1], x[2], x[3]);
             let loc: Vec<(usize, f64)> = layout
