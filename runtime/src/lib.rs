@@ -13,6 +13,7 @@
 // `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
 #![allow(clippy::manual_clamp)]
 
+pub mod conv;
 pub mod epd;
 pub mod format;
 pub mod fresnel;
@@ -24,6 +25,7 @@ pub mod math;
 pub mod mmap;
 pub mod smith;
 
+pub use conv::Convolution;
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
