@@ -5,7 +5,8 @@
 //! into self-describing table files; this crate reads them zero-copy and
 //! interpolates them. It is `no_std` unless the `std` feature is enabled, never
 //! allocates, and never panics on a lookup path.
-#![cfg_attr(not(feature = "std"), no_std)]
+// Unit tests use std (Vec, format!); the library itself is no_std without the feature.
+#![cfg_attr(not(any(feature = "std", test)), no_std)]
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 // `!(x > 0.0)` is the guard that also catches NaN, used on purpose throughout.
