@@ -4,7 +4,9 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use twoscale::{Complex, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId};
+use twoscale::{
+    Complex, ConvTable, Convolution, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId,
+};
 
 const BATCH: usize = 1024;
 
@@ -220,5 +222,65 @@ fn fresnel(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith_g1, sigma_ratio, fresnel);
+/// T3: the accurate form (T3b) and the paper's form (T3a) against the exact
+/// convolution (direct quadrature, one angle per call).
+fn convolution(c: &mut Criterion) {
+    let buf = suite::read_table(TableId::Convolution);
+    let table = ConvTable::from_bytes(buf.bytes()).expect("valid T3");
+    let fit = table.fit();
+    let mut rng = generator::rng::SplitMix64::new(3);
+    let points: Vec<[f32; 6]> = (0..BATCH)
+        .map(|_| {
+            let theta = rng.uniform_in(0.0, 0.5) as f32;
+            [
+                libm::sinf(theta),
+                libm::cosf(theta),
+                (rng.uniform_in(0.1f64.ln(), 3000.1f64.ln()).exp() - 0.1) as f32,
+                (1.0 + rng.log_uniform_in(0.01, 9.0)) as f32,
+                rng.log_uniform_in(0.002, 1.0) as f32,
+                rng.uniform_in(0.2, 5.0) as f32,
+            ]
+        })
+        .collect();
+    let mut group = c.benchmark_group("convolution");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    for (name, form) in [("t3b_table", &table as &dyn Convolution), ("t3a_fit", &fit)] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut sum = 0.0f32;
+                for x in &points {
+                    let x = black_box(*x);
+                    sum += form.convolution_sin_cos(x[0], x[1], x[2], x[3], x[4], x[5]);
+                }
+                sum
+            })
+        });
+    }
+    group.finish();
+
+    const REFERENCE_BATCH: usize = 8;
+    let mut group = c.benchmark_group("convolution");
+    group.throughput(Throughput::Elements(REFERENCE_BATCH as u64));
+    group.sample_size(10);
+    group.bench_function("exact_direct", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f64;
+            for x in points.iter().take(REFERENCE_BATCH) {
+                let theta = f64::from(x[0]).atan2(f64::from(x[1]));
+                sum += generator::reference::conv::convolution(
+                    black_box(theta),
+                    f64::from(x[2]),
+                    f64::from(x[3]),
+                    f64::from(x[4]),
+                    f64::from(x[5]),
+                )
+                .unwrap_or(0.0);
+            }
+            sum
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, smith_g1, sigma_ratio, fresnel, convolution);
 criterion_main!(benches);

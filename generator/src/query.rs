@@ -12,9 +12,9 @@ use rayon::prelude::*;
 use std::io::{BufRead, Write};
 use std::path::Path;
 use twoscale::mmap::MappedFile;
-use twoscale::{SigmaRatioTable, SmithG1Table};
+use twoscale::{ConvTable, Convolution, SigmaRatioTable, SmithG1Table};
 
-use crate::reference::{epd, fresnel, kcorr};
+use crate::reference::{conv, epd, fresnel, kcorr};
 use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
@@ -22,6 +22,7 @@ pub const QUANTITIES: &[(&str, &[&str])] = &[
     ("g1", &["p", "a"]),
     ("sigma-ratio", &["theta_i", "B", "c"]),
     ("fresnel", &["n", "k", "cos_theta"]),
+    ("conv", &["u", "c", "beta", "p", "theta_h"]),
 ];
 
 /// Outcome of a query run.
@@ -133,6 +134,33 @@ pub fn run(
             }),
             &["table", "reference"],
         ),
+        "conv" => {
+            mapped = open(tables, twoscale::TableId::Convolution)?;
+            let table = ConvTable::from_bytes(mapped.bytes())
+                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::Convolution)))?;
+            (
+                // `fit` = T3a (the paper's s, g form), `table` = T3b, both
+                // from the runtime; `reference` = exact C by direct quadrature.
+                Box::new(move |x: &[f64]| {
+                    let (u, c, beta, p, theta_h) = (x[0], x[1], x[2], x[3], x[4]);
+                    let reference = conv::convolution(theta_h, u, c, beta, p)
+                        .map_err(|e| format!("reference: {e}"))?;
+                    let (sin, cos) = (theta_h.sin() as f32, theta_h.cos() as f32);
+                    let args = (u as f32, c as f32, beta as f32, p as f32);
+                    Ok(vec![
+                        table
+                            .fit()
+                            .convolution_sin_cos(sin, cos, args.0, args.1, args.2, args.3)
+                            .to_string(),
+                        table
+                            .convolution_sin_cos(sin, cos, args.0, args.1, args.2, args.3)
+                            .to_string(),
+                        reference.to_string(),
+                    ])
+                }),
+                &["fit", "table", "reference"],
+            )
+        }
         _ => unreachable!("quantity list and dispatch agree"),
     };
 

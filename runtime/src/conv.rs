@@ -1,15 +1,60 @@
 //! The normalised spherical convolution `C(θh; u, c, β, p)` of the diffraction
-//! lobe with the EPD NDF (SPEC §2.5, HP17 32–33, 39–41):
+//! lobe with the EPD NDF (SPEC §2.5, HP17 32–33, 39–41), and its table T3.
 //!
 //! ```text
 //!   C(θh; u, c, β, p) = ∫_{h·m > 0} k(2u sin∠(h,m)) cos²∠(h,m) D(m) dω_m
 //!   k(x) = (1 + x²)^(−(c+1)/2),     u = (b/λ) cos θd
 //! ```
 //!
-//! The BRDF reads `C` through the [`Convolution`] trait, so that the table
-//! forms (T3b, the accurate form, by default; T3a, the paper's `s · k(2g sin θh)`
-//! form, on request) are interchangeable.
+//! The BRDF reads `C` through the [`Convolution`] trait, so that the two forms
+//! stored in T3 are interchangeable:
+//!
+//! * [`ConvTable`] (**T3b**, the accurate form, the default): at every node of
+//!   the `(u, c, β, p)` grid, `ln C` at 32 evenly spaced values of a
+//!   normalised angle `ξ ∈ [0, 1]` ([`normalised_angle`]). A lookup blends
+//!   the four `ln C` values around `ξ(θh)` multilinearly over the 16 corners
+//!   of the parameter cell, then interpolates them along `ξ` by a monotone
+//!   cubic (Fritsch–Carlson), and exponentiates.
+//! * [`ConvFitTable`] (**T3a**, the paper's form, HP17 39–41):
+//!   `C ≈ s · k(2 g sin θh)` with `ln s` and `ln(g² + g_offset)` blended
+//!   multilinearly.
+//!
+//! Both live in one file (table id [`TableId::Convolution`], channels
+//! `[ln s, ln(g² + g_offset), ln C(ξ_0), …, ln C(ξ_31)]`) because the generator
+//! computes both from the same exact profile at each node.
+//!
+//! # The normalised angle
+//!
+//! With `τ = tan θh`, `u_e = √(u² + u_floor²)` and `y = (τ/β)^(2p)`,
+//!
+//! ```text
+//!   F(τ) = asinh(2 u_e τ) + λ · ln(1 + Y (1 − e^(−y/Y))),     ξ = F(τ) / F(τ_max)
+//! ```
+//!
+//! The first term is the kernel's own variable (linear in `θh` inside the
+//! kernel width `1/(2u)`, logarithmic in `tan θh` beyond it, up to the horizon
+//! where small-`p` NDFs peak); the second is the NDF's exponent
+//! (`ln D = const − y + 2 ln(1 + τ²)`), which puts nodes across the cliff of
+//! large-`p` lobes and saturates where `D` has fallen by `e^−Y`. Everything is
+//! known at lookup time. `τ_max`, `u_floor`, `λ` and `Y` are stored in the
+//! header (`params`), so the file is self-describing.
+//!
+//! # Out of the domain
+//!
+//! * `c`, `β`, `p` clamp to the table's domain (`c ∈ [1.01, 10]`,
+//!   `β ∈ [0.002, 1]`, `p ∈ [0.2, 5]` in the shipped table).
+//! * `u > u_max` (3000): the kernel is then far narrower than any other
+//!   feature and `C` follows the narrow-kernel limit `C ≈ D(θh) ∫K dω`; the
+//!   profile is taken at `u_max` and scaled by the ratio of the planar kernel
+//!   integrals `I(u) = (1 − (1 + 4u²)^((1−c)/2)) / ((c − 1) u²)` (T3a: `s`
+//!   scaled the same way, `g` held at its `u_max` value, as the paper
+//!   describes `g` saturating for large `u`).
+//! * `θh` beyond `atan(τ_max)` (within 1e-4 rad of the horizon) takes the
+//!   value at `τ_max`; `cos θh ≤ 0` is the horizon.
+//! * Non-finite inputs give 0. The result is never NaN or ∞.
 
+use crate::format::{FormatError, Header, Table, TableId};
+use crate::interp::Grid;
 use crate::math;
 
 /// A source of `C(θh; u, c, β, p)` (SPEC §2.5).
@@ -17,10 +62,27 @@ use crate::math;
 /// Implementations never panic and never return NaN or ∞ for finite inputs;
 /// each documents what it does outside its domain.
 pub trait Convolution {
-    /// `C` at `cos θh ∈ [0, 1]` (the cosine of the half vector's angle to the
-    /// normal) for the kernel parameters `u ≥ 0`, `c > 1` and the NDF's
-    /// `β > 0`, `p > 0`.
-    fn convolution(&self, cos_theta_h: f32, u: f32, c: f32, beta: f32, p: f32) -> f32;
+    /// `C` at the half-vector angle given by `sin θh` and `cos θh` (both in
+    /// `[0, 1]`; passing both keeps narrow lobes resolved: in f32,
+    /// `cos θh` alone cannot tell `θh = 1e-4` from 0) for the kernel
+    /// parameters `u ≥ 0`, `c > 1` and the NDF's `β > 0`, `p > 0`.
+    fn convolution_sin_cos(
+        &self,
+        sin_theta_h: f32,
+        cos_theta_h: f32,
+        u: f32,
+        c: f32,
+        beta: f32,
+        p: f32,
+    ) -> f32;
+
+    /// [`Convolution::convolution_sin_cos`] from `cos θh` alone (coarse for
+    /// `θh ≲ 1e-3`; prefer the sine and cosine from the half vector).
+    fn convolution(&self, cos_theta_h: f32, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        let cos = cos_theta_h.max(0.0).min(1.0);
+        let sin = math::sqrtf(((1.0 - cos) * (1.0 + cos)).max(0.0));
+        self.convolution_sin_cos(sin, cos, u, c, beta, p)
+    }
 }
 
 /// The K-correlation kernel shape `k(x) = (1 + x²)^(−(c+1)/2)` (HP17 14, 40),
@@ -32,4 +94,329 @@ pub fn kernel(x: f32, c: f32) -> f32 {
         return 0.0;
     }
     math::exp(-0.5 * (f64::from(c) + 1.0) * math::ln_1p(x2)) as f32
+}
+
+/// Number of channels before the `ln C` values: `ln s`, `ln(g² + g_offset)`.
+pub const FIT_CHANNELS: usize = 2;
+
+/// The constants of the normalised angle (see the module documentation),
+/// as stored in the header's `params[1..5]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleParams {
+    /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
+    pub tau_max: f64,
+    /// `u_floor`: `u_e = √(u² + u_floor²)`.
+    pub kernel_scale_floor: f64,
+    /// `λ`: weight of the NDF term.
+    pub ndf_weight: f64,
+    /// `Y`: where the NDF term saturates.
+    pub ndf_exponent_cap: f64,
+}
+
+/// `asinh x` for `x ≥ 0`, accurate for small `x`.
+#[inline]
+fn asinh_pos(x: f64) -> f64 {
+    math::ln_1p(x + x * x / (1.0 + math::sqrt(1.0 + x * x)))
+}
+
+/// `F(τ)` of the normalised angle (module documentation), `τ ≥ 0`.
+#[inline]
+fn angle_function(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
+    let ue = math::sqrt(u * u + a.kernel_scale_floor * a.kernel_scale_floor);
+    let kernel_term = asinh_pos(2.0 * ue * tau);
+    let y = if tau > 0.0 {
+        math::exp(2.0 * p * math::ln(tau / beta))
+    } else {
+        0.0
+    };
+    let cap = a.ndf_exponent_cap;
+    // 1 − e^(−y/Y), with y = ∞ giving 1.
+    let saturated = -math::exp_m1(-(y / cap));
+    kernel_term + a.ndf_weight * math::ln_1p(cap * saturated)
+}
+
+/// The normalised angle `ξ ∈ [0, 1]` of `τ = tan θh` for the parameters
+/// `(u, β, p)`: `ξ = F(min(τ, τ_max)) / F(τ_max)` (module documentation).
+/// Shared by the generator (node placement) and the lookup. Inputs must be
+/// finite with `β, p > 0`, `u ≥ 0`; `τ < 0` is treated as 0.
+pub fn normalised_angle(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
+    let tau = tau.max(0.0).min(a.tau_max);
+    let top = angle_function(a.tau_max, u, beta, p, a);
+    (angle_function(tau, u, beta, p, a) / top).max(0.0).min(1.0)
+}
+
+/// The inverse of [`normalised_angle`]: `τ(ξ)` by bisection on `[0, τ_max]`
+/// in `ln(1 + τ)` (F is increasing), to full f64 precision. For the generator.
+pub fn tan_of_normalised_angle(xi: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
+    if !(xi > 0.0) {
+        return 0.0;
+    }
+    if xi >= 1.0 {
+        return a.tau_max;
+    }
+    let top = angle_function(a.tau_max, u, beta, p, a);
+    let target = xi * top;
+    let (mut lo, mut hi) = (0.0f64, math::ln_1p(a.tau_max));
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if angle_function(math::exp_m1(mid), u, beta, p, a) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    math::exp_m1(0.5 * (lo + hi))
+}
+
+/// The planar kernel integral `I(u) = (1 − (1 + 4u²)^((1−c)/2)) / ((c − 1) u²)`
+/// (∝ ∫ k(2u sin γ) dω for a narrow kernel), used for `u > u_max`.
+fn planar_kernel_integral(u: f64, c: f64) -> f64 {
+    let cm1 = c - 1.0;
+    // 1 − (1 + 4u²)^(−(c−1)/2) = −expm1(…), accurate for c → 1.
+    let one_minus = -math::exp_m1(-0.5 * cm1 * math::ln_1p(4.0 * u * u));
+    one_minus / (cm1 * u * u)
+}
+
+/// The T3 file: both forms. Use [`ConvTable::fit`] for the paper's form.
+#[derive(Clone, Copy, Debug)]
+pub struct ConvTable<'a> {
+    grid: Grid<'a>,
+    angle: AngleParams,
+    /// Number of `ξ` nodes (channels after the fit channels).
+    angles: usize,
+    g_offset: f32,
+    u_max: f32,
+    domain: [(f32, f32); 4],
+}
+
+/// The paper's form of T3 (T3a), a view of a [`ConvTable`].
+#[derive(Clone, Copy, Debug)]
+pub struct ConvFitTable<'a> {
+    table: ConvTable<'a>,
+}
+
+/// Inputs after the out-of-domain rules: clamped parameters and the factor
+/// for `u > u_max`.
+struct Clamped {
+    u: f32,
+    c: f32,
+    beta: f32,
+    p: f32,
+    factor: f32,
+}
+
+impl<'a> ConvTable<'a> {
+    /// Reads a T3 file.
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, FormatError> {
+        Self::from_table(Table::from_bytes_expecting(bytes, TableId::Convolution)?)
+    }
+
+    /// Checks that `table` is a T3 file with a usable layout.
+    pub fn from_table(table: Table<'a>) -> Result<Self, FormatError> {
+        let header: &Header = table.expecting(TableId::Convolution)?.header();
+        let used = header.used_axes();
+        let channels = header.channels as usize;
+        let angles = header.params[0] as usize;
+        if used.len() != 4 || angles < 4 || channels != FIT_CHANNELS + angles {
+            return Err(FormatError::Shape(
+                "T3 needs 4 axes and 2 + angles channels with at least 4 angles",
+            ));
+        }
+        let angle = AngleParams {
+            tau_max: header.params[1],
+            kernel_scale_floor: header.params[2],
+            ndf_weight: header.params[3],
+            ndf_exponent_cap: header.params[4],
+        };
+        if !(angle.tau_max > 0.0) || !(angle.ndf_exponent_cap > 0.0) || !(header.params[5] > 0.0) {
+            return Err(FormatError::Shape("T3 angle parameters must be positive"));
+        }
+        let grid = Grid::new(header, table.grid())?;
+        let mut domain = [(0.0, 0.0); 4];
+        for (d, slot) in domain.iter_mut().enumerate() {
+            *slot = (grid.axis(d).lo(), grid.axis(d).hi());
+        }
+        if !(domain[1].0 > 1.0) || !(domain[2].0 > 0.0) || !(domain[3].0 > 0.0) || domain[0].0 < 0.0
+        {
+            return Err(FormatError::Shape(
+                "T3 domain must have c > 1, beta > 0, p > 0, u >= 0",
+            ));
+        }
+        Ok(ConvTable {
+            grid,
+            angle,
+            angles,
+            g_offset: header.params[5] as f32,
+            u_max: domain[0].1,
+            domain,
+        })
+    }
+
+    /// The paper's form (T3a) from the same file.
+    pub fn fit(&self) -> ConvFitTable<'a> {
+        ConvFitTable { table: *self }
+    }
+
+    /// The normalised-angle constants stored in the header.
+    pub fn angle_params(&self) -> AngleParams {
+        self.angle
+    }
+
+    /// Number of `ξ` nodes.
+    pub fn angles(&self) -> usize {
+        self.angles
+    }
+
+    fn clamp(&self, u: f32, c: f32, beta: f32, p: f32) -> Option<Clamped> {
+        if !(u.is_finite() && c.is_finite() && beta.is_finite() && p.is_finite()) {
+            return None;
+        }
+        let [du, dc, db, dp] = self.domain;
+        let c = c.max(dc.0).min(dc.1);
+        let u = u.max(du.0);
+        let (u, factor) = if u > self.u_max {
+            let (uf, um, cf) = (f64::from(u), f64::from(self.u_max), f64::from(c));
+            let ratio = planar_kernel_integral(uf, cf) / planar_kernel_integral(um, cf);
+            (
+                self.u_max,
+                if ratio.is_finite() { ratio as f32 } else { 0.0 },
+            )
+        } else {
+            (u, 1.0)
+        };
+        Some(Clamped {
+            u,
+            c,
+            beta: beta.max(db.0).min(db.1),
+            p: p.max(dp.0).min(dp.1),
+            factor,
+        })
+    }
+
+    fn cells(&self, k: &Clamped) -> [(usize, f32); 4] {
+        [
+            self.grid.axis(0).locate(k.u),
+            self.grid.axis(1).locate(k.c),
+            self.grid.axis(2).locate(k.beta),
+            self.grid.axis(3).locate(k.p),
+        ]
+    }
+
+    /// `ln C` at `ξ` for already clamped parameters: multilinear blend of the
+    /// four channels around `ξ`, then a monotone cubic along `ξ`.
+    fn ln_c(&self, cells: [(usize, f32); 4], xi: f64) -> f32 {
+        let n = self.angles;
+        let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
+        let k = (math::floorf(position) as usize).min(n - 2);
+        let t = position - k as f32;
+        let at = |j: isize| -> f32 {
+            let j = j.max(0).min(n as isize - 1) as usize;
+            self.grid.blend(cells, FIT_CHANNELS + j)
+        };
+        let k = k as isize;
+        let (v0, v1, v2, v3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
+        // Secant slopes (per node spacing) and Fritsch–Carlson derivatives.
+        let s_left = if k == 0 { v2 - v1 } else { v1 - v0 };
+        let s_mid = v2 - v1;
+        let s_right = if k as usize + 2 >= n {
+            v2 - v1
+        } else {
+            v3 - v2
+        };
+        let d1 = monotone_derivative(s_left, s_mid);
+        let d2 = monotone_derivative(s_mid, s_right);
+        // Cubic Hermite on [v1, v2] with derivatives d1, d2 (unit spacing).
+        let t2 = t * t;
+        let t3 = t2 * t;
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        h00 * v1 + h10 * d1 + h01 * v2 + h11 * d2
+    }
+
+    /// `C` from T3b at `τ = tan θh` (f64 inputs; the [`Convolution`] impl
+    /// takes `cos θh`).
+    pub fn at_tan(&self, tau: f64, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        let Some(k) = self.clamp(u, c, beta, p) else {
+            return 0.0;
+        };
+        if tau.is_nan() {
+            return 0.0;
+        }
+        let xi = normalised_angle(
+            tau,
+            f64::from(k.u),
+            f64::from(k.beta),
+            f64::from(k.p),
+            &self.angle,
+        );
+        let value = math::expf(self.ln_c(self.cells(&k), xi)) * k.factor;
+        if value.is_finite() { value } else { 0.0 }
+    }
+
+    /// `(s, g)` of the paper's form (T3a) at the given parameters, after the
+    /// out-of-domain rules (`s` includes the `u > u_max` factor). `(0, 0)` for
+    /// non-finite inputs.
+    pub fn fit_parameters(&self, u: f32, c: f32, beta: f32, p: f32) -> (f32, f32) {
+        let Some(k) = self.clamp(u, c, beta, p) else {
+            return (0.0, 0.0);
+        };
+        let cells = self.cells(&k);
+        let s = math::expf(self.grid.blend(cells, 0)) * k.factor;
+        let g2 = math::expf(self.grid.blend(cells, 1)) - self.g_offset;
+        let s = if s.is_finite() { s } else { 0.0 };
+        (s, math::sqrtf(g2.max(0.0)))
+    }
+}
+
+/// The Fritsch–Carlson derivative at a node between secant slopes `a` and
+/// `b`: the harmonic mean when they agree in sign, else 0 (keeps the cubic
+/// monotone between monotone data).
+#[inline]
+fn monotone_derivative(a: f32, b: f32) -> f32 {
+    if a * b > 0.0 {
+        2.0 * a * b / (a + b)
+    } else {
+        0.0
+    }
+}
+
+/// `tan θh = sin θh / cos θh`, with non-positive cosines at the horizon (∞)
+/// and NaN for non-finite inputs.
+#[inline]
+fn tan_from_sin_cos(sin_theta_h: f32, cos_theta_h: f32) -> f64 {
+    if !(sin_theta_h.is_finite() && cos_theta_h.is_finite()) {
+        return f64::NAN;
+    }
+    let (s, c) = (f64::from(sin_theta_h).max(0.0), f64::from(cos_theta_h));
+    if c > 0.0 { s / c } else { f64::INFINITY }
+}
+
+impl Convolution for ConvTable<'_> {
+    fn convolution_sin_cos(&self, sin: f32, cos: f32, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        self.at_tan(tan_from_sin_cos(sin, cos), u, c, beta, p)
+    }
+}
+
+impl ConvFitTable<'_> {
+    /// `(s, g)` at the given parameters; see [`ConvTable::fit_parameters`].
+    pub fn parameters(&self, u: f32, c: f32, beta: f32, p: f32) -> (f32, f32) {
+        self.table.fit_parameters(u, c, beta, p)
+    }
+}
+
+impl Convolution for ConvFitTable<'_> {
+    /// `s · k(2 g sin θh)` (HP17 39–41); `sin θh` is clamped to `[0, 1]`.
+    fn convolution_sin_cos(&self, sin: f32, _cos: f32, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        if !sin.is_finite() {
+            return 0.0;
+        }
+        let (s, g) = self.parameters(u, c, beta, p);
+        let c = c.max(self.table.domain[1].0).min(self.table.domain[1].1);
+        s * kernel(2.0 * g * sin.max(0.0).min(1.0), c)
+    }
 }

@@ -57,14 +57,19 @@ pub enum TableId {
     /// T5: internal diffuse Fresnel reflectance F_dr,int(η) of a dielectric
     /// over η; see [`crate::fresnel::DiffuseFresnelTable`].
     DiffuseFresnel = 3,
+    /// T3: the convolution `C(θh; u, c, β, p)` of the diffraction lobe with
+    /// the EPD NDF over (u, c, β, p): the paper's `s, g` (T3a) and `ln C` at
+    /// 32 normalised angles (T3b) per node; see [`crate::conv`].
+    Convolution = 4,
 }
 
 impl TableId {
     /// Every table id, in tag order.
-    pub const ALL: [TableId; 3] = [
+    pub const ALL: [TableId; 4] = [
         TableId::SmithG1,
         TableId::SigmaRatio,
         TableId::DiffuseFresnel,
+        TableId::Convolution,
     ];
 
     /// The tag stored in the file.
@@ -83,6 +88,7 @@ impl TableId {
             TableId::SmithG1 => "t1-smith-g1",
             TableId::SigmaRatio => "t2-sigma-ratio",
             TableId::DiffuseFresnel => "t5-diffuse-fresnel",
+            TableId::Convolution => "t3-convolution",
         }
     }
 
@@ -98,6 +104,9 @@ impl TableId {
             TableId::DiffuseFresnel => {
                 "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, SPEC 2.6); cubic B-spline coefficients"
             }
+            TableId::Convolution => {
+                "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); multilinear in the parameters"
+            }
         }
     }
 
@@ -107,6 +116,7 @@ impl TableId {
             TableId::SmithG1 => &["p", "a_scaled"],
             TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
             TableId::DiffuseFresnel => &["eta"],
+            TableId::Convolution => &["u", "c", "beta", "p"],
         }
     }
 
@@ -117,6 +127,16 @@ impl TableId {
             TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
             TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
             TableId::DiffuseFresnel => &["quadrature_rel_tol", "quadrature_abs_tol"],
+            TableId::Convolution => &[
+                "angles",
+                "tau_max",
+                "kernel_scale_floor",
+                "ndf_weight",
+                "ndf_exponent_cap",
+                "g_offset",
+                "value_floor",
+                "reference_target",
+            ],
         }
     }
 }

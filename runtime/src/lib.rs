@@ -26,7 +26,7 @@ pub mod math;
 pub mod mmap;
 pub mod smith;
 
-pub use conv::Convolution;
+pub use conv::{ConvFitTable, ConvTable, Convolution};
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};

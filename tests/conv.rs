@@ -1,0 +1,273 @@
+//! T3 (the convolution C of SPEC §2.5) through the runtime: the lookup
+//! machinery on synthetic tables it must reproduce exactly, the documented
+//! behaviour outside the domain, the normalised angle, and the shipped table
+//! against the exact reference (at its nodes, and at random points with the
+//! issue's acceptance figures).
+
+use generator::reference::conv as reference;
+use generator::tables::t3;
+use twoscale::TableId;
+use twoscale::conv::{ConvTable, Convolution, normalised_angle, tan_of_normalised_angle};
+use twoscale::format::write::{TableSpec, encode};
+use twoscale::format::{AxisHeader, Kernel, aligned_copy};
+use twoscale::interp::{coordinate_f64, node_value};
+
+fn small_axis(nodes: u32, base: &AxisHeader) -> AxisHeader {
+    AxisHeader { nodes, ..*base }
+}
+
+/// A T3 file on a small grid whose stored `ln C` is linear in the mapped
+/// coordinates of the parameters and in `ξ` (and `ln s`, `ln(g² + offset)`
+/// linear in the parameters): multilinear blending and the monotone cubic
+/// along `ξ` reproduce such data exactly.
+fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f64) -> f64) {
+    let axes = [
+        small_axis(4, &t3::U_AXIS),
+        small_axis(3, &t3::C_AXIS),
+        small_axis(5, &t3::BETA_AXIS),
+        small_axis(3, &t3::P_AXIS),
+    ];
+    let coeff = [0.3, -0.7, 1.1, 0.4];
+    let f = move |x: [f64; 4], xi: f64| -> f64 {
+        let mut v = -2.0 - 5.0 * xi;
+        for d in 0..4 {
+            v += coeff[d] * coordinate_f64(&axes[d], x[d]);
+        }
+        v
+    };
+    let mut grid = Vec::new();
+    for i in 0..4 {
+        for j in 0..3 {
+            for k in 0..5 {
+                for l in 0..3 {
+                    let x = [
+                        node_value(&axes[0], i),
+                        node_value(&axes[1], j),
+                        node_value(&axes[2], k),
+                        node_value(&axes[3], l),
+                    ];
+                    grid.push(f(x, 0.0) as f32); // ln s
+                    grid.push(f(x, 0.5) as f32); // ln(g² + offset)
+                    for a in 0..angles {
+                        grid.push(f(x, a as f64 / (angles - 1) as f64) as f32);
+                    }
+                }
+            }
+        }
+    }
+    let a = t3::ANGLE;
+    let bytes = encode(&TableSpec {
+        table_id: TableId::Convolution,
+        channels: (2 + angles) as u32,
+        kernel: Kernel::Multilinear,
+        axes: &axes,
+        params: &[
+            angles as f64,
+            a.tau_max,
+            a.kernel_scale_floor,
+            a.ndf_weight,
+            a.ndf_exponent_cap,
+            t3::G_OFFSET,
+            t3::VALUE_FLOOR,
+            1e-6,
+        ],
+        grid: &grid,
+        aux: &[],
+        generator_version: "test",
+    })
+    .unwrap();
+    (bytes, axes, f)
+}
+
+#[test]
+fn lookup_reproduces_data_linear_in_parameters_and_angle() {
+    let (bytes, _, f) = linear_table(12);
+    let buf = aligned_copy(&bytes);
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    let mut rng = generator::rng::SplitMix64::new(5);
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        let x = [
+            f64::from(rng.log_uniform_in(1e-3, 3000.0) as f32),
+            f64::from((1.0 + rng.log_uniform_in(0.01, 9.0)) as f32),
+            f64::from(rng.log_uniform_in(0.002, 1.0) as f32),
+            f64::from(rng.uniform_in(0.2, 5.0) as f32),
+        ];
+        let tau = rng.log_uniform_in(1e-6, 1e5);
+        let xi = normalised_angle(tau, x[0], x[2], x[3], &table.angle_params());
+        let want = f(x, xi);
+        let got =
+            f64::from(table.at_tan(tau, x[0] as f32, x[1] as f32, x[2] as f32, x[3] as f32)).ln();
+        worst = worst.max((got - want).abs());
+    }
+    // f32 storage and blending of values of magnitude ~10: a few ulps.
+    assert!(worst < 2e-5, "max |ln C error| {worst}");
+    // T3a: s = exp(ln s), g² = exp(…) − offset.
+    let (s, g) = table.fit().parameters(10.0, 2.0, 0.1, 1.0);
+    let x = [
+        f64::from(10.0f32),
+        f64::from(2.0f32),
+        f64::from(0.1f32),
+        f64::from(1.0f32),
+    ];
+    assert!((f64::from(s).ln() - f(x, 0.0)).abs() < 2e-5);
+    let g2 = f(x, 0.5).exp() - t3::G_OFFSET;
+    assert!((f64::from(g) - g2.max(0.0).sqrt()).abs() < 1e-4 * g2.sqrt().max(1.0));
+}
+
+#[test]
+fn out_of_domain_inputs_give_finite_values() {
+    let (bytes, _, _) = linear_table(8);
+    let buf = aligned_copy(&bytes);
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    let fit = table.fit();
+    let odd = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -1.0,
+        0.0,
+        1e-30,
+        0.5,
+        1.0,
+        1.5,
+        1e30,
+        f32::MAX,
+    ];
+    for &s in &odd {
+        for &c in &odd {
+            for &u in &odd {
+                for &x in &odd {
+                    for form in [&table as &dyn Convolution, &fit] {
+                        let v = form.convolution_sin_cos(s, c, u, x, x, x);
+                        assert!(v.is_finite() && v >= 0.0, "{s} {c} {u} {x}: {v}");
+                        let v = form.convolution(c, u, 1.5, 0.1, x);
+                        assert!(v.is_finite() && v >= 0.0, "{c} {u} {x}: {v}");
+                    }
+                }
+            }
+        }
+    }
+    // Non-finite parameters give 0.
+    assert_eq!(table.convolution(1.0, f32::NAN, 2.0, 0.1, 1.0), 0.0);
+    assert_eq!(fit.convolution(1.0, 1.0, 2.0, f32::INFINITY, 1.0), 0.0);
+}
+
+/// Beyond u_max the profile at u_max is scaled by the ratio of planar kernel
+/// integrals, which falls like 1/u² for large u and is continuous at u_max.
+#[test]
+fn beyond_u_max_follows_the_narrow_kernel_limit() {
+    let (bytes, axes, _) = linear_table(8);
+    let buf = aligned_copy(&bytes);
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    let u_max = axes[0].hi as f32;
+    let at = |u: f32| table.at_tan(0.01, u, 3.0, 0.1, 1.0);
+    let continuity = (at(u_max * 1.0001) / at(u_max) - 1.0).abs();
+    assert!(continuity < 1e-3, "jump at u_max: {continuity}");
+    let ratio = at(4.0 * u_max) / at(2.0 * u_max);
+    assert!((ratio - 0.25).abs() < 1e-3, "u² law: {ratio}");
+    let (s1, g1) = table.fit().parameters(u_max, 3.0, 0.1, 1.0);
+    let (s2, g2) = table.fit().parameters(2.0 * u_max, 3.0, 0.1, 1.0);
+    assert_eq!(g1, g2, "g is held beyond u_max");
+    assert!(s2 < 0.3 * s1);
+}
+
+#[test]
+fn normalised_angle_inverts_and_is_monotone() {
+    let a = t3::ANGLE;
+    for &(u, beta, p) in &[
+        (0.0, 0.002, 0.2),
+        (3000.0, 0.002, 5.0),
+        (30.0, 0.3, 1.0),
+        (3000.0, 1.0, 0.2),
+        (0.5, 1.0, 5.0),
+    ] {
+        let mut last = -1.0;
+        for k in 0..=200 {
+            let xi = k as f64 / 200.0;
+            let tau = tan_of_normalised_angle(xi, u, beta, p, &a);
+            assert!(tau >= last, "τ(ξ) not monotone at {u} {beta} {p} ξ = {xi}");
+            last = tau;
+            let back = normalised_angle(tau, u, beta, p, &a);
+            assert!(
+                (back - xi).abs() < 1e-12,
+                "{u} {beta} {p}: ξ {xi} -> τ {tau} -> {back}"
+            );
+        }
+    }
+}
+
+/// The angle rule of the T3a fit integrates `sin θ` over `[0, atan τ_max]`
+/// (it is the trapezoid rule in ξ with the exact Jacobian).
+#[test]
+fn angle_rule_integrates_the_measure() {
+    for &(u, beta, p) in &[(0.0, 1.0, 1.0), (30.0, 0.05, 2.0), (3000.0, 0.002, 0.2)] {
+        let (thetas, weights) = t3::angle_rule(u, beta, p);
+        let sum: f64 = weights.iter().sum();
+        let want = 1.0 - thetas.last().unwrap().cos();
+        assert!(
+            (sum / want - 1.0).abs() < 0.05,
+            "{u} {beta} {p}: {sum} vs {want}"
+        );
+    }
+}
+
+fn shipped() -> Option<twoscale::format::AlignedBuf> {
+    let path = suite::tables_dir().join(generator::tables::file_name(TableId::Convolution));
+    path.exists()
+        .then(|| suite::read_table(TableId::Convolution))
+}
+
+/// At grid nodes the lookup returns the node's exact profile at its 32
+/// angles (the runtime and the generator agree on the layout, the angle and
+/// the storage order), to f32 rounding.
+#[test]
+fn shipped_table_reproduces_exact_profiles_at_nodes() {
+    let Some(buf) = shipped() else {
+        panic!("tables/t3-convolution.tbl is missing: run `cargo run -p generator --release`");
+    };
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    for index in [0usize, 7, 1234, 5555, 9001, 13_337, 16_000, 20_159] {
+        let [u, c, beta, p] = t3::node_params(index);
+        let (thetas, _) = t3::angle_rule(u, beta, p);
+        let exact = reference::convolution_profile(u, c, beta, p, &thetas).unwrap();
+        let peak = exact.iter().cloned().fold(0.0, f64::max);
+        for (&theta, &want) in thetas.iter().zip(&exact) {
+            if want < 1e-9 * peak {
+                continue;
+            }
+            let got =
+                f64::from(table.at_tan(theta.tan(), u as f32, c as f32, beta as f32, p as f32));
+            assert!(
+                ((got - want) / want).abs() < 2e-4,
+                "node {index} θ {theta}: {got} vs {want}"
+            );
+        }
+    }
+}
+
+/// The acceptance figures for T3b at random points (as `verify`
+/// measures them, at other points): pointwise relative error where
+/// C > 1e-3 C(0), median ≤ 1% and 95th percentile ≤ 5%.
+#[test]
+fn shipped_table_meets_the_pointwise_targets() {
+    let Some(buf) = shipped() else {
+        panic!("tables/t3-convolution.tbl is missing: run `cargo run -p generator --release`");
+    };
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    let mut errors = Vec::new();
+    for point in t3::verification_points(16, 4242) {
+        let r = t3::verify_point(&table, point).unwrap();
+        errors.extend(r.accurate_pointwise);
+    }
+    errors.sort_by(f64::total_cmp);
+    let q = |f: f64| errors[((errors.len() - 1) as f64 * f) as usize];
+    eprintln!(
+        "T3b pointwise relative error at {} angles: median {:.3e}, p95 {:.3e}, max {:.3e}",
+        errors.len(),
+        q(0.5),
+        q(0.95),
+        q(1.0)
+    );
+    assert!(q(0.5) <= 0.01 && q(0.95) <= 0.05);
+}
