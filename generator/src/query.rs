@@ -14,7 +14,7 @@ use std::path::Path;
 use twoscale::mmap::MappedFile;
 use twoscale::{SigmaRatioTable, SmithG1Table};
 
-use crate::reference::{epd, fresnel, kcorr};
+use crate::reference::{brdf, epd, fresnel, kcorr};
 use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
@@ -22,6 +22,13 @@ pub const QUANTITIES: &[(&str, &[&str])] = &[
     ("g1", &["p", "a"]),
     ("sigma-ratio", &["theta_i", "B", "c"]),
     ("fresnel", &["n", "k", "cos_theta"]),
+    (
+        "brdf",
+        &[
+            "beta", "p", "sigma_s", "b", "c", "n", "k", "lambda", "ix", "iy", "iz", "ox", "oy",
+            "oz",
+        ],
+    ),
 ];
 
 /// Outcome of a query run.
@@ -82,6 +89,7 @@ pub fn run(
 
     // Load the tables before reading rows, so a missing file fails fast.
     let mapped;
+    let mapped_brdf;
     let (evaluate, outputs): (Evaluator<'_>, &[&str]) = match quantity {
         "g1" => {
             mapped = open(tables, twoscale::TableId::SmithG1)?;
@@ -133,6 +141,72 @@ pub fn run(
             }),
             &["table", "reference"],
         ),
+        "brdf" => {
+            // SPEC §6: the conductor two-scale model. `table` is the runtime
+            // (`twoscale::brdf::TwoScale`, f32) reading T1, T2 and T5;
+            // `reference` is `reference::brdf::two_scale` (exact Λ, σrel, C).
+            mapped_brdf = (
+                open(tables, twoscale::TableId::SmithG1)?,
+                open(tables, twoscale::TableId::SigmaRatio)?,
+                open(tables, twoscale::TableId::DiffuseFresnel)?,
+            );
+            let (t1, t2, t5) = &mapped_brdf;
+            let table_err = |id: twoscale::TableId| move |e| format!("{}: {e}", file_name(id));
+            let runtime_tables = twoscale::brdf::Tables {
+                smith: SmithG1Table::from_bytes(t1.bytes())
+                    .map_err(table_err(twoscale::TableId::SmithG1))?,
+                sigma_ratio: SigmaRatioTable::from_bytes(t2.bytes())
+                    .map_err(table_err(twoscale::TableId::SigmaRatio))?,
+                diffuse_fresnel: twoscale::DiffuseFresnelTable::from_bytes(t5.bytes())
+                    .map_err(table_err(twoscale::TableId::DiffuseFresnel))?,
+                // ─── T3 PLUG-IN POINT ──────────────────────────────────────
+                // C comes from the exact f64 reference through an adapter
+                // until the T3b table (`ConvTable`) exists; then open the T3b
+                // file like T1/T2 above and put `&conv_table` here. Until
+                // then `table` carries the error of T1, T2 and f32 only.
+                convolution: &brdf::ExactConvolution,
+            };
+            (
+                Box::new(move |x: &[f64]| {
+                    let params = brdf::Params {
+                        beta: x[0],
+                        p: x[1],
+                        sigma_s: x[2],
+                        b: x[3],
+                        c: x[4],
+                        n: x[5],
+                        k: x[6],
+                        lambda: x[7],
+                    };
+                    let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
+                    let options = twoscale::brdf::Options::default();
+                    let reference = brdf::two_scale(&params, i, o, &options)
+                        .map_err(|e| format!("reference: {e}"))?;
+                    let f = |v: f64| v as f32;
+                    let layer = twoscale::brdf::Layer {
+                        surface: twoscale::brdf::Surface {
+                            beta: f(params.beta),
+                            p: f(params.p),
+                            sigma_s: f(params.sigma_s),
+                            b: f(params.b),
+                            c: f(params.c),
+                        },
+                        base: twoscale::brdf::BaseLayer::Conductor,
+                        lambertian: 0.0,
+                    };
+                    let model = twoscale::TwoScale::new(
+                        &runtime_tables,
+                        layer,
+                        f(params.lambda),
+                        twoscale::Complex::new(f(params.n), f(params.k)),
+                        options,
+                    );
+                    let table = model.eval(i.map(f), o.map(f));
+                    Ok(vec![table.to_string(), reference.total().to_string()])
+                }),
+                &["table", "reference"],
+            )
+        }
         _ => unreachable!("quantity list and dispatch agree"),
     };
 
