@@ -14,7 +14,7 @@ use std::path::Path;
 use twoscale::mmap::MappedFile;
 use twoscale::{ConvTable, Convolution, SigmaRatioTable, SmithG1Table};
 
-use crate::reference::{conv, epd, fresnel, kcorr};
+use crate::reference::{brdf, conv, epd, fresnel, kcorr};
 use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
@@ -23,6 +23,13 @@ pub const QUANTITIES: &[(&str, &[&str])] = &[
     ("sigma-ratio", &["theta_i", "B", "c"]),
     ("fresnel", &["n", "k", "cos_theta"]),
     ("conv", &["u", "c", "beta", "p", "theta_h"]),
+    (
+        "brdf",
+        &[
+            "beta", "p", "sigma_s", "b", "c", "n", "k", "lambda", "ix", "iy", "iz", "ox", "oy",
+            "oz",
+        ],
+    ),
 ];
 
 /// Outcome of a query run.
@@ -83,6 +90,8 @@ pub fn run(
 
     // Load the tables before reading rows, so a missing file fails fast.
     let mapped;
+    let mapped_brdf;
+    let conv_table;
     let (evaluate, outputs): (Evaluator<'_>, &[&str]) = match quantity {
         "g1" => {
             mapped = open(tables, twoscale::TableId::SmithG1)?;
@@ -159,6 +168,71 @@ pub fn run(
                     ])
                 }),
                 &["fit", "table", "reference"],
+            )
+        }
+        "brdf" => {
+            // SPEC §6: the conductor two-scale model. `table` is the runtime
+            // (`twoscale::brdf::TwoScale`, f32) reading T1, T2 and T5;
+            // `reference` is `reference::brdf::two_scale` (exact Λ, σrel, C).
+            mapped_brdf = (
+                open(tables, twoscale::TableId::SmithG1)?,
+                open(tables, twoscale::TableId::SigmaRatio)?,
+                open(tables, twoscale::TableId::DiffuseFresnel)?,
+                open(tables, twoscale::TableId::Convolution)?,
+            );
+            let (t1, t2, t5, t3) = &mapped_brdf;
+            conv_table = ConvTable::from_bytes(t3.bytes())
+                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::Convolution)))?;
+            let table_err = |id: twoscale::TableId| move |e| format!("{}: {e}", file_name(id));
+            let runtime_tables = twoscale::brdf::Tables {
+                smith: SmithG1Table::from_bytes(t1.bytes())
+                    .map_err(table_err(twoscale::TableId::SmithG1))?,
+                sigma_ratio: SigmaRatioTable::from_bytes(t2.bytes())
+                    .map_err(table_err(twoscale::TableId::SigmaRatio))?,
+                diffuse_fresnel: twoscale::DiffuseFresnelTable::from_bytes(t5.bytes())
+                    .map_err(table_err(twoscale::TableId::DiffuseFresnel))?,
+                // C from T3b, the runtime's default form.
+                convolution: &conv_table,
+            };
+            (
+                Box::new(move |x: &[f64]| {
+                    let params = brdf::Params {
+                        beta: x[0],
+                        p: x[1],
+                        sigma_s: x[2],
+                        b: x[3],
+                        c: x[4],
+                        n: x[5],
+                        k: x[6],
+                        lambda: x[7],
+                    };
+                    let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
+                    let options = twoscale::brdf::Options::default();
+                    let reference = brdf::two_scale(&params, i, o, &options)
+                        .map_err(|e| format!("reference: {e}"))?;
+                    let f = |v: f64| v as f32;
+                    let layer = twoscale::brdf::Layer {
+                        surface: twoscale::brdf::Surface {
+                            beta: f(params.beta),
+                            p: f(params.p),
+                            sigma_s: f(params.sigma_s),
+                            b: f(params.b),
+                            c: f(params.c),
+                        },
+                        base: twoscale::brdf::BaseLayer::Conductor,
+                        lambertian: 0.0,
+                    };
+                    let model = twoscale::TwoScale::new(
+                        &runtime_tables,
+                        layer,
+                        f(params.lambda),
+                        twoscale::Complex::new(f(params.n), f(params.k)),
+                        options,
+                    );
+                    let table = model.eval(i.map(f), o.map(f));
+                    Ok(vec![table.to_string(), reference.total().to_string()])
+                }),
+                &["table", "reference"],
             )
         }
         _ => unreachable!("quantity list and dispatch agree"),

@@ -14,18 +14,22 @@
 // `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
 #![allow(clippy::manual_clamp)]
 
+pub mod brdf;
 pub mod conv;
 pub mod epd;
 pub mod format;
 pub mod fresnel;
 pub mod gamma;
+pub mod hp15;
 pub mod interp;
 pub mod kcorr;
+pub mod materials;
 pub mod math;
 #[cfg(feature = "std")]
 pub mod mmap;
 pub mod smith;
 
+pub use brdf::{Rgb, TwoScale};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};

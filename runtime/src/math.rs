@@ -57,6 +57,12 @@ forward! {
     sinf(x) -> f32 = sin / sinf;
     /// cos x (f32).
     cosf(x) -> f32 = cos / cosf;
+    /// sin x (f64).
+    sin(x) -> f64 = sin / sin;
+    /// cos x (f64).
+    cos(x) -> f64 = cos / cos;
+    /// arccos x (f64), NaN outside [−1, 1] (callers clamp).
+    acos(x) -> f64 = acos / acos;
 }
 
 /// ln Γ(x) for x > 0 (f64, libm's `lgamma` in both builds: `std` has no lgamma).

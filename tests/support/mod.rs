@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+pub mod brdf;
+
 // The README's code examples run as doctests of this crate.
 #[doc = include_str!("../../README.md")]
 mod readme {}

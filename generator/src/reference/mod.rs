@@ -5,6 +5,8 @@
 //! failures and invalid parameters are reported as
 //! [`QuadError`](crate::quad::QuadError); nothing here panics on bad input.
 //!
+//! * [`brdf`]: the two-scale BRDF of a conductor (HP17 24-33) with exact
+//!   Λ, σrel and C, and the exact-C adapter of the runtime's `Convolution` trait.
 //! * [`epd`]: the Exponential Power Distribution NDF of (HP17 34–35), its
 //!   sampling (HP17 49–50) and its Smith masking term Λ, G1 (HP17 36–38).
 //! * [`kcorr`]: the K-correlation spectrum (HP17 16) and the renormalisation
@@ -16,6 +18,7 @@
 //!   diffraction colour term Q of (HP17 10), and the diffuse Fresnel
 //!   reflectances of a dielectric (SPEC §2.6).
 
+pub mod brdf;
 pub mod conv;
 pub mod epd;
 pub mod fresnel;

@@ -1,0 +1,188 @@
+//! `f64` reference of the two-scale BRDF of SPEC §2.5 (HP17 24-33) for a
+//! conductor, with every ingredient exact: Smith Λ by quadrature
+//! ([`epd::lambda`]), σrel by quadrature ([`kcorr::sigma_ratio`]), C by the
+//! direct 2-D quadrature ([`conv::convolution`]), F and Q̄ in f64
+//! ([`fresnel`]). It mirrors `twoscale::brdf::TwoScale::eval_lobes` formula
+//! by formula, so that the runtime's error is the tables' error.
+//!
+//! Cost: dominated by C (1–30 ms per call).
+//!
+//! [`ExactConvolution`] adapts [`conv::convolution`] to the runtime's
+//! `Convolution` trait; it stands in for the T3 tables where they are not yet
+//! available (tests, `query brdf`).
+
+use std::f64::consts::PI;
+
+use twoscale::brdf::{ColourTerms, Masking, Options, SigmaRelMode};
+
+use crate::reference::{conv, epd, fresnel, kcorr};
+
+/// The parameters of the conductor two-scale model (SPEC §6 `query brdf`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Params {
+    /// EPD width β.
+    pub beta: f64,
+    /// EPD shape p.
+    pub p: f64,
+    /// RMS height σs (µm).
+    pub sigma_s: f64,
+    /// Correlation length b (µm).
+    pub b: f64,
+    /// Spectral exponent c > 1.
+    pub c: f64,
+    /// Real part of the index.
+    pub n: f64,
+    /// Imaginary part of the index.
+    pub k: f64,
+    /// Wavelength (µm).
+    pub lambda: f64,
+}
+
+/// The three terms of ρ (sr⁻¹): `A_spec ρ_CT`, `ρ_CTD`, and their sum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Value {
+    /// `A_spec · ρ_CT` (HP17 25-26).
+    pub specular: f64,
+    /// `ρ_CTD` (HP17 32-33 with SPEC §2.5's constant).
+    pub diffraction: f64,
+}
+
+impl Value {
+    /// ρ.
+    pub fn total(&self) -> f64 {
+        self.specular + self.diffraction
+    }
+}
+
+fn normalise(v: [f64; 3], name: &str) -> Result<[f64; 3], String> {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if !(len > 0.0 && len.is_finite()) {
+        return Err(format!("{name}: not a finite non-zero direction"));
+    }
+    Ok(v.map(|x| x / len))
+}
+
+/// `tan θ` of a unit vector, from its components.
+fn tan_theta(w: [f64; 3]) -> f64 {
+    w[0].hypot(w[1]) / w[2]
+}
+
+/// ρ(i, o) of the conductor two-scale model (module documentation), with the
+/// runtime's `options` (masking, σrel mode, colour terms). Directions at or
+/// below the horizon give 0, as in the runtime.
+pub fn two_scale(
+    params: &Params,
+    i: [f64; 3],
+    o: [f64; 3],
+    options: &Options,
+) -> Result<Value, String> {
+    let (wi, wo) = (normalise(i, "i")?, normalise(o, "o")?);
+    let zero = Value {
+        specular: 0.0,
+        diffraction: 0.0,
+    };
+    if !(wi[2] > 0.0 && wo[2] > 0.0) {
+        return Ok(zero);
+    }
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let Params {
+        beta,
+        p,
+        sigma_s,
+        b,
+        c,
+        n,
+        k,
+        lambda,
+    } = *params;
+    let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+    let len = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
+    let h = sum.map(|x| x / len);
+    let cos_d = (wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2]).clamp(0.0, 1.0);
+    let theta_h = h[0].hypot(h[1]).atan2(h[2]);
+    let (cos_i, cos_o) = (wi[2], wo[2]);
+
+    let lambda_i = epd::lambda(p, beta * tan_theta(wi)).map_err(|e| err(&e))?;
+    let lambda_o = epd::lambda(p, beta * tan_theta(wo)).map_err(|e| err(&e))?;
+    let g = match options.masking {
+        Masking::Separable => 1.0 / ((1.0 + lambda_i) * (1.0 + lambda_o)),
+        Masking::HeightCorrelated => 1.0 / (1.0 + lambda_i + lambda_o),
+    };
+    let eta = fresnel::Complex64::new(n, k);
+    let white = options.colour == ColourTerms::White;
+    let f = if white {
+        1.0
+    } else {
+        fresnel::fresnel(eta, cos_d).map_err(|e| err(&e))?
+    };
+    let d = epd::Epd::new(beta, p).map_err(|e| err(&e))?.d(h[2]);
+    let rho_ct = f * d * g / (4.0 * cos_i * cos_o);
+
+    let big_b = b / lambda;
+    let sigma_rel_sq = if sigma_s > 0.0 {
+        let ratio = |cos: f64| {
+            kcorr::sigma_ratio(cos.clamp(0.0, 1.0).acos(), big_b, c).map_err(|e| err(&e))
+        };
+        let ratio_sq = match options.sigma_rel {
+            SigmaRelMode::Incident => ratio(cos_i)?.powi(2),
+            SigmaRelMode::Symmetrised => 0.5 * (ratio(cos_i)?.powi(2) + ratio(cos_o)?.powi(2)),
+        };
+        sigma_s * sigma_s * ratio_sq
+    } else {
+        0.0
+    };
+    let x = (4.0 * PI * cos_d / lambda).powi(2);
+    let a_spec = (-x * sigma_rel_sq).exp();
+    let specular = a_spec * rho_ct;
+
+    let diffraction = if sigma_s > 0.0 && b > 0.0 {
+        let q = if white {
+            1.0
+        } else {
+            fresnel::q_bar(eta, wi, wo).map_err(|e| err(&e))?
+        };
+        // (1 − A)/σrel², → x as σrel → 0.
+        let t = x * sigma_rel_sq;
+        let one_minus_a_over = if t < 1e-8 {
+            x * (1.0 - 0.5 * t)
+        } else {
+            -(-t).exp_m1() / sigma_rel_sq
+        };
+        let halo =
+            (c - 1.0) * sigma_s * sigma_s * b * b / (2.0 * PI * lambda * lambda) * one_minus_a_over;
+        let c_value = conv::convolution(theta_h, big_b * cos_d, c, beta, p).map_err(|e| err(&e))?;
+        q * g * halo * c_value
+    } else {
+        0.0
+    };
+    Ok(Value {
+        specular,
+        diffraction,
+    })
+}
+
+/// The exact C of [`conv::convolution`] behind the runtime's
+/// `twoscale::Convolution` trait (f32 in and out; 0 where the reference
+/// fails, e.g. outside its parameter domain). 1–30 ms per call: a stand-in
+/// in tests that measure everything but C's table.
+///
+/// The angle is recovered as `atan2(sin θh, cos θh)` from the f32 pair.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ExactConvolution;
+
+impl twoscale::Convolution for ExactConvolution {
+    fn convolution_sin_cos(&self, sin: f32, cos: f32, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        let theta_h = f64::from(sin.max(0.0))
+            .atan2(f64::from(cos.max(0.0)))
+            .clamp(0.0, std::f64::consts::FRAC_PI_2);
+        conv::convolution(
+            theta_h,
+            f64::from(u),
+            f64::from(c),
+            f64::from(beta),
+            f64::from(p),
+        )
+        .map(|v| v as f32)
+        .unwrap_or(0.0)
+    }
+}

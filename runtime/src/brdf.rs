@@ -1,0 +1,839 @@
+//! The two-scale BRDF of Holzschuch & Pacanowski 2017 (SPEC §2.5–§2.7):
+//! evaluation, importance sampling and the exact pdf of the sampler, at one
+//! wavelength ([`TwoScale`]) and at the three default RGB wavelengths
+//! ([`Rgb`]).
+//!
+//! ```text
+//! ρ(i,o)  = A_spec(θd) · ρ_CT(i,o) + ρ_CTD(i,o) + ρ_base(i,o) [+ k_d/π]   (HP17 24)
+//! A_spec  = exp(−(4π σrel cos θd / λ)²)                                   (HP17 25)
+//! ρ_CT    = F(η, θd) D(θh) G(i,o) / (4 cos θi cos θo)                      (HP17 26)
+//! ρ_CTD   = Q̄(i,o) G(i,o) (1 − A_spec) (c−1) σs² b² / (2π σrel² λ²) · C(θh; u, c, β, p)
+//!           u = (b/λ) cos θd                                              (HP17 32-33, 40)
+//! ```
+//!
+//! `σrel = σrel(θi)` comes from T2 ([`SigmaRatioTable`]), D and G from the EPD
+//! distribution ([`Epd`], T1), `C` from any [`Convolution`] (the T3 tables, or
+//! an adapter), F and Q̄ from [`crate::fresnel`]. The constant of ρ_CTD makes
+//! the halo of a flat facet carry exactly `(1 − A) Q̄` (SPEC §2.5).
+//!
+//! # Conventions and guards
+//!
+//! Directions are unit vectors in the local frame (normal `+z`), `i` towards
+//! the light, `o` towards the viewer; they are renormalised in f64. Lengths
+//! (σs, b, λ) are in µm. Everything is computed in f64 and rounded once to
+//! f32. `eval` is 0 when either direction is at or below the horizon
+//! (`z ≤ 0`) or not finite; `pdf` likewise; `sample` returns `None` then, and
+//! when the sampled direction falls at or below the horizon. No function
+//! allocates, panics or returns NaN/∞ for finite input: every result passes
+//! through a final guard that maps a non-finite value to 0 (documented as a
+//! last resort; the tests check it is never needed on the sweep).
+//!
+//! # Reciprocity
+//!
+//! With `σs = 0` the model is the EPD Cook–Torrance conductor and is
+//! reciprocal. With `σs > 0` it is not exactly, because σrel — hence A_spec
+//! and the halo's normalisation — depends on θi only (SPEC §7). The option
+//! [`SigmaRelMode::Symmetrised`] uses `σrel² = (σrel²(θi) + σrel²(θo))/2`,
+//! which makes the two-scale part reciprocal (Q̄, G, D, C and F(θd) are
+//! symmetric in i ↔ o) at the price of the halo's exact energy normalisation.
+//!
+//! # Sampling (SPEC §2.7)
+//!
+//! One lobe is chosen with probabilities that depend on `i` only
+//! ([`TwoScale::lobe_weights`]); its direction is sampled; [`TwoScale::pdf`]
+//! is the mixture `Σ w_k pdf_k(o)`, the exact solid-angle density of what
+//! [`TwoScale::sample`] returns (directions that would fall below the horizon
+//! are not returned, so `∫ pdf ≤ 1`).
+
+use crate::conv::Convolution;
+use crate::epd::Epd;
+use crate::fresnel::{Complex, DiffuseFresnelTable, fresnel, q_bar};
+use crate::kcorr::SigmaRatioTable;
+use crate::math;
+use crate::smith::SmithG1Table;
+use core::f64::consts::PI;
+
+/// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; SPEC §1).
+pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];
+
+/// The largest f32 below one (sample inputs are clamped to [0, BELOW_ONE]).
+const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The micro- and nano-geometry of a surface (wavelength independent).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// EPD width β (HP17 35).
+    pub beta: f32,
+    /// EPD shape p (HP17 35), in [0.2, 5].
+    pub p: f32,
+    /// RMS height of the nano-geometry σs, µm (HP17 16). 0 disables diffraction.
+    pub sigma_s: f32,
+    /// Correlation length b of the K-correlation spectrum, µm (HP17 16).
+    pub b: f32,
+    /// Spectral exponent c > 1 of the K-correlation spectrum (HP17 16).
+    pub c: f32,
+}
+
+/// What lies under the two-scale interface (SPEC §2.6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BaseLayer {
+    /// A conductor: no base, `ρ_base = 0`.
+    Conductor,
+    /// A dielectric varnish of real index `η = n` (the material's index) over a
+    /// diffuse layer of albedo ρd (HP17 43, corrected in SPEC §2.6):
+    /// `ρ_base = (1 − F(θi))(1 − F(θo)) ρd / (π η² (1 − ρd F_dr,int(η)))`.
+    Plastic {
+        /// Albedo ρd ∈ [0, 1] of the diffuse layer.
+        albedo: f32,
+    },
+    /// Subsurface scattering under the interface (HP17 44-47), with albedo α.
+    Subsurface {
+        /// Single-scattering albedo α ∈ [0, 1] of the medium.
+        albedo: f32,
+    },
+}
+
+/// A layered material at one wavelength's worth of geometry: the surface, its
+/// base layer and an optional Lambertian term `k_d/π`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layer {
+    /// Micro- and nano-geometry.
+    pub surface: Surface,
+    /// The base layer.
+    pub base: BaseLayer,
+    /// Optional Lambertian reflectance `k_d ∈ [0, 1]` (0 for none): adds `k_d/π`.
+    pub lambertian: f32,
+}
+
+/// A material with one complex index per RGB channel (at [`RGB_WAVELENGTHS`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Geometry, base layer, Lambertian term.
+    pub layer: Layer,
+    /// Index of refraction `n + ik` at 0.645, 0.526, 0.444 µm.
+    pub eta_rgb: [Complex; 3],
+}
+
+/// Which shadowing–masking term G the model uses (SPEC §2.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Masking {
+    /// `G = G1(i) G1(o)`, as both papers (the default).
+    #[default]
+    Separable,
+    /// `G = 1 / (1 + Λ(i) + Λ(o))`.
+    HeightCorrelated,
+}
+
+/// How σrel enters A_spec and the halo's normalisation (SPEC §7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SigmaRelMode {
+    /// `σrel = σrel(θi)` (HP17 19), the paper's model (the default). Not reciprocal.
+    #[default]
+    Incident,
+    /// `σrel² = (σrel²(θi) + σrel²(θo)) / 2`: reciprocal.
+    Symmetrised,
+}
+
+/// The colour terms of the model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ColourTerms {
+    /// F of (HP17 3-4) and Q̄ of (HP17 10) from the complex index (the default).
+    #[default]
+    Physical,
+    /// `F ≡ 1` and `Q̄ ≡ 1`: the white-furnace configuration of SPEC §7. The
+    /// base layers then receive no light (T = 0); the Lambertian term stays.
+    White,
+}
+
+/// Model options; `Options::default()` is the paper's model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Shadowing–masking term.
+    pub masking: Masking,
+    /// σrel symmetrisation.
+    pub sigma_rel: SigmaRelMode,
+    /// Physical or white colour terms.
+    pub colour: ColourTerms,
+}
+
+/// The tables the model reads. `convolution` is the source of C: the T3b
+/// table by default, T3a for the paper's form, or any adapter.
+#[derive(Clone, Copy)]
+pub struct Tables<'a> {
+    /// T1, Smith G1 of the EPD.
+    pub smith: SmithG1Table<'a>,
+    /// T2, σrel/σs.
+    pub sigma_ratio: SigmaRatioTable<'a>,
+    /// T5, F_dr,int (plastic and subsurface bases).
+    pub diffuse_fresnel: DiffuseFresnelTable<'a>,
+    /// The source of `C(θh; u, c, β, p)` (`Sync`, so that one model can be
+    /// shared by a renderer's threads).
+    pub convolution: &'a (dyn Convolution + Sync),
+}
+
+/// The lobes of the model, for sampling and for [`Lobes`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lobe {
+    /// `A_spec · ρ_CT`, sampled through the EPD (HP17 49-50).
+    Specular,
+    /// `ρ_CTD`, sampled from the spectrum around the specular direction (HP17 51-55).
+    Diffraction,
+    /// `ρ_base + k_d/π`, cosine-weighted.
+    Base,
+}
+
+/// The three terms of ρ at one pair of directions (sr⁻¹).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lobes {
+    /// `A_spec(θd) · ρ_CT`.
+    pub specular: f32,
+    /// `ρ_CTD`.
+    pub diffraction: f32,
+    /// `ρ_base + k_d/π`.
+    pub base: f32,
+}
+
+impl Lobes {
+    /// `ρ`, the sum of the three terms.
+    pub fn total(&self) -> f32 {
+        finite_or_zero(
+            f64::from(self.specular) + f64::from(self.diffraction) + f64::from(self.base),
+        )
+    }
+}
+
+/// A sampled outgoing direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// The outgoing direction (unit vector, `z > 0`).
+    pub o: [f32; 3],
+    /// [`TwoScale::pdf`] at `o` (solid-angle density, > 0).
+    pub pdf: f32,
+    /// ρ(i, o) (sr⁻¹).
+    pub value: f32,
+    /// The lobe that produced `o`.
+    pub lobe: Lobe,
+}
+
+/// Maps a non-finite value to 0 and rounds to f32 (saturating at f32::MAX).
+#[inline]
+fn finite_or_zero(x: f64) -> f32 {
+    if x.is_finite() {
+        x.max(-f64::from(f32::MAX)).min(f64::from(f32::MAX)) as f32
+    } else {
+        0.0
+    }
+}
+
+/// A direction normalised in f64, or `None` when it is not finite, zero, or
+/// at/below the horizon.
+#[inline]
+fn upper(v: [f32; 3]) -> Option<[f64; 3]> {
+    let [x, y, z] = v.map(f64::from);
+    let len = math::sqrt(x * x + y * y + z * z);
+    if !(len > 0.0 && len < f64::INFINITY) {
+        return None;
+    }
+    let w = [x / len, y / len, z / len];
+    if !(w[2] > 0.0) {
+        return None;
+    }
+    Some(w)
+}
+
+#[inline]
+fn to_f32(v: [f64; 3]) -> [f32; 3] {
+    v.map(|x| x as f32)
+}
+
+#[inline]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `(1 − exp(−x s))/s` for `s ≥ 0`, without cancellation, → `x` as `s → 0`.
+#[inline]
+fn one_minus_exp_over(x: f64, s: f64) -> f64 {
+    let t = x * s;
+    if t < 1e-8 {
+        x * (1.0 - 0.5 * t)
+    } else {
+        -math::exp_m1(-t) / s
+    }
+}
+
+/// The two-scale BRDF at one wavelength (see the module documentation).
+#[derive(Clone, Copy)]
+pub struct TwoScale<'a> {
+    ndf: Epd<'a>,
+    sigma_ratio: SigmaRatioTable<'a>,
+    conv: &'a (dyn Convolution + Sync),
+    /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
+    surface: Surface,
+    lambda: f64,
+    /// `B = b / λ`.
+    big_b: f64,
+    eta: Complex,
+    base: BaseLayer,
+    /// `F_dr,int(n)` from T5 (0 for a conductor).
+    f_dr_int: f64,
+    lambertian: f64,
+    options: Options,
+}
+
+impl<'a> TwoScale<'a> {
+    /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
+    ///
+    /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
+    /// or ≤ 1 → no diffraction (σs = 0); λ NaN or ≤ 0 → 0.526 µm, λ clamped to
+    /// [0.01, 100] µm; albedos and `k_d` clamped to [0, 1].
+    pub fn new(
+        tables: &Tables<'a>,
+        layer: Layer,
+        lambda: f32,
+        eta: Complex,
+        options: Options,
+    ) -> Self {
+        let s = layer.surface;
+        let nonneg = |x: f32| if x > 0.0 { x.min(f32::MAX) } else { 0.0 };
+        let c_ok = s.c > 1.0;
+        let ndf = Epd::new(s.beta, s.p, &tables.smith);
+        let surface = Surface {
+            beta: ndf.beta(),
+            p: ndf.p(),
+            sigma_s: if c_ok { nonneg(s.sigma_s) } else { 0.0 },
+            b: nonneg(s.b),
+            c: if c_ok { s.c.min(1e6) } else { 2.0 },
+        };
+        let lambda = if lambda > 0.0 {
+            f64::from(lambda).max(0.01).min(100.0)
+        } else {
+            0.526
+        };
+        let unit = |x: f32| f64::from(x.max(0.0).min(1.0));
+        let base = match layer.base {
+            BaseLayer::Conductor => BaseLayer::Conductor,
+            BaseLayer::Plastic { albedo } => BaseLayer::Plastic {
+                albedo: unit(albedo) as f32,
+            },
+            BaseLayer::Subsurface { albedo } => BaseLayer::Subsurface {
+                albedo: unit(albedo) as f32,
+            },
+        };
+        let f_dr_int = match base {
+            BaseLayer::Conductor => 0.0,
+            _ => f64::from(tables.diffuse_fresnel.f_dr_int(eta.re)),
+        };
+        TwoScale {
+            ndf,
+            sigma_ratio: tables.sigma_ratio,
+            conv: tables.convolution,
+            surface,
+            lambda,
+            big_b: f64::from(surface.b) / lambda,
+            eta,
+            base,
+            f_dr_int,
+            lambertian: unit(layer.lambertian),
+            options,
+        }
+    }
+
+    /// A conductor (no base layer, no Lambertian term) with the default options.
+    pub fn conductor(tables: &Tables<'a>, surface: Surface, lambda: f32, eta: Complex) -> Self {
+        let layer = Layer {
+            surface,
+            base: BaseLayer::Conductor,
+            lambertian: 0.0,
+        };
+        Self::new(tables, layer, lambda, eta, Options::default())
+    }
+
+    /// The sanitised surface parameters in use.
+    pub fn surface(&self) -> Surface {
+        self.surface
+    }
+
+    /// The wavelength in use (µm).
+    pub fn wavelength(&self) -> f32 {
+        self.lambda as f32
+    }
+
+    /// The EPD distribution in use.
+    pub fn ndf(&self) -> &Epd<'a> {
+        &self.ndf
+    }
+
+    fn white(&self) -> bool {
+        self.options.colour == ColourTerms::White
+    }
+
+    /// F(η, cos θ), or 1 for white colour terms.
+    fn fresnel_at(&self, cos: f64) -> f64 {
+        if self.white() {
+            1.0
+        } else {
+            f64::from(fresnel(self.eta, cos as f32))
+        }
+    }
+
+    /// `σrel² (µm²)` for the incidence `cos θi` (and `cos θo` when symmetrised).
+    fn sigma_rel_sq(&self, cos_i: f64, cos_o: f64) -> f64 {
+        let s = &self.surface;
+        let ratio = |cos: f64| {
+            f64::from(
+                self.sigma_ratio
+                    .sigma_ratio_cos(cos as f32, self.big_b as f32, s.c),
+            )
+        };
+        let ratio_sq = match self.options.sigma_rel {
+            SigmaRelMode::Incident => {
+                let r = ratio(cos_i);
+                r * r
+            }
+            SigmaRelMode::Symmetrised => {
+                let (a, b) = (ratio(cos_i), ratio(cos_o));
+                0.5 * (a * a + b * b)
+            }
+        };
+        let sigma_s = f64::from(s.sigma_s);
+        sigma_s * sigma_s * ratio_sq
+    }
+
+    /// Shadowing–masking G (separable or height-correlated, per the options).
+    fn masking(&self, i: [f32; 3], o: [f32; 3]) -> f64 {
+        f64::from(match self.options.masking {
+            Masking::Separable => self.ndf.g(i, o),
+            Masking::HeightCorrelated => self.ndf.g_height_correlated(i, o),
+        })
+    }
+
+    /// ρ(i, o) in sr⁻¹ (HP17 24; module documentation). 0 below the horizon.
+    pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        self.eval_lobes(i, o).total()
+    }
+
+    /// The three terms of ρ(i, o) separately.
+    pub fn eval_lobes(&self, i: [f32; 3], o: [f32; 3]) -> Lobes {
+        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
+            return Lobes::default();
+        };
+        let (cos_i, cos_o) = (wi[2], wo[2]);
+        let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        // |i + o| ≥ z_i + z_o > 0.
+        let len = math::sqrt(dot(sum, sum));
+        let h = sum.map(|x| x / len);
+        let cos_d = dot(wi, h).max(0.0).min(1.0);
+        let cos_h = h[2].max(0.0).min(1.0);
+        // sin θh from the tangential components (f64): resolves θh ≪ 1e-3,
+        // which an f32 cos θh cannot.
+        let sin_h = math::sqrt(h[0] * h[0] + h[1] * h[1]).min(1.0);
+        let (i32_, o32, h32) = (to_f32(wi), to_f32(wo), to_f32(h));
+        let g = self.masking(i32_, o32);
+        let s = &self.surface;
+
+        // A_spec = exp(−x σrel²), x = (4π cos θd / λ)²            (HP17 25)
+        let x = {
+            let t = 4.0 * PI * cos_d / self.lambda;
+            t * t
+        };
+        let sigma_rel_sq = if s.sigma_s > 0.0 {
+            self.sigma_rel_sq(cos_i, cos_o)
+        } else {
+            0.0
+        };
+        let a_spec = math::exp(-x * sigma_rel_sq);
+
+        // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
+        let d = f64::from(self.ndf.d(h32));
+        let rho_ct = self.fresnel_at(cos_d) * d * g / (4.0 * cos_i * cos_o);
+        let specular = a_spec * rho_ct;
+
+        // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, SPEC §2.5)
+        let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && g > 0.0 {
+            let q = if self.white() {
+                1.0
+            } else {
+                f64::from(q_bar(self.eta, i32_, o32))
+            };
+            let sigma_s = f64::from(s.sigma_s);
+            let b = f64::from(s.b);
+            let halo = (f64::from(s.c) - 1.0) * sigma_s * sigma_s * b * b
+                / (2.0 * PI * self.lambda * self.lambda)
+                * one_minus_exp_over(x, sigma_rel_sq);
+            let u = self.big_b * cos_d;
+            let c_value = f64::from(self.conv.convolution_sin_cos(
+                sin_h as f32,
+                cos_h as f32,
+                u as f32,
+                s.c,
+                s.beta,
+                s.p,
+            ));
+            let c_value = if c_value > 0.0 { c_value } else { 0.0 };
+            q * g * halo * c_value
+        } else {
+            0.0
+        };
+
+        Lobes {
+            specular: finite_or_zero(specular),
+            diffraction: finite_or_zero(diffraction),
+            base: finite_or_zero(self.base_value(cos_i, cos_o)),
+        }
+    }
+
+    /// `ρ_base + k_d/π` (SPEC §2.6; HP17 42-47).
+    fn base_value(&self, cos_i: f64, cos_o: f64) -> f64 {
+        let lambertian = self.lambertian / PI;
+        if self.white() {
+            return lambertian;
+        }
+        let transmitted = || (1.0 - self.fresnel_at(cos_i)) * (1.0 - self.fresnel_at(cos_o)); // (HP17 42)
+        let n = f64::from(self.eta.re).abs().max(1e-3);
+        let base = match self.base {
+            BaseLayer::Conductor => 0.0,
+            BaseLayer::Plastic { albedo } => {
+                // (HP17 43) with SPEC §2.6's corrections (ρd in the bracket, 1/η²).
+                let rho_d = f64::from(albedo);
+                transmitted() * rho_d / (PI * n * n * (1.0 - rho_d * self.f_dr_int))
+            }
+            BaseLayer::Subsurface { albedo } => {
+                let alpha = f64::from(albedo);
+                let t = transmitted();
+                // cos θ' of the refracted ray: √(1 − sin²θ / n²).
+                let refracted = |cos: f64| math::sqrt((1.0 - (1.0 - cos * cos) / (n * n)).max(0.0));
+                let single =
+                    alpha * t / (4.0 * PI) / (refracted(cos_i) + refracted(cos_o)).max(1e-12); // (HP17 44)
+                let a_f = (1.0 - self.f_dr_int) / (1.0 + self.f_dr_int); // (HP17 45), as printed
+                let root = math::sqrt(3.0 * (1.0 - alpha));
+                let multi = alpha * t / (2.0 * PI)
+                    * math::exp(-root)
+                    * (1.0 + math::exp(-4.0 / 3.0 * a_f * root)); // (HP17 46)
+                single + multi // (HP17 47)
+            }
+        };
+        base + lambertian
+    }
+
+    /// The lobe-selection probabilities `[specular, diffraction, base]` for
+    /// incidence `i` (sum 1; all 0 for `i` below the horizon):
+    ///
+    /// ```text
+    /// A_imp = exp(−(2π σs cos θi / λ)²)                              (HP17 48)
+    /// E_s   = F(η, cos θi)         (1 with white colour terms)
+    /// E_b   = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
+    ///         (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
+    /// w     ∝ [A_imp E_s, (1 − A_imp) E_s, E_b]
+    /// ```
+    ///
+    /// The surface lobes share F(θi) as the estimate of their energy and split
+    /// it by (HP17 48) as printed. When every estimate is 0 (η = 1 and no
+    /// base) the split `[A_imp, 1 − A_imp, 0]` is used.
+    pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
+        let Some(wi) = upper(i) else {
+            return [0.0; 3];
+        };
+        let w = self.weights(wi[2]);
+        [w[0] as f32, w[1] as f32, w[2] as f32]
+    }
+
+    fn weights(&self, cos_i: f64) -> [f64; 3] {
+        let t = 2.0 * PI * f64::from(self.surface.sigma_s) * cos_i / self.lambda;
+        let a_imp = math::exp(-t * t);
+        let e_s = self.fresnel_at(cos_i);
+        let mut e_b = self.lambertian;
+        if !self.white() {
+            let into = 1.0 - self.fresnel_at(cos_i);
+            e_b += match self.base {
+                BaseLayer::Conductor => 0.0,
+                BaseLayer::Plastic { albedo } => {
+                    let rho_d = f64::from(albedo);
+                    into * rho_d * (1.0 - self.f_dr_int) / (1.0 - rho_d * self.f_dr_int)
+                }
+                BaseLayer::Subsurface { albedo } => into * f64::from(albedo),
+            };
+        }
+        let w = [a_imp * e_s, (1.0 - a_imp) * e_s, e_b];
+        let total = w[0] + w[1] + w[2];
+        if total > 0.0 && total.is_finite() {
+            w.map(|x| x / total)
+        } else {
+            [a_imp, 1.0 - a_imp, 0.0]
+        }
+    }
+
+    /// The solid-angle density over `o` of [`TwoScale::sample`] for incidence
+    /// `i`: `Σ_k w_k(i) pdf_k(i, o)` with the weights of
+    /// [`TwoScale::lobe_weights`] and the lobe densities of
+    /// [`TwoScale::pdf_lobe`]. 0 below the horizon.
+    pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
+            return 0.0;
+        };
+        let w = self.weights(wi[2]);
+        let mut total = 0.0;
+        for (k, lobe) in [Lobe::Specular, Lobe::Diffraction, Lobe::Base]
+            .into_iter()
+            .enumerate()
+        {
+            if w[k] > 0.0 {
+                total += w[k] * self.pdf_lobe_f64(lobe, wi, wo);
+            }
+        }
+        finite_or_zero(total)
+    }
+
+    /// The solid-angle density of [`TwoScale::sample_lobe`] for one lobe:
+    ///
+    /// * specular: `D(h) cos θh / (4 i·h)` (reflection about an EPD normal, HP17 49-50);
+    /// * diffraction (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
+    ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
+    ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
+    ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`;
+    /// * base: `cos θo / π`.
+    ///
+    /// 0 below the horizon or where the lobe cannot produce `o`.
+    pub fn pdf_lobe(&self, lobe: Lobe, i: [f32; 3], o: [f32; 3]) -> f32 {
+        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
+            return 0.0;
+        };
+        finite_or_zero(self.pdf_lobe_f64(lobe, wi, wo))
+    }
+
+    fn pdf_lobe_f64(&self, lobe: Lobe, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        match lobe {
+            Lobe::Specular => {
+                let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+                let len = math::sqrt(dot(sum, sum));
+                let h = sum.map(|x| x / len);
+                let cos_d = dot(wi, h);
+                if !(cos_d > 0.0) {
+                    return 0.0;
+                }
+                f64::from(self.ndf.pdf(to_f32(h))) / (4.0 * cos_d)
+            }
+            Lobe::Diffraction => self.diffraction_pdf(wi, wo),
+            Lobe::Base => wo[2] / PI,
+        }
+    }
+
+    /// `(B, s, M)` of the diffraction sampler, or `None` when the spectrum is
+    /// degenerate (σs = 0 or b = 0).
+    fn diffraction_setup(&self, wi: [f64; 3]) -> Option<(f64, f64, f64)> {
+        let s = &self.surface;
+        if !(s.sigma_s > 0.0 && self.big_b > 0.0) {
+            return None;
+        }
+        let sin_i = math::hypot(wi[0], wi[1]).min(1.0);
+        let b = self.big_b;
+        let half_cm1 = 0.5 * (f64::from(s.c) - 1.0);
+        let reach = b * (1.0 + sin_i);
+        let m = -math::exp_m1(-half_cm1 * math::ln_1p(reach * reach)); // (HP17 52)
+        if !(m > 0.0) {
+            return None;
+        }
+        Some((b, sin_i, m))
+    }
+
+    /// φmax of (HP17 53) for `r = λ f`: the half-width of the arc of
+    /// directions of `d` around `i_p` that keeps `o_p = d − i_p` in the unit disc.
+    fn phi_max(r: f64, sin_i: f64) -> f64 {
+        if r + sin_i <= 1.0 {
+            return PI;
+        }
+        let x = (r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i);
+        math::acos(x.max(-1.0).min(1.0))
+    }
+
+    fn diffraction_pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        let Some((b, sin_i, m)) = self.diffraction_setup(wi) else {
+            return 0.0;
+        };
+        let (dx, dy) = (wo[0] + wi[0], wo[1] + wi[1]);
+        let r = math::hypot(dx, dy);
+        if r > 1.0 + sin_i {
+            return 0.0;
+        }
+        let phi_max = Self::phi_max(r, sin_i);
+        if !(phi_max > 0.0) {
+            return 0.0;
+        }
+        let c = f64::from(self.surface.c);
+        let density = (c - 1.0) * b * b * math::exp(-0.5 * (c + 1.0) * math::ln_1p(b * b * r * r))
+            / (2.0 * m * phi_max);
+        density * wo[2]
+    }
+
+    /// Samples `o` from one lobe with the uniforms `u` (clamped to [0, 1));
+    /// `None` when `i` is below the horizon, the lobe is degenerate, or the
+    /// direction falls at or below the horizon. Its density is
+    /// [`TwoScale::pdf_lobe`].
+    ///
+    /// * specular: `m` from the EPD (HP17 49-50), `o = 2(i·m)m − i`;
+    /// * diffraction (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
+    ///   `ψ = (2u₁ − 1) φmax(r)`, `d = r (cos(φi + ψ), sin(φi + ψ))`,
+    ///   `o_p = d − i_p`. (HP17 54-55) write the same arc as `φf = φi + π ± φmax`
+    ///   with `o_p = −i_p + λ f`; the arc that keeps `o_p` in the disc is
+    ///   centred on `+i_p` as written here (at ψ = 0, `o_p` moves from the
+    ///   mirror direction towards `i`'s side);
+    /// * base: cosine-weighted hemisphere.
+    pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
+        let wi = upper(i)?;
+        let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
+        let o = match lobe {
+            Lobe::Specular => {
+                let m = self.ndf.sample([u[0] as f32, u[1] as f32]).map(f64::from);
+                let k = 2.0 * dot(wi, m);
+                [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
+            }
+            Lobe::Diffraction => {
+                let (b, sin_i, m) = self.diffraction_setup(wi)?;
+                let c = f64::from(self.surface.c);
+                let t = -2.0 / (c - 1.0) * math::ln_1p(-m * u[0]); // (HP17 51)
+                let r = (math::sqrt(math::exp_m1(t).max(0.0)) / b).min(1.0 + sin_i);
+                let psi = (2.0 * u[1] - 1.0) * Self::phi_max(r, sin_i); // (HP17 53-54)
+                let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
+                    (wi[0] / sin_i, wi[1] / sin_i)
+                } else {
+                    (1.0, 0.0)
+                };
+                let (cp, sp) = (math::cos(psi), math::sin(psi));
+                let dir = [
+                    cos_phi_i * cp - sin_phi_i * sp,
+                    sin_phi_i * cp + cos_phi_i * sp,
+                ];
+                let ox = r * dir[0] - wi[0]; // (HP17 55)
+                let oy = r * dir[1] - wi[1];
+                let z2 = 1.0 - ox * ox - oy * oy;
+                if !(z2 > 0.0) {
+                    return None;
+                }
+                [ox, oy, math::sqrt(z2)]
+            }
+            Lobe::Base => {
+                let r = math::sqrt(u[0]);
+                let phi = 2.0 * PI * u[1];
+                [
+                    r * math::cos(phi),
+                    r * math::sin(phi),
+                    math::sqrt((1.0 - u[0]).max(0.0)),
+                ]
+            }
+        };
+        let o = upper(to_f32(o))?;
+        Some(to_f32(o))
+    }
+
+    /// Samples an outgoing direction for incidence `i` from three uniforms:
+    /// `u[0]` picks the lobe with the weights of [`TwoScale::lobe_weights`]
+    /// (and is rescaled), `u[1], u[2]` drive [`TwoScale::sample_lobe`].
+    /// Returns the direction, [`TwoScale::pdf`] there (> 0) and ρ there;
+    /// `None` when nothing can be sampled (see `sample_lobe`).
+    pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
+        let wi = upper(i)?;
+        let w = self.weights(wi[2]);
+        let pick = f64::from(u[0].max(0.0).min(BELOW_ONE));
+        let lobe = pick_lobe(pick, w);
+        let o = self.sample_lobe(lobe, i, [u[1], u[2]])?;
+        let pdf = self.pdf(i, o);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(Sample {
+            o,
+            pdf,
+            value: self.eval(i, o),
+            lobe,
+        })
+    }
+}
+
+/// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
+/// past the last interval falls on the last lobe of positive weight.
+fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
+    const LOBES: [Lobe; 3] = [Lobe::Specular, Lobe::Diffraction, Lobe::Base];
+    let mut cumulative = 0.0;
+    let mut last = Lobe::Specular;
+    for (k, lobe) in LOBES.into_iter().enumerate() {
+        if w[k] > 0.0 {
+            cumulative += w[k];
+            last = lobe;
+            if pick < cumulative {
+                return lobe;
+            }
+        }
+    }
+    last
+}
+
+/// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
+#[derive(Clone, Copy)]
+pub struct Rgb<'a> {
+    /// The red, green and blue channels.
+    pub channels: [TwoScale<'a>; 3],
+}
+
+/// A sampled direction of the RGB model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RgbSample {
+    /// The outgoing direction (unit vector, `z > 0`).
+    pub o: [f32; 3],
+    /// [`Rgb::pdf`] at `o`.
+    pub pdf: f32,
+    /// ρ(i, o) per channel (sr⁻¹).
+    pub value: [f32; 3],
+}
+
+impl<'a> Rgb<'a> {
+    /// The three channels of `material` at [`RGB_WAVELENGTHS`].
+    pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
+        let channel = |k: usize| {
+            TwoScale::new(
+                tables,
+                material.layer,
+                RGB_WAVELENGTHS[k],
+                material.eta_rgb[k],
+                options,
+            )
+        };
+        Rgb {
+            channels: [channel(0), channel(1), channel(2)],
+        }
+    }
+
+    /// ρ(i, o) per channel.
+    pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
+        [
+            self.channels[0].eval(i, o),
+            self.channels[1].eval(i, o),
+            self.channels[2].eval(i, o),
+        ]
+    }
+
+    /// The density of [`Rgb::sample`]: the mean of the channels' pdfs (one
+    /// channel's sampler is picked uniformly).
+    pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        let sum: f64 = self.channels.iter().map(|ch| f64::from(ch.pdf(i, o))).sum();
+        finite_or_zero(sum / 3.0)
+    }
+
+    /// Picks a channel's sampler with `u[0]` (uniformly; `u[0]` is rescaled
+    /// and reused to pick the lobe), samples it, and returns the direction,
+    /// the mixture density [`Rgb::pdf`] and the three values.
+    pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<RgbSample> {
+        let pick = 3.0 * f64::from(u[0].max(0.0).min(BELOW_ONE));
+        let k = (pick as usize).min(2);
+        let rest = (pick - k as f64) as f32;
+        let s = self.channels[k].sample(i, [rest, u[1], u[2]])?;
+        let pdf = self.pdf(i, s.o);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(RgbSample {
+            o: s.o,
+            pdf,
+            value: self.eval(i, s.o),
+        })
+    }
+}
