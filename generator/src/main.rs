@@ -16,10 +16,13 @@ use twoscale::interp::node_value;
 use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
-use generator::tables::{self, Accuracy, TableKind, file_name};
+use generator::materials::Materials;
+use generator::tables::{self, Accuracy, TableKind, t4::ShBrdf};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
+/// The workspace's materials file (T4 builds one table per material).
+const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
 
 #[derive(Parser)]
 #[command(
@@ -35,11 +38,15 @@ struct Cli {
 enum Command {
     /// Build tables (all, or the ones named) into a directory.
     Build {
-        /// Tables to build (names or unique prefixes, e.g. t1); all if none.
+        /// Tables to build (file names without .tbl, or prefixes: t1, t4 = every
+        /// material's T4, t4-nickel); all if none.
         tables: Vec<String>,
         /// Output directory.
         #[arg(long, default_value = DEFAULT_TABLES)]
         out: PathBuf,
+        /// Materials file (T4: one table per material).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
         /// Worker threads (default: all cores). The output does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -50,6 +57,9 @@ enum Command {
         /// Table directory.
         #[arg(default_value = DEFAULT_TABLES)]
         dir: PathBuf,
+        /// Materials file (T4: one table per material).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
         /// Random points per table.
         #[arg(long, default_value_t = 20_000)]
         points: usize,
@@ -84,20 +94,23 @@ fn main() -> ExitCode {
     let command = cli.command.unwrap_or(Command::Build {
         tables: Vec::new(),
         out: PathBuf::from(DEFAULT_TABLES),
+        materials: PathBuf::from(DEFAULT_MATERIALS),
         threads: None,
     });
     let result = match command {
         Command::Build {
             tables,
             out,
+            materials,
             threads,
-        } => set_threads(threads).and_then(|()| build(&tables, &out)),
+        } => set_threads(threads).and_then(|()| build(&tables, &out, &materials)),
         Command::Verify {
             dir,
+            materials,
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, points, seed)),
+        } => set_threads(threads).and_then(|()| verify(&dir, &materials, points, seed)),
         Command::Inspect { files } => inspect(&files),
         Command::Query { quantity, tables } => query(&quantity, &tables),
     };
@@ -120,28 +133,57 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
     Ok(())
 }
 
-fn selected(names: &[String]) -> Result<Vec<&'static dyn TableKind>, String> {
-    if names.is_empty() {
-        return Ok(tables::all());
-    }
-    names
-        .iter()
-        .map(|n| {
-            tables::by_name(n).ok_or_else(|| {
-                let known: Vec<_> = tables::all().iter().map(|t| t.id().name()).collect();
-                format!("unknown table '{n}' (known: {})", known.join(", "))
-            })
-        })
-        .collect()
+/// The T4 builders of the materials file.
+fn material_tables(materials: &Path) -> Result<Vec<ShBrdf>, String> {
+    let materials = Materials::load(materials).map_err(|e| e.to_string())?;
+    Ok(ShBrdf::all(&materials))
 }
 
-fn build(names: &[String], out: &Path) -> Result<ExitCode, String> {
-    let kinds = selected(names)?;
+/// Every table: the fixed ones, then T4 per material.
+fn catalogue(t4: &[ShBrdf]) -> Vec<&dyn TableKind> {
+    let mut kinds = tables::all();
+    kinds.extend(t4.iter().map(|k| k as &dyn TableKind));
+    kinds
+}
+
+/// The tables named: a name selects the table whose file stem it is, else
+/// the tables whose stems start with it, if they are all of one table id
+/// (so `t4` selects every material's T4).
+fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableKind>, String> {
+    let all = catalogue(t4);
+    if names.is_empty() {
+        return Ok(all);
+    }
+    let mut chosen: Vec<&dyn TableKind> = Vec::new();
+    for n in names {
+        let exact: Vec<_> = all.iter().filter(|t| t.file_stem() == *n).collect();
+        let matches: Vec<_> = if exact.is_empty() {
+            all.iter()
+                .filter(|t| t.file_stem().starts_with(n.as_str()))
+                .collect()
+        } else {
+            exact
+        };
+        let one_id = matches.windows(2).all(|w| w[0].id() == w[1].id());
+        if matches.is_empty() || !one_id {
+            let known: Vec<_> = all.iter().map(|t| t.file_stem()).collect();
+            return Err(format!(
+                "unknown or ambiguous table '{n}' (known: {})",
+                known.join(", ")
+            ));
+        }
+        chosen.extend(matches.into_iter().copied());
+    }
+    Ok(chosen)
+}
+
+fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials)?;
+    let kinds = selected(names, &t4)?;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let out = &std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     let total = Instant::now();
     for kind in kinds {
-        let id = kind.id();
         let progress = ProgressBar::new(kind.work_items()).with_style(
             ProgressStyle::with_template(
                 "{prefix:>14} [{bar:40}] {pos}/{len} nodes, {elapsed}, eta {eta}",
@@ -149,17 +191,16 @@ fn build(names: &[String], out: &Path) -> Result<ExitCode, String> {
             .expect("static template")
             .progress_chars("=> "),
         );
-        progress.set_prefix(id.name());
+        let stem = kind.file_stem();
+        progress.set_prefix(stem.clone());
         let start = Instant::now();
-        let bytes = kind
-            .build(&progress)
-            .map_err(|e| format!("{}: {e}", id.name()))?;
+        let bytes = kind.build(&progress).map_err(|e| format!("{stem}: {e}"))?;
         progress.finish_and_clear();
-        let path = out.join(file_name(id));
+        let path = out.join(format!("{stem}.tbl"));
         write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         eprintln!(
             "built {} ({} bytes, {} nodes) in {:.1} s -> {}",
-            id.name(),
+            stem,
             bytes.len(),
             kind.work_items(),
             start.elapsed().as_secs_f64(),
@@ -170,11 +211,13 @@ fn build(names: &[String], out: &Path) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
-    let mut rows: Vec<(TableId, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
-    for kind in tables::all() {
+fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials)?;
+    let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
+    for kind in catalogue(&t4) {
         let id = kind.id();
-        let path = dir.join(file_name(id));
+        let stem = kind.file_stem();
+        let path = dir.join(format!("{stem}.tbl"));
         let outcome = MappedFile::open(&path)
             .map_err(|e| format!("cannot open {}: {e}", path.display()))
             .and_then(|file| {
@@ -184,33 +227,33 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
                 let start = Instant::now();
                 let accuracy = kind
                     .verify(file.bytes(), points, seed)
-                    .map_err(|e| format!("{}: {e}", id.name()))?;
+                    .map_err(|e| format!("{stem}: {e}"))?;
                 eprintln!(
                     "verified {} at {points} points in {:.1} s",
-                    id.name(),
+                    stem,
                     start.elapsed().as_secs_f64()
                 );
                 Ok((size, accuracy))
             });
         match outcome {
-            Ok((size, accuracy)) => rows.push((id, size, Ok(accuracy))),
-            Err(e) => rows.push((id, 0, Err(e))),
+            Ok((size, accuracy)) => rows.push((stem, size, Ok(accuracy))),
+            Err(e) => rows.push((stem, 0, Err(e))),
         }
     }
     println!(
-        "{:<18} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
+        "{:<22} {:>9}  {:<28} {:>7} {:>10} {:>10} {:>10} {:>9}  result  worst at",
         "table", "bytes", "metric", "points", "max", "median", "p99", "target"
     );
     let mut failed = false;
-    for (id, size, outcome) in &rows {
+    for (stem, size, outcome) in &rows {
         match outcome {
             Ok(accuracy) => {
                 for a in accuracy {
                     let ok = a.passed();
                     failed |= !ok;
                     println!(
-                        "{:<18} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
-                        id.name(),
+                        "{:<22} {:>9}  {:<28} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>9.1e}  {:<6}  {}",
+                        stem,
                         size,
                         a.metric,
                         a.points,
@@ -225,7 +268,7 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
             }
             Err(e) => {
                 failed = true;
-                println!("{:<18} {:>9}  FAIL: {e}", id.name(), "-");
+                println!("{:<22} {:>9}  FAIL: {e}", stem, "-");
             }
         }
     }
@@ -288,6 +331,18 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
         println!("  generator version  {}", header.generator_version_str());
         for (name, value) in id.param_names().iter().zip(header.params) {
             println!("  param {name:<18} {value:e}");
+        }
+        if id == TableId::ShBrdf
+            && let Ok(table) = twoscale::ShBrdfTable::from_bytes(bytes)
+        {
+            println!(
+                "  projected BRDF     {:?}, {} packed coefficients per channel",
+                table.model(),
+                twoscale::sh::coefficient_count(table.band_limit())
+            );
+            for (name, value) in twoscale::sh::AUX_NAMES.iter().zip(table.aux()) {
+                println!("  aux {name:<20} {value}");
+            }
         }
         println!(
             "  payload            {} bytes at offset {}",

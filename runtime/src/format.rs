@@ -57,14 +57,18 @@ pub enum TableId {
     /// T5: internal diffuse Fresnel reflectance F_dr,int(η) of a dielectric
     /// over η; see [`crate::fresnel::DiffuseFresnelTable`].
     DiffuseFresnel = 3,
+    /// T4: spherical-harmonic BRDF matrix of one material ([WAT92] §2, SPEC
+    /// §2.9), one channel per wavelength; see [`crate::sh`].
+    ShBrdf = 6,
 }
 
 impl TableId {
     /// Every table id, in tag order.
-    pub const ALL: [TableId; 3] = [
+    pub const ALL: [TableId; 4] = [
         TableId::SmithG1,
         TableId::SigmaRatio,
         TableId::DiffuseFresnel,
+        TableId::ShBrdf,
     ];
 
     /// The tag stored in the file.
@@ -83,6 +87,7 @@ impl TableId {
             TableId::SmithG1 => "t1-smith-g1",
             TableId::SigmaRatio => "t2-sigma-ratio",
             TableId::DiffuseFresnel => "t5-diffuse-fresnel",
+            TableId::ShBrdf => "t4-sh-brdf",
         }
     }
 
@@ -98,6 +103,9 @@ impl TableId {
             TableId::DiffuseFresnel => {
                 "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, SPEC 2.6); cubic B-spline coefficients"
             }
+            TableId::ShBrdf => {
+                "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, SPEC 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
+            }
         }
     }
 
@@ -107,6 +115,7 @@ impl TableId {
             TableId::SmithG1 => &["p", "a_scaled"],
             TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
             TableId::DiffuseFresnel => &["eta"],
+            TableId::ShBrdf => &["coefficient"],
         }
     }
 
@@ -117,6 +126,7 @@ impl TableId {
             TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
             TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
             TableId::DiffuseFresnel => &["quadrature_rel_tol", "quadrature_abs_tol"],
+            TableId::ShBrdf => &crate::sh::PARAM_NAMES,
         }
     }
 }

@@ -24,10 +24,12 @@ pub mod kcorr;
 pub mod math;
 #[cfg(feature = "std")]
 pub mod mmap;
+pub mod sh;
 pub mod smith;
 
 pub use conv::Convolution;
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
+pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};
