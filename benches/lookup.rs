@@ -223,7 +223,6 @@ fn fresnel(c: &mut Criterion) {
 /// T4: SH evaluation (all three channels, committed files) against the
 /// direct f64 evaluation of the BRDF it projects (the stand-in, one channel).
 fn sh_brdf(c: &mut Criterion) {
-    use generator::sh::IsotropicBrdf;
     let pairs = generator::tables::t4::verification_pairs(1024, 7);
     let narrow: Vec<([f32; 3], [f32; 3])> = pairs
         .iter()
