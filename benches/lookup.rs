@@ -282,5 +282,52 @@ fn convolution(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, smith_g1, sigma_ratio, fresnel, convolution);
+/// T4: SH evaluation (all three channels, committed files) against the
+/// direct f64 evaluation of the BRDF it projects (the stand-in, one channel).
+fn sh_brdf(c: &mut Criterion) {
+    let pairs = generator::tables::t4::verification_pairs(1024, 7);
+    let narrow: Vec<([f32; 3], [f32; 3])> = pairs
+        .iter()
+        .map(|(i, o)| (i.map(|v| v as f32), o.map(|v| v as f32)))
+        .collect();
+    let materials = generator::materials::Materials::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/materials.toml"
+    )))
+    .unwrap();
+    let mut group = c.benchmark_group("sh_brdf");
+    group.throughput(Throughput::Elements(pairs.len() as u64));
+    for material in &materials.materials {
+        let bytes =
+            std::fs::read(suite::tables_dir().join(format!("t4-{}.tbl", material.name))).unwrap();
+        let buf = twoscale::format::aligned_copy(&bytes);
+        let table = twoscale::ShBrdfTable::from_bytes(buf.bytes()).unwrap();
+        let name = format!("{} L={}", material.name, table.band_limit());
+        group.bench_function(format!("sh eval_rgb {name}"), |b| {
+            b.iter(|| {
+                for &(i, o) in &narrow {
+                    black_box(table.eval_rgb(black_box(i), black_box(o)));
+                }
+            })
+        });
+        let brdf = generator::tables::t4::material_brdf(material, 0, 0.645).unwrap();
+        group.bench_function(format!("direct stand-in f64 {}", material.name), |b| {
+            b.iter(|| {
+                for &(i, o) in &pairs {
+                    black_box(brdf.eval(black_box(i), black_box(o)));
+                }
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    smith_g1,
+    sigma_ratio,
+    fresnel,
+    convolution,
+    sh_brdf
+);
 criterion_main!(benches);

@@ -9,10 +9,13 @@
 //! - [`query`]: the batch CSV queries of SPEC §6;
 //! - [`rng`]: deterministic random points for verification.
 
+pub mod analytic;
 pub mod bspline;
 pub mod fit;
+pub mod materials;
 pub mod quad;
 pub mod query;
 pub mod reference;
 pub mod rng;
+pub mod sh;
 pub mod tables;

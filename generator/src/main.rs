@@ -16,10 +16,13 @@ use twoscale::interp::node_value;
 use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
-use generator::tables::{self, Accuracy, TableKind, file_name};
+use generator::materials::Materials;
+use generator::tables::{self, Accuracy, TableKind, t4::ShBrdf};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
+/// The workspace's materials file (T4 builds one table per material).
+const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
 
 #[derive(Parser)]
 #[command(
@@ -35,11 +38,15 @@ struct Cli {
 enum Command {
     /// Build tables (all, or the ones named) into a directory.
     Build {
-        /// Tables to build (names or unique prefixes, e.g. t1); all if none.
+        /// Tables to build (file names without .tbl, or prefixes: t1, t4 = every
+        /// material's T4, t4-nickel); all if none.
         tables: Vec<String>,
         /// Output directory.
         #[arg(long, default_value = DEFAULT_TABLES)]
         out: PathBuf,
+        /// Materials file (T4: one table per material).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
         /// Worker threads (default: all cores). The output does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -50,6 +57,9 @@ enum Command {
         /// Table directory.
         #[arg(default_value = DEFAULT_TABLES)]
         dir: PathBuf,
+        /// Materials file (T4: one table per material).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
         /// Random points per table.
         #[arg(long, default_value_t = 20_000)]
         points: usize,
@@ -63,11 +73,14 @@ enum Command {
     /// Recompute a spread of grid nodes of tables too expensive to rebuild
     /// in CI (T3) and compare their bits with the files in a directory.
     SpotCheck {
-        /// Tables to check (names or unique prefixes); all that support it if none.
+        /// Tables to check (names or prefixes); all that support it if none.
         tables: Vec<String>,
         /// Table directory.
         #[arg(long, default_value = DEFAULT_TABLES)]
         dir: PathBuf,
+        /// Materials file (T4: one table per material).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
         /// Nodes to recompute per table (spread evenly, first and last included).
         #[arg(long, default_value_t = 24)]
         nodes: usize,
@@ -86,7 +99,7 @@ enum Command {
     /// (columns theta_i,B,c; θi in radians), fresnel (columns n,k,cos_theta;
     /// `table` is the runtime's f32 value, which needs no table), conv
     /// (columns u,c,beta,p,theta_h; outputs fit = T3a, table = T3b,
-    /// reference = exact C).
+    /// reference = exact C), brdf (SPEC §6 columns; conductor two-scale model).
     Query {
         /// The quantity.
         quantity: String,
@@ -101,26 +114,30 @@ fn main() -> ExitCode {
     let command = cli.command.unwrap_or(Command::Build {
         tables: Vec::new(),
         out: PathBuf::from(DEFAULT_TABLES),
+        materials: PathBuf::from(DEFAULT_MATERIALS),
         threads: None,
     });
     let result = match command {
         Command::Build {
             tables,
             out,
+            materials,
             threads,
-        } => set_threads(threads).and_then(|()| build(&tables, &out)),
+        } => set_threads(threads).and_then(|()| build(&tables, &out, &materials)),
         Command::Verify {
             dir,
+            materials,
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, points, seed)),
+        } => set_threads(threads).and_then(|()| verify(&dir, &materials, points, seed)),
         Command::SpotCheck {
             tables,
             dir,
+            materials,
             nodes,
             threads,
-        } => set_threads(threads).and_then(|()| spot_check(&tables, &dir, nodes)),
+        } => set_threads(threads).and_then(|()| spot_check(&tables, &dir, &materials, nodes)),
         Command::Inspect { files } => inspect(&files),
         Command::Query { quantity, tables } => query(&quantity, &tables),
     };
@@ -143,28 +160,57 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
     Ok(())
 }
 
-fn selected(names: &[String]) -> Result<Vec<&'static dyn TableKind>, String> {
-    if names.is_empty() {
-        return Ok(tables::all());
-    }
-    names
-        .iter()
-        .map(|n| {
-            tables::by_name(n).ok_or_else(|| {
-                let known: Vec<_> = tables::all().iter().map(|t| t.id().name()).collect();
-                format!("unknown table '{n}' (known: {})", known.join(", "))
-            })
-        })
-        .collect()
+/// The T4 builders of the materials file.
+fn material_tables(materials: &Path) -> Result<Vec<ShBrdf>, String> {
+    let materials = Materials::load(materials).map_err(|e| e.to_string())?;
+    Ok(ShBrdf::all(&materials))
 }
 
-fn build(names: &[String], out: &Path) -> Result<ExitCode, String> {
-    let kinds = selected(names)?;
+/// Every table: the fixed ones, then T4 per material.
+fn catalogue(t4: &[ShBrdf]) -> Vec<&dyn TableKind> {
+    let mut kinds = tables::all();
+    kinds.extend(t4.iter().map(|k| k as &dyn TableKind));
+    kinds
+}
+
+/// The tables named: a name selects the table whose file stem it is, else
+/// the tables whose stems start with it, if they are all of one table id
+/// (so `t4` selects every material's T4).
+fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableKind>, String> {
+    let all = catalogue(t4);
+    if names.is_empty() {
+        return Ok(all);
+    }
+    let mut chosen: Vec<&dyn TableKind> = Vec::new();
+    for n in names {
+        let exact: Vec<_> = all.iter().filter(|t| t.file_stem() == *n).collect();
+        let matches: Vec<_> = if exact.is_empty() {
+            all.iter()
+                .filter(|t| t.file_stem().starts_with(n.as_str()))
+                .collect()
+        } else {
+            exact
+        };
+        let one_id = matches.windows(2).all(|w| w[0].id() == w[1].id());
+        if matches.is_empty() || !one_id {
+            let known: Vec<_> = all.iter().map(|t| t.file_stem()).collect();
+            return Err(format!(
+                "unknown or ambiguous table '{n}' (known: {})",
+                known.join(", ")
+            ));
+        }
+        chosen.extend(matches.into_iter().copied());
+    }
+    Ok(chosen)
+}
+
+fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials)?;
+    let kinds = selected(names, &t4)?;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let out = &std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     let total = Instant::now();
     for kind in kinds {
-        let id = kind.id();
         let progress = ProgressBar::new(kind.work_items()).with_style(
             ProgressStyle::with_template(
                 "{prefix:>14} [{bar:40}] {pos}/{len} nodes, {elapsed}, eta {eta}",
@@ -172,26 +218,27 @@ fn build(names: &[String], out: &Path) -> Result<ExitCode, String> {
             .expect("static template")
             .progress_chars("=> "),
         );
-        progress.set_prefix(id.name());
+        let stem = kind.file_stem();
+        progress.set_prefix(stem.clone());
         let start = Instant::now();
         // indicatif draws only on a terminal; elsewhere (CI logs, redirected
         // output) print a plain progress line every 30 s instead.
         let done = std::sync::atomic::AtomicBool::new(false);
         let bytes = std::thread::scope(|scope| {
             if !std::io::stderr().is_terminal() {
-                scope.spawn(|| plain_progress(id.name(), &progress, &done, start));
+                scope.spawn(|| plain_progress(&stem, &progress, &done, start));
             }
             let result = kind.build(&progress);
             done.store(true, std::sync::atomic::Ordering::Relaxed);
             result
         })
-        .map_err(|e| format!("{}: {e}", id.name()))?;
+        .map_err(|e| format!("{stem}: {e}"))?;
         progress.finish_and_clear();
-        let path = out.join(file_name(id));
+        let path = out.join(format!("{stem}.tbl"));
         write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         eprintln!(
             "built {} ({} bytes, {} nodes) in {:.1} s -> {}",
-            id.name(),
+            stem,
             bytes.len(),
             kind.work_items(),
             start.elapsed().as_secs_f64(),
@@ -229,11 +276,63 @@ fn plain_progress(
     }
 }
 
-fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
-    let mut rows: Vec<(TableId, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
-    for kind in tables::all() {
+fn spot_check(
+    names: &[String],
+    dir: &Path,
+    materials: &Path,
+    nodes: usize,
+) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials)?;
+    let kinds = selected(names, &t4)?;
+    let mut failed = false;
+    let mut any = false;
+    for kind in kinds {
+        let stem = kind.file_stem();
+        let path = dir.join(format!("{stem}.tbl"));
+        let start = Instant::now();
+        let file =
+            MappedFile::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let Some(outcome) = kind.spot_check(file.bytes(), nodes) else {
+            if !names.is_empty() {
+                eprintln!("{stem}: no spot check (rebuild it whole instead)");
+            }
+            continue;
+        };
+        any = true;
+        let check = outcome.map_err(|e| format!("{stem}: {e}"))?;
+        if check.mismatched.is_empty() {
+            println!(
+                "{stem}: {} nodes recomputed bit-identically in {:.1} s",
+                check.checked,
+                start.elapsed().as_secs_f64()
+            );
+        } else {
+            failed = true;
+            println!(
+                "{stem}: {} of {} recomputed nodes differ from the file (nodes {:?})",
+                check.mismatched.len(),
+                check.checked,
+                check.mismatched
+            );
+        }
+    }
+    if !any {
+        return Err("none of the selected tables has a spot check".into());
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials)?;
+    let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
+    for kind in catalogue(&t4) {
         let id = kind.id();
-        let path = dir.join(file_name(id));
+        let stem = kind.file_stem();
+        let path = dir.join(format!("{stem}.tbl"));
         let outcome = MappedFile::open(&path)
             .map_err(|e| format!("cannot open {}: {e}", path.display()))
             .and_then(|file| {
@@ -243,25 +342,25 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
                 let start = Instant::now();
                 let accuracy = kind
                     .verify(file.bytes(), points, seed)
-                    .map_err(|e| format!("{}: {e}", id.name()))?;
+                    .map_err(|e| format!("{stem}: {e}"))?;
                 eprintln!(
                     "verified {} at {points} points in {:.1} s",
-                    id.name(),
+                    stem,
                     start.elapsed().as_secs_f64()
                 );
                 Ok((size, accuracy))
             });
         match outcome {
-            Ok((size, accuracy)) => rows.push((id, size, Ok(accuracy))),
-            Err(e) => rows.push((id, 0, Err(e))),
+            Ok((size, accuracy)) => rows.push((stem, size, Ok(accuracy))),
+            Err(e) => rows.push((stem, 0, Err(e))),
         }
     }
     println!(
-        "{:<18} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>14}  result  worst at",
+        "{:<22} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>14}  result  worst at",
         "table", "bytes", "metric", "points", "max", "median", "p90", "p99", "target"
     );
     let mut failed = false;
-    for (id, size, outcome) in &rows {
+    for (stem, size, outcome) in &rows {
         match outcome {
             Ok(accuracy) => {
                 for a in accuracy {
@@ -274,8 +373,8 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
                         format!("max <= {:.0e}", a.target)
                     };
                     println!(
-                        "{:<18} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>14}  {:<6}  {}",
-                        id.name(),
+                        "{:<22} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>14}  {:<6}  {}",
+                        stem,
                         size,
                         a.metric,
                         a.points,
@@ -291,55 +390,9 @@ fn verify(dir: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
             }
             Err(e) => {
                 failed = true;
-                println!("{:<18} {:>9}  FAIL: {e}", id.name(), "-");
+                println!("{:<22} {:>9}  FAIL: {e}", stem, "-");
             }
         }
-    }
-    Ok(if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    })
-}
-
-fn spot_check(names: &[String], dir: &Path, nodes: usize) -> Result<ExitCode, String> {
-    let kinds = selected(names)?;
-    let mut failed = false;
-    let mut any = false;
-    for kind in kinds {
-        let id = kind.id();
-        let path = dir.join(file_name(id));
-        let file =
-            MappedFile::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        let start = Instant::now();
-        let Some(outcome) = kind.spot_check(file.bytes(), nodes) else {
-            if !names.is_empty() {
-                eprintln!("{}: no spot check (rebuild it whole instead)", id.name());
-            }
-            continue;
-        };
-        any = true;
-        let check = outcome.map_err(|e| format!("{}: {e}", id.name()))?;
-        if check.mismatched.is_empty() {
-            println!(
-                "{}: {} nodes recomputed bit-identically in {:.1} s",
-                id.name(),
-                check.checked,
-                start.elapsed().as_secs_f64()
-            );
-        } else {
-            failed = true;
-            println!(
-                "{}: {} of {} recomputed nodes differ from the file (nodes {:?})",
-                id.name(),
-                check.mismatched.len(),
-                check.checked,
-                check.mismatched
-            );
-        }
-    }
-    if !any {
-        return Err("none of the selected tables has a spot check".into());
     }
     Ok(if failed {
         ExitCode::FAILURE
@@ -400,6 +453,18 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
         println!("  generator version  {}", header.generator_version_str());
         for (name, value) in id.param_names().iter().zip(header.params) {
             println!("  param {name:<18} {value:e}");
+        }
+        if id == TableId::ShBrdf
+            && let Ok(table) = twoscale::ShBrdfTable::from_bytes(bytes)
+        {
+            println!(
+                "  projected BRDF     {:?}, {} packed coefficients per channel",
+                table.model(),
+                twoscale::sh::coefficient_count(table.band_limit())
+            );
+            for (name, value) in twoscale::sh::AUX_NAMES.iter().zip(table.aux()) {
+                println!("  aux {name:<20} {value}");
+            }
         }
         println!(
             "  payload            {} bytes at offset {}",

@@ -61,15 +61,19 @@ pub enum TableId {
     /// the EPD NDF over (u, c, β, p): the paper's `s, g` (T3a) and `ln C` at
     /// 32 normalised angles (T3b) per node; see [`crate::conv`].
     Convolution = 4,
+    /// T4: spherical-harmonic BRDF matrix of one material ([WAT92] §2, SPEC
+    /// §2.9), one channel per wavelength; see [`crate::sh`].
+    ShBrdf = 6,
 }
 
 impl TableId {
     /// Every table id, in tag order.
-    pub const ALL: [TableId; 4] = [
+    pub const ALL: [TableId; 5] = [
         TableId::SmithG1,
         TableId::SigmaRatio,
         TableId::DiffuseFresnel,
         TableId::Convolution,
+        TableId::ShBrdf,
     ];
 
     /// The tag stored in the file.
@@ -89,6 +93,7 @@ impl TableId {
             TableId::SigmaRatio => "t2-sigma-ratio",
             TableId::DiffuseFresnel => "t5-diffuse-fresnel",
             TableId::Convolution => "t3-convolution",
+            TableId::ShBrdf => "t4-sh-brdf",
         }
     }
 
@@ -107,6 +112,9 @@ impl TableId {
             TableId::Convolution => {
                 "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); multilinear in the parameters"
             }
+            TableId::ShBrdf => {
+                "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, SPEC 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
+            }
         }
     }
 
@@ -117,6 +125,7 @@ impl TableId {
             TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
             TableId::DiffuseFresnel => &["eta"],
             TableId::Convolution => &["u", "c", "beta", "p"],
+            TableId::ShBrdf => &["coefficient"],
         }
     }
 
@@ -137,6 +146,7 @@ impl TableId {
                 "value_floor",
                 "reference_target",
             ],
+            TableId::ShBrdf => &crate::sh::PARAM_NAMES,
         }
     }
 }

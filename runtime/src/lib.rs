@@ -27,6 +27,7 @@ pub mod materials;
 pub mod math;
 #[cfg(feature = "std")]
 pub mod mmap;
+pub mod sh;
 pub mod smith;
 
 pub use brdf::{Rgb, TwoScale};
@@ -34,4 +35,5 @@ pub use conv::{ConvFitTable, ConvTable, Convolution};
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
+pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};

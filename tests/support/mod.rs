@@ -14,9 +14,14 @@ pub fn tables_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tables")
 }
 
-/// Reads a committed table file into a 64-byte-aligned buffer.
+/// Reads a committed table file into a 64-byte-aligned buffer (for T4, which
+/// has one file per material, the rough aluminium's).
 pub fn read_table(id: twoscale::TableId) -> twoscale::format::AlignedBuf {
-    let path = tables_dir().join(generator::tables::file_name(id));
+    let name = match id {
+        twoscale::TableId::ShBrdf => "t4-rough-aluminium.tbl".to_string(),
+        _ => generator::tables::file_name(id),
+    };
+    let path = tables_dir().join(name);
     let bytes = std::fs::read(&path).unwrap_or_else(|e| {
         panic!(
             "{}: {e} (build it with `cargo run -p generator --release`)",

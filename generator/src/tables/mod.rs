@@ -10,12 +10,18 @@ use crate::quad::QuadError;
 pub mod t1;
 pub mod t2;
 pub mod t3;
+pub mod t4;
 pub mod t5;
 
 /// A table the generator knows how to build and verify.
 pub trait TableKind: Sync {
     /// Which table.
     fn id(&self) -> TableId;
+
+    /// File name without `.tbl` (tables with one file per material override it).
+    fn file_stem(&self) -> String {
+        self.id().name().to_string()
+    }
 
     /// Number of grid nodes to compute (for the progress bar).
     fn work_items(&self) -> u64;

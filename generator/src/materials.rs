@@ -1,0 +1,350 @@
+//! The materials file (`materials.toml` at the repository root): named
+//! materials with their two-scale parameters, read by `generator build` and
+//! `verify` for T4.
+//!
+//! ```toml
+//! wavelengths = [0.645, 0.526, 0.444]   # µm, one per channel (1 to 3); HP15 §5.5
+//!
+//! [[material]]
+//! name = "nickel"          # file t4-nickel.tbl; [a-z0-9-], unique
+//! beta = 0.0598            # EPD width β (HP17 34-35), (0, 1]
+//! p = 1.0                  # EPD shape p, [0.2, 5]
+//! sigma_s = 0.0273         # RMS height of the nano-roughness σs, µm, ≥ 0
+//! b = 4.8418               # correlation length of the K-correlation spectrum, µm, > 0
+//! c = 2.0                  # K-correlation exponent, (1, 100]
+//! n = [2.0, 1.8, 1.7]      # complex index n + ik per wavelength
+//! k = [3.8, 3.3, 2.8]
+//! base = "conductor"       # or "plastic" (then `albedo` per wavelength, and k = 0)
+//! band_limit = 48          # T4 band limit L, [2, 127]
+//! filter = { start = 40, width = 8 }   # optional half-Gaussian band filter (WAT92 §2.5)
+//! ```
+//!
+//! Unknown keys, missing fields and out-of-range values are errors that name
+//! the material and the field.
+
+use serde::Deserialize;
+use std::fmt;
+use std::path::Path;
+
+use crate::sh::BandFilter;
+
+/// The materials file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Materials {
+    /// Wavelength of each channel, µm.
+    pub wavelengths: Vec<f64>,
+    /// The materials, in file order.
+    pub materials: Vec<Material>,
+}
+
+/// Base layer under the microfacet interface (SPEC §2.6).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Base {
+    /// No base: a conductor.
+    Conductor,
+    /// A varnish of index `n` (real) over a diffuse layer of albedo ρd per
+    /// wavelength (HP17 42-43).
+    Plastic {
+        /// ρd per wavelength, in [0, 1).
+        albedo: Vec<f64>,
+    },
+}
+
+/// One material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name, `[a-z0-9-]+`; the T4 file is `t4-<name>.tbl`.
+    pub name: String,
+    /// EPD width β.
+    pub beta: f64,
+    /// EPD shape p.
+    pub p: f64,
+    /// σs, µm.
+    pub sigma_s: f64,
+    /// b, µm.
+    pub b: f64,
+    /// c.
+    pub c: f64,
+    /// Real part of the index, per wavelength.
+    pub n: Vec<f64>,
+    /// Imaginary part of the index, per wavelength.
+    pub k: Vec<f64>,
+    /// Base layer.
+    pub base: Base,
+    /// T4 band limit L.
+    pub band_limit: usize,
+    /// Optional half-Gaussian band filter of T4.
+    pub filter: Option<BandFilter>,
+}
+
+/// What is wrong with a materials file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialsError(pub String);
+
+impl fmt::Display for MaterialsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for MaterialsError {}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    wavelengths: Vec<f64>,
+    #[serde(default)]
+    material: Vec<RawMaterial>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    name: String,
+    beta: f64,
+    p: f64,
+    sigma_s: f64,
+    b: f64,
+    c: f64,
+    n: Vec<f64>,
+    k: Vec<f64>,
+    base: String,
+    albedo: Option<Vec<f64>>,
+    band_limit: usize,
+    filter: Option<RawFilter>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFilter {
+    start: f64,
+    width: f64,
+}
+
+impl Materials {
+    /// Reads and validates a materials file.
+    pub fn load(path: &Path) -> Result<Materials, MaterialsError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| MaterialsError(format!("cannot read {}: {e}", path.display())))?;
+        Self::parse(&text).map_err(|e| MaterialsError(format!("{}: {e}", path.display())))
+    }
+
+    /// Parses and validates the text of a materials file.
+    pub fn parse(text: &str) -> Result<Materials, MaterialsError> {
+        let raw: RawFile = toml::from_str(text).map_err(|e| MaterialsError(e.to_string()))?;
+        let channels = raw.wavelengths.len();
+        if !(1..=twoscale::sh::MAX_CHANNELS).contains(&channels) {
+            return Err(MaterialsError(format!(
+                "wavelengths: {channels} given, 1 to {} allowed",
+                twoscale::sh::MAX_CHANNELS
+            )));
+        }
+        for &lambda in &raw.wavelengths {
+            if !(0.2..=2.0).contains(&lambda) {
+                return Err(MaterialsError(format!(
+                    "wavelengths: {lambda} µm is outside [0.2, 2] µm"
+                )));
+            }
+        }
+        let mut materials: Vec<Material> = Vec::new();
+        for m in raw.material {
+            let material = m.validate(channels)?;
+            if materials.iter().any(|other| other.name == material.name) {
+                return Err(MaterialsError(format!(
+                    "material '{}' is defined twice",
+                    material.name
+                )));
+            }
+            materials.push(material);
+        }
+        Ok(Materials {
+            wavelengths: raw.wavelengths,
+            materials,
+        })
+    }
+}
+
+fn in_range(
+    name: &str,
+    field: &str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    open_lo: bool,
+) -> Result<(), MaterialsError> {
+    let ok = value.is_finite() && value <= hi && if open_lo { value > lo } else { value >= lo };
+    if ok {
+        Ok(())
+    } else {
+        let bracket = if open_lo { '(' } else { '[' };
+        Err(MaterialsError(format!(
+            "material '{name}': {field} = {value} is outside {bracket}{lo}, {hi}]"
+        )))
+    }
+}
+
+impl RawMaterial {
+    fn validate(self, channels: usize) -> Result<Material, MaterialsError> {
+        let name = self.name;
+        if name.is_empty()
+            || !name
+                .bytes()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == b'-')
+        {
+            return Err(MaterialsError(format!(
+                "material name '{name}' must be non-empty and use only a-z, 0-9 and '-'"
+            )));
+        }
+        in_range(&name, "beta", self.beta, 0.0, 1.0, true)?;
+        in_range(&name, "p", self.p, 0.2, 5.0, false)?;
+        in_range(&name, "sigma_s", self.sigma_s, 0.0, 1.0, false)?;
+        in_range(&name, "b", self.b, 0.0, 1000.0, true)?;
+        in_range(&name, "c", self.c, 1.0, 100.0, true)?;
+        for (field, values) in [("n", &self.n), ("k", &self.k)] {
+            if values.len() != channels {
+                return Err(MaterialsError(format!(
+                    "material '{name}': {field} has {} values, one per wavelength ({channels}) needed",
+                    values.len()
+                )));
+            }
+        }
+        for &v in &self.n {
+            in_range(&name, "n", v, 0.0, 10.0, true)?;
+        }
+        for &v in &self.k {
+            in_range(&name, "k", v, 0.0, 20.0, false)?;
+        }
+        let base = match (self.base.as_str(), self.albedo) {
+            ("conductor", None) => Base::Conductor,
+            ("conductor", Some(_)) => {
+                return Err(MaterialsError(format!(
+                    "material '{name}': albedo is only for base = \"plastic\""
+                )));
+            }
+            ("plastic", Some(albedo)) => {
+                if albedo.len() != channels {
+                    return Err(MaterialsError(format!(
+                        "material '{name}': albedo has {} values, one per wavelength ({channels}) needed",
+                        albedo.len()
+                    )));
+                }
+                for &a in &albedo {
+                    in_range(&name, "albedo", a, 0.0, 0.999, false)?;
+                }
+                if self.k.iter().any(|&k| k != 0.0) || self.n.iter().any(|&n| n < 1.0) {
+                    return Err(MaterialsError(format!(
+                        "material '{name}': a plastic's varnish needs a real index n ≥ 1 (k = 0)"
+                    )));
+                }
+                Base::Plastic { albedo }
+            }
+            ("plastic", None) => {
+                return Err(MaterialsError(format!(
+                    "material '{name}': base = \"plastic\" needs an albedo per wavelength"
+                )));
+            }
+            (other, _) => {
+                return Err(MaterialsError(format!(
+                    "material '{name}': unknown base '{other}' (conductor or plastic)"
+                )));
+            }
+        };
+        let max = twoscale::sh::MAX_BAND_LIMIT;
+        if !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&self.band_limit) {
+            return Err(MaterialsError(format!(
+                "material '{name}': band_limit = {} is outside [2, {max}]",
+                self.band_limit
+            )));
+        }
+        let filter = match self.filter {
+            None => None,
+            Some(f) => {
+                in_range(&name, "filter.start", f.start, 0.0, max as f64, false)?;
+                in_range(&name, "filter.width", f.width, 0.0, 1000.0, true)?;
+                Some(BandFilter {
+                    start: f.start,
+                    width: f.width,
+                })
+            }
+        };
+        Ok(Material {
+            name,
+            beta: self.beta,
+            p: self.p,
+            sigma_s: self.sigma_s,
+            b: self.b,
+            c: self.c,
+            n: self.n,
+            k: self.k,
+            base,
+            band_limit: self.band_limit,
+            filter,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+wavelengths = [0.645, 0.526, 0.444]
+[[material]]
+name = "ni"
+beta = 0.06
+p = 1.0
+sigma_s = 0.03
+b = 4.8
+c = 2.0
+n = [2.0, 1.8, 1.7]
+k = [3.8, 3.3, 2.8]
+base = "conductor"
+band_limit = 16
+"#;
+
+    fn error_of(text: &str) -> String {
+        Materials::parse(text).unwrap_err().0
+    }
+
+    #[test]
+    fn parses_a_valid_file() {
+        let m = Materials::parse(GOOD).unwrap();
+        assert_eq!(m.wavelengths, vec![0.645, 0.526, 0.444]);
+        assert_eq!(m.materials.len(), 1);
+        assert_eq!(m.materials[0].base, Base::Conductor);
+        assert_eq!(m.materials[0].filter, None);
+    }
+
+    #[test]
+    fn the_repository_file_is_valid() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
+        let m = Materials::load(Path::new(path)).unwrap();
+        assert!(m.materials.len() >= 2);
+    }
+
+    #[test]
+    fn rejects_unknown_keys_missing_fields_and_bad_values() {
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\ncolour = 1"));
+        assert!(e.contains("unknown field") && e.contains("colour"), "{e}");
+        let e = error_of(&GOOD.replace("beta = 0.06\n", ""));
+        assert!(e.contains("missing field") && e.contains("beta"), "{e}");
+        let e = error_of(&GOOD.replace("beta = 0.06", "beta = 1.5"));
+        assert!(e.contains("'ni'") && e.contains("beta"), "{e}");
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 1.0"));
+        assert!(e.contains("c = 1"), "{e}");
+        let e = error_of(&GOOD.replace("k = [3.8, 3.3, 2.8]", "k = [3.8, 3.3]"));
+        assert!(e.contains("k has 2 values"), "{e}");
+        let e = error_of(&GOOD.replace("band_limit = 16", "band_limit = 500"));
+        assert!(e.contains("band_limit"), "{e}");
+        let e = error_of(&GOOD.replace("\"conductor\"", "\"wood\""));
+        assert!(e.contains("unknown base"), "{e}");
+        let e = error_of(&GOOD.replace("\"conductor\"", "\"plastic\""));
+        assert!(e.contains("needs an albedo"), "{e}");
+        let e = error_of(&GOOD.replace("name = \"ni\"", "name = \"Ni 2\""));
+        assert!(e.contains("a-z"), "{e}");
+        let twice = format!("{GOOD}{}", &GOOD[GOOD.find("[[material]]").unwrap()..]);
+        assert!(error_of(&twice).contains("twice"));
+        let e = error_of(&GOOD.replace("[0.645, 0.526, 0.444]", "[]"));
+        assert!(e.contains("wavelengths"), "{e}");
+    }
+}
