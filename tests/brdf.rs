@@ -303,10 +303,70 @@ fn white_furnace() {
     eprintln!("above 1: {excess:#?}");
 }
 
+/// The albedo `∫ ρ cos θo dωo` of every preset (`twoscale::materials`) per
+/// RGB channel with its real F and Q̄ (HP17 10), at θi = 0°, 45°, 70°, 85°:
+/// importance sampling with the model's sampler, 2·10⁴ samples per value
+/// (the printed ± is one standard error); C exact (`ProfileConvolution`, one
+/// profile per preset). Q̄ is not bounded by 1 away from the specular
+/// direction (SPEC §7), so nothing bounds the albedo by 1: the test prints
+/// the table and lists the values above 1 by more than 4 standard errors;
+/// it asserts only that every albedo is finite and positive (even at normal
+/// incidence the real Q̄ can push a strong halo above 1: gold-rough).
+#[test]
+fn preset_albedos() {
+    let owned = BrdfTables::load();
+    let incidences = [0.0, 45.0, 70.0, 85.0];
+    let n = 20_000;
+    let mut table = String::from(
+        "preset               θi   albedo R          G                 B                 (halo R, G, B)\n",
+    );
+    let mut above = Vec::new();
+    for (name, material) in twoscale::materials::PRESETS {
+        let s = material.layer.surface;
+        let u_max = f64::from(s.b / twoscale::brdf::RGB_WAVELENGTHS[2]) * 1.0001;
+        let conv = ProfileConvolution::new(s.c, s.beta, s.p, u_max);
+        let tables = owned.tables(&conv);
+        let rgb = twoscale::Rgb::new(&tables, &material, Options::default());
+        for deg in incidences {
+            let i = from_angles(f64::to_radians(deg), 0.7);
+            let mut row = format!("{name:<20} {deg:>3}° ");
+            let mut halos = Vec::new();
+            for (k, model) in rgb.channels.iter().enumerate() {
+                let mut rng = SplitMix64::new(31 + k as u64);
+                let (mut sum, mut sum_sq, mut halo) = (0.0, 0.0, 0.0);
+                for _ in 0..n {
+                    let u = [0, 1, 2].map(|_| rng.uniform() as f32);
+                    if let Some(sample) = model.sample(i, u) {
+                        let cos_o = f64::from(sample.o[2]) / f64::from(sample.pdf);
+                        let w = f64::from(sample.value) * cos_o;
+                        halo += f64::from(model.eval_lobes(i, sample.o).diffraction) * cos_o;
+                        sum += w;
+                        sum_sq += w * w;
+                    }
+                }
+                let mean = sum / n as f64;
+                let err = ((sum_sq / n as f64 - mean * mean) / n as f64).sqrt();
+                let halo = halo / n as f64;
+                assert!(mean.is_finite() && mean > 0.0, "{name} θi = {deg}°: {mean}");
+                if mean > 1.0 + 4.0 * err {
+                    above.push(format!(
+                        "{name} θi = {deg}° channel {k}: {mean:.4} ± {err:.4}"
+                    ));
+                }
+                row.push_str(&format!("{mean:.4} ± {err:.4}   "));
+                halos.push(format!("{halo:.4}"));
+            }
+            table.push_str(&format!("{row}({})\n", halos.join(", ")));
+        }
+    }
+    eprintln!("preset albedos (real F and Q̄, exact C):\n{table}above 1: {above:#?}");
+}
+
 /// χ² tests of `sample` against `pdf`, per lobe and for the full model,
 /// several incidences (grazing included) and materials (very narrow, HP17,
-/// very rough, plastic), 10⁶ samples each, Šidák-corrected α = 0.01; and
-/// `∫ pdf ≤ 1`, equal to the sampler's success rate.
+/// very rough, plastic), 10⁶ samples for the full model and 4·10⁵ per lobe,
+/// Šidák-corrected α = 0.01; and `∫ pdf ≤ 1`, equal to the sampler's
+/// success rate.
 #[test]
 fn sampling_matches_pdf() {
     let owned = BrdfTables::load();
@@ -339,9 +399,15 @@ fn sampling_matches_pdf() {
         };
         for deg in incidences {
             for lobe in [Some(Lobe::Specular), Some(Lobe::Diffraction), None] {
-                // Known failure, under investigation (see
-                // `narrow_grazing_specular_sampling`): excluded here.
-                if name == "narrow" && deg == 87.0 && lobe != Some(Lobe::Diffraction) {
+                // The narrow specular lobe at grazing incidence has its own
+                // test with 10⁶ samples (`narrow_grazing_specular_sampling`).
+                if name == "narrow" && deg == 87.0 && lobe == Some(Lobe::Specular) {
+                    continue;
+                }
+                // The surface lobes' samplers depend on the geometry only,
+                // not on the base layer: the conductors cover them; the
+                // plastic is tested for its full mixture and its base lobe.
+                if name == "plastic" && matches!(lobe, Some(Lobe::Specular | Lobe::Diffraction)) {
                     continue;
                 }
                 cases.push((name, layer, eta, deg, lobe));
@@ -352,7 +418,7 @@ fn sampling_matches_pdf() {
         }
     }
     let alpha = suite::sidak(0.01, cases.len() + 2);
-    // 10⁶ samples for the full model, 4·10⁵ per lobe (test time).
+    // 10⁶ samples for the full model (every lobe at once), 4·10⁵ per lobe.
     let (n, n_lobe) = (1_000_000, 400_000);
     let results = Mutex::new(Vec::new());
     let next = Mutex::new(0usize);
@@ -378,7 +444,7 @@ fn sampling_matches_pdf() {
                             i,
                             |u| model.sample_lobe(lobe, i, [u[1], u[2]]),
                             |o| f64::from(model.pdf_lobe(lobe, i, o)),
-                            n,
+                            n_lobe,
                             scale,
                             k as u64 + 100,
                         ),
@@ -711,12 +777,14 @@ fn runtime_matches_reference() {
 }
 
 /// The specular lobe of a very narrow material (β = 0.004, p = 0.6) at
-/// θi = 87°: the χ² test fails (p ≈ 1e-30) and ∫ pdf = 0.99965 against a
-/// success rate of 0.99995. Not yet explained (candidates: the f32 pdf of a
-/// lobe this narrow next to the horizon, or the test's cell quadrature
-/// there). Ignored until resolved; run with `--ignored`.
+/// θi = 87°, 10⁶ samples. This case once failed (p ≈ 1e-26, ∫ pdf = 0.99965
+/// against a success rate of 0.99995) because of the test, not the runtime:
+/// at grazing incidence the lobe is a ridge along the plane of incidence,
+/// 1/(2 cos θi) ≈ 10 times longer than wide, lying on the χ² cells' sector
+/// edges, and a single 8-point rule per sector missed it in the tail
+/// (`suite::brdf::chi_square_sampler` now integrates each sector in four
+/// parts; refined further, ∫ pdf moves by < 5e-7).
 #[test]
-#[ignore]
 fn narrow_grazing_specular_sampling() {
     let owned = BrdfTables::load();
     let stub = NarrowNdfConvolution;
@@ -728,17 +796,26 @@ fn narrow_grazing_specular_sampling() {
         NICKEL_LIKE,
     );
     let i = from_angles(f64::to_radians(87.0), 1.1);
+    let n = 1_000_000;
     let check = chi_square_sampler(
         i,
         |u| model.sample_lobe(Lobe::Specular, i, [u[1], u[2]]),
         |o| f64::from(model.pdf_lobe(Lobe::Specular, i, o)),
-        1_000_000,
+        n,
         0.008,
         7,
     );
     eprintln!(
-        "p = {:e}, ∫pdf = {}, sampled {}",
+        "narrow, θi = 87°, specular: p = {:.4}, ∫pdf = {:.7}, sampled {:.7}",
         check.chi.p_value, check.pdf_integral, check.success
     );
-    assert!(check.chi.p_value >= 0.01);
+    assert!(check.chi.p_value >= 0.01, "p = {}", check.chi.p_value);
+    let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
+    assert!(check.pdf_integral <= 1.0 + 1e-5);
+    assert!(
+        (check.pdf_integral - check.success).abs() <= 5.0 * se + 5e-6,
+        "∫pdf {} vs sampled {}",
+        check.pdf_integral,
+        check.success
+    );
 }

@@ -151,7 +151,7 @@ pub struct SamplerCheck {
 /// the angle `α` from `r` (edges at 0 and geometrically spaced from
 /// `scale/8` to π, so that lobes of width ~`scale` are resolved) and the
 /// azimuth around `r` (16 equal sectors). Expected counts are `n · ∫ pdf dω`
-/// over each cell by nested adaptive quadrature, with the part of the cell
+/// over each cell by a Gauss product rule (on four sub-sectors), with the part of the cell
 /// below the horizon cut away analytically (no discontinuity inside the
 /// integrals). Cells expecting fewer than 5 events are pooled.
 pub fn chi_square_sampler(
@@ -264,11 +264,28 @@ pub fn chi_square_sampler(
         }
         cell_part(a0, a1, p0, p1)
     };
+    // Each sector is integrated as PHI_SPLIT sub-sectors: at grazing
+    // incidence a narrow lobe is a thin ridge along the plane of incidence
+    // (φ = 0 and π, which are sector edges), stretched 1/(2 cos θi) times
+    // along it (reflection about m moves o by 2δ in the plane and by
+    // 2 cos θi δ across it). One 8-point rule over a whole sector puts its
+    // first node 0.008 rad from that edge and misses most of a ridge
+    // narrower than that: for β = 0.004, p = 0.6 at θi = 87° the undivided
+    // rule gave ∫ pdf = 0.99965 against a success rate of 0.99995
+    // (p ≈ 1e-26); split in 2, 4 or 8 it gives 0.999953, 0.999956,
+    // 0.999956 (p = 0.94 at each).
+    const PHI_SPLIT: usize = 4;
+    let sub = dphi / PHI_SPLIT as f64;
     let mut expected = vec![0.0; n_alpha * n_phi];
     for ka in 0..n_alpha {
         for kp in 0..n_phi {
             let p0 = kp as f64 * dphi;
-            expected[ka * n_phi + kp] = cell(alpha_edges[ka], alpha_edges[ka + 1], p0, p0 + dphi);
+            expected[ka * n_phi + kp] = (0..PHI_SPLIT)
+                .map(|j| {
+                    let q0 = p0 + j as f64 * sub;
+                    cell(alpha_edges[ka], alpha_edges[ka + 1], q0, q0 + sub)
+                })
+                .sum();
         }
     }
     let pdf_integral: f64 = expected.iter().sum();
