@@ -356,7 +356,7 @@ fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<Exit
         }
     }
     println!(
-        "{:<22} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>14}  result  worst at",
+        "{:<22} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>20}  result  worst at",
         "table", "bytes", "metric", "points", "max", "median", "p90", "p99", "target"
     );
     let mut failed = false;
@@ -368,12 +368,17 @@ fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<Exit
                     let target = if !a.target.is_finite() {
                         "-".to_string()
                     } else if a.gate_quantile < 1.0 {
-                        format!("p{:.0} <= {:.0e}", 100.0 * a.gate_quantile, a.target)
+                        format!(
+                            "p{:.0} {:.1e}<={:.0e}",
+                            100.0 * a.gate_quantile,
+                            a.gated,
+                            a.target
+                        )
                     } else {
                         format!("max <= {:.0e}", a.target)
                     };
                     println!(
-                        "{:<22} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>14}  {:<6}  {}",
+                        "{:<22} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>20}  {:<6}  {}",
                         stem,
                         size,
                         a.metric,

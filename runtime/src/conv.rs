@@ -190,6 +190,10 @@ pub struct ConvTable<'a> {
     g_offset: f32,
     u_max: f32,
     domain: [(f32, f32); 4],
+    /// Node counts of the parameter axes.
+    nodes: [usize; 4],
+    /// Per parameter axis: Catmull–Rom (4 nodes) instead of linear (2 nodes).
+    cubic: [bool; 4],
 }
 
 /// The paper's form of T3 (T3a), a view of a [`ConvTable`].
@@ -245,6 +249,10 @@ impl<'a> ConvTable<'a> {
                 "T3 domain must have c > 1, beta > 0, p > 0, u >= 0",
             ));
         }
+        let mut nodes = [0; 4];
+        for (d, n) in nodes.iter_mut().enumerate() {
+            *n = used[d].nodes as usize;
+        }
         Ok(ConvTable {
             grid,
             angle,
@@ -252,7 +260,77 @@ impl<'a> ConvTable<'a> {
             g_offset: header.params[5] as f32,
             u_max: domain[0].1,
             domain,
+            nodes,
+            cubic: DEFAULT_CUBIC_AXES,
         })
+    }
+
+    /// The same table with the given per-axis interpolation of T3b along the
+    /// parameters (`true`: Catmull–Rom through 4 nodes, `false`: linear).
+    pub fn with_cubic_axes(mut self, cubic: [bool; 4]) -> Self {
+        self.cubic = cubic;
+        self
+    }
+
+    /// Blend of one channel over the parameter cell: per axis, linear weights
+    /// on nodes `i, i+1`, or Catmull–Rom weights on `i−1 … i+2` (linear in the
+    /// first and last cell, where a node is missing).
+    fn blend_params(&self, cells: [(usize, f32); 4], channel: usize) -> f32 {
+        let channels = FIT_CHANNELS + self.angles;
+        let mut start = [0usize; 4];
+        let mut count = [2usize; 4];
+        let mut weights = [[0.0f32; 4]; 4];
+        for d in 0..4 {
+            let (i, t) = cells[d];
+            let n = self.nodes[d];
+            if self.cubic[d] && i >= 1 && i + 2 < n {
+                start[d] = i - 1;
+                count[d] = 4;
+                weights[d] = catmull_rom_weights(t);
+            } else if self.cubic[d] && n >= 3 && i == 0 {
+                // First cell: the quadratic through nodes 0, 1, 2.
+                start[d] = 0;
+                count[d] = 3;
+                weights[d] = [
+                    0.5 * (t - 1.0) * (t - 2.0),
+                    -t * (t - 2.0),
+                    0.5 * t * (t - 1.0),
+                    0.0,
+                ];
+            } else if self.cubic[d] && n >= 3 && i + 2 == n {
+                // Last cell: the quadratic through nodes n−3, n−2, n−1.
+                start[d] = i - 1;
+                count[d] = 3;
+                weights[d] = [
+                    0.5 * t * (t - 1.0),
+                    (1.0 - t) * (1.0 + t),
+                    0.5 * t * (t + 1.0),
+                    0.0,
+                ];
+            } else {
+                start[d] = i;
+                weights[d] = [1.0 - t, t, 0.0, 0.0];
+            }
+        }
+        let values = self.grid.values();
+        let [_, n1, n2, n3] = self.nodes;
+        let mut sum = 0.0f32;
+        for (a, wa) in weights[0][..count[0]].iter().enumerate() {
+            let ia = start[0] + a;
+            for (b, wb) in weights[1][..count[1]].iter().enumerate() {
+                let ib = ia * n1 + start[1] + b;
+                let wab = wa * wb;
+                for (c, wc) in weights[2][..count[2]].iter().enumerate() {
+                    let ic = ib * n2 + start[2] + c;
+                    let wabc = wab * wc;
+                    for (d, wd) in weights[3][..count[3]].iter().enumerate() {
+                        let index = (ic * n3 + start[3] + d) * channels + channel;
+                        sum += wabc * wd * values.get(index).copied().unwrap_or(0.0);
+                    }
+                }
+            }
+        }
+        sum
     }
 
     /// The paper's form (T3a) from the same file.
@@ -314,7 +392,7 @@ impl<'a> ConvTable<'a> {
         let t = position - k as f32;
         let at = |j: isize| -> f32 {
             let j = j.max(0).min(n as isize - 1) as usize;
-            self.grid.blend(cells, FIT_CHANNELS + j)
+            self.blend_params(cells, FIT_CHANNELS + j)
         };
         let k = k as isize;
         let (v0, v1, v2, v3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
@@ -326,8 +404,14 @@ impl<'a> ConvTable<'a> {
         } else {
             v3 - v2
         };
-        let d1 = monotone_derivative(s_left, s_mid);
-        let d2 = monotone_derivative(s_mid, s_right);
+        let (d1, d2) = if ANGLE_CATMULL_ROM {
+            (0.5 * (s_left + s_mid), 0.5 * (s_mid + s_right))
+        } else {
+            (
+                monotone_derivative(s_left, s_mid),
+                monotone_derivative(s_mid, s_right),
+            )
+        };
         // Cubic Hermite on [v1, v2] with derivatives d1, d2 (unit spacing).
         let t2 = t * t;
         let t3 = t2 * t;
@@ -371,6 +455,26 @@ impl<'a> ConvTable<'a> {
         let s = if s.is_finite() { s } else { 0.0 };
         (s, math::sqrtf(g2.max(0.0)))
     }
+}
+
+/// Which parameter axes (u, c, β, p) T3b interpolates with Catmull–Rom by
+/// default (see the README for the measurement behind the choice).
+pub const DEFAULT_CUBIC_AXES: [bool; 4] = [true, true, true, true];
+
+/// Along `ξ`: Catmull–Rom derivatives (true) or Fritsch–Carlson (false).
+const ANGLE_CATMULL_ROM: bool = true;
+
+/// Catmull–Rom weights of nodes `i−1, i, i+1, i+2` at fraction `t` of cell `i`.
+#[inline]
+fn catmull_rom_weights(t: f32) -> [f32; 4] {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    [
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    ]
 }
 
 /// The Fritsch–Carlson derivative at a node between secant slopes `a` and
