@@ -272,10 +272,11 @@ impl<'a> ConvTable<'a> {
         self
     }
 
-    /// Blend of one channel over the parameter cell: per axis, linear weights
+    /// Blend of the `N` consecutive channels from `first` over the parameter
+    /// cell (one pass over the corners): per axis, linear weights
     /// on nodes `i, i+1`, or Catmull–Rom weights on `i−1 … i+2` (linear in the
     /// first and last cell, where a node is missing).
-    fn blend_params(&self, cells: [(usize, f32); 4], channel: usize) -> f32 {
+    fn blend_params<const N: usize>(&self, cells: [(usize, f32); 4], first: usize) -> [f32; N] {
         let channels = FIT_CHANNELS + self.angles;
         let mut start = [0usize; 4];
         let mut count = [2usize; 4];
@@ -314,7 +315,7 @@ impl<'a> ConvTable<'a> {
         }
         let values = self.grid.values();
         let [_, n1, n2, n3] = self.nodes;
-        let mut sum = 0.0f32;
+        let mut sum = [0.0f32; N];
         for (a, wa) in weights[0][..count[0]].iter().enumerate() {
             let ia = start[0] + a;
             for (b, wb) in weights[1][..count[1]].iter().enumerate() {
@@ -324,8 +325,13 @@ impl<'a> ConvTable<'a> {
                     let ic = ib * n2 + start[2] + c;
                     let wabc = wab * wc;
                     for (d, wd) in weights[3][..count[3]].iter().enumerate() {
-                        let index = (ic * n3 + start[3] + d) * channels + channel;
-                        sum += wabc * wd * values.get(index).copied().unwrap_or(0.0);
+                        let index = (ic * n3 + start[3] + d) * channels + first;
+                        let w = wabc * wd;
+                        if let Some(v) = values.get(index..index + N) {
+                            for (acc, &x) in sum.iter_mut().zip(v) {
+                                *acc += w * x;
+                            }
+                        }
                     }
                 }
             }
@@ -390,11 +396,15 @@ impl<'a> ConvTable<'a> {
         let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
         let k = (math::floorf(position) as usize).min(n - 2);
         let t = position - k as f32;
+        // The four channels around ξ (clamped to the table), blended in one
+        // pass: channels are contiguous, so read a window of 4 and pick.
+        let k = k as isize;
+        let first = (k - 1).max(0).min(n as isize - 4) as usize;
+        let window: [f32; 4] = self.blend_params(cells, FIT_CHANNELS + first);
         let at = |j: isize| -> f32 {
             let j = j.max(0).min(n as isize - 1) as usize;
-            self.blend_params(cells, FIT_CHANNELS + j)
+            window[(j - first).min(3)]
         };
-        let k = k as isize;
         let (v0, v1, v2, v3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
         // Secant slopes (per node spacing) and Fritsch–Carlson derivatives.
         let s_left = if k == 0 { v2 - v1 } else { v1 - v0 };
