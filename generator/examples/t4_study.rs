@@ -7,7 +7,9 @@
 //! two-scale model (as T4 does: the runtime `TwoScale` with the workspace's
 //! T1, T2, T5 and T3b) of the rough and the glossy presets of `materials.toml`
 //! at the green channel (0.526 µm); `-- beckmann` the Beckmann Cook–Torrance
-//! lobes (F = 1) of the earlier study.
+//! lobes (F = 1) of the earlier study; `-- polished` a Beckmann lobe as
+//! narrow as the gold-polished preset's (α = β = 0.005) at L = 64 and 127,
+//! with 4× the default θ nodes so that the quadrature resolves the lobe.
 
 use generator::analytic::BeckmannCt;
 use generator::materials::Materials;
@@ -16,7 +18,7 @@ use generator::tables::t4::{ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verif
 use std::path::Path;
 use std::time::Instant;
 
-fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize]) {
+fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize], theta_factor: usize) {
     let pairs = verification_pairs(20_000, 11);
     let exact: Vec<f64> = pairs
         .iter()
@@ -26,7 +28,9 @@ fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize]) {
     let norm: f64 = exact.iter().map(|v| v * v).sum::<f64>();
     for &l in bands {
         let start = Instant::now();
-        let projection = project(brdf, l, default_quadrature(l), None);
+        let mut quadrature = default_quadrature(l);
+        quadrature.theta_nodes *= theta_factor;
+        let projection = project(brdf, l, quadrature, None);
         let seconds = start.elapsed().as_secs_f64();
         let (diff, matrix_norm) = projection.asymmetry();
         let mut errors = Vec::new();
@@ -63,8 +67,16 @@ fn main() {
                 &[8, 16, 32, 48, 64, 96][..],
             ),
         ] {
-            study(name, &BeckmannCt { alpha, eta: None }, bands);
+            study(name, &BeckmannCt { alpha, eta: None }, bands, 1);
         }
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("polished") {
+        let brdf = BeckmannCt {
+            alpha: 0.005,
+            eta: None,
+        };
+        study("Beckmann polished α = 0.005", &brdf, &[64, 127], 4);
         return;
     }
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
@@ -84,6 +96,6 @@ fn main() {
             .find(|m| m.name == name)
             .expect("preset in materials.toml");
         let brdf = two_scale_brdf(material, channel, lambda, &tables);
-        study(&format!("two-scale {name} at {lambda} µm"), &brdf, bands);
+        study(&format!("two-scale {name} at {lambda} µm"), &brdf, bands, 1);
     }
 }

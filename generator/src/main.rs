@@ -61,6 +61,10 @@ enum Command {
         /// Materials file (T4: one table per material).
         #[arg(long, default_value = DEFAULT_MATERIALS)]
         materials: PathBuf,
+        /// Only these tables (names or prefixes as for `build`, e.g.
+        /// `--table t4`); all if none.
+        #[arg(long = "table")]
+        tables: Vec<String>,
         /// Random points per table.
         #[arg(long, default_value_t = 20_000)]
         points: usize,
@@ -128,10 +132,11 @@ fn main() -> ExitCode {
         Command::Verify {
             dir,
             materials,
+            tables,
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, &materials, points, seed)),
+        } => set_threads(threads).and_then(|()| verify(&dir, &materials, &tables, points, seed)),
         Command::SpotCheck {
             tables,
             dir,
@@ -341,10 +346,16 @@ fn spot_check(
     })
 }
 
-fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
+fn verify(
+    dir: &Path,
+    materials: &Path,
+    names: &[String],
+    points: usize,
+    seed: u64,
+) -> Result<ExitCode, String> {
     let t4 = material_tables(materials, dir)?;
     let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
-    for kind in catalogue(&t4) {
+    for kind in selected(names, &t4)? {
         let id = kind.id();
         let stem = kind.file_stem();
         let path = dir.join(format!("{stem}.tbl"));

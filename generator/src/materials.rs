@@ -407,6 +407,19 @@ band_limit = 16
         assert!(e.contains("unknown base"), "{e}");
         let e = error_of(&GOOD.replace("\"conductor\"", "\"plastic\""));
         assert!(e.contains("needs an albedo"), "{e}");
+        let subsurface = GOOD.replace(
+            "base = \"conductor\"",
+            "base = \"subsurface\"\nalbedo = [0.9, 0.9, 0.9]",
+        );
+        let e = error_of(&subsurface);
+        assert!(e.contains("real index"), "{e}");
+        let dielectric = subsurface.replace("k = [3.8, 3.3, 2.8]", "k = [0.0, 0.0, 0.0]");
+        let m = Materials::parse(&dielectric).unwrap();
+        assert_eq!(m.materials[0].base.albedo(2), 0.9);
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\nlambertian = 1.5"));
+        assert!(e.contains("lambertian"), "{e}");
+        let m = Materials::parse(&GOOD.replace("band_limit = 16\n", "")).unwrap();
+        assert_eq!(m.materials[0].band_limit, None);
         let e = error_of(&GOOD.replace("name = \"ni\"", "name = \"Ni 2\""));
         assert!(e.contains("a-z"), "{e}");
         let twice = format!("{GOOD}{}", &GOOD[GOOD.find("[[material]]").unwrap()..]);
