@@ -290,8 +290,9 @@ fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
 }
 
 // Bounds of `committed_rough_file_matches_the_two_scale_model`: the figures
-// measured on the committed gold-rough file (L = 16; README, T4) rounded up
-// by at most 20%: a rebuilt file that is worse fails.
-const RMS_BOUND: f64 = 1.0;
-const P99_BOUND: f64 = 1.0;
-const MAX_BOUND: f64 = 1.0;
+// measured on the committed gold-rough file (L = 24, 4000 pairs of seed 21;
+// worst channel, blue: rel RMS 3.58e-2, p99 3.43e-2, max 0.130) raised by
+// about 17%: a file projected at L = 16 (5.4e-2 RMS) or from another BRDF fails.
+const RMS_BOUND: f64 = 0.042;
+const P99_BOUND: f64 = 0.040;
+const MAX_BOUND: f64 = 0.15;
