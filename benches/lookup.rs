@@ -3,6 +3,7 @@
 //! the machine). Each iteration evaluates a batch of 1024 pseudo-random inputs.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use generator::sh::IsotropicBrdf;
 use std::hint::black_box;
 use twoscale::{
     Complex, ConvTable, Convolution, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId,
@@ -283,7 +284,8 @@ fn convolution(c: &mut Criterion) {
 }
 
 /// T4: SH evaluation (all three channels, committed files) against the
-/// direct f64 evaluation of the BRDF it projects (the stand-in, one channel).
+/// direct evaluation of the BRDF it projects (the runtime two-scale model
+/// with T3b, one channel, f64 directions rounded to f32 per call).
 fn sh_brdf(c: &mut Criterion) {
     let pairs = generator::tables::t4::verification_pairs(1024, 7);
     let narrow: Vec<([f32; 3], [f32; 3])> = pairs
@@ -297,12 +299,18 @@ fn sh_brdf(c: &mut Criterion) {
     .unwrap();
     let mut group = c.benchmark_group("sh_brdf");
     group.throughput(Throughput::Elements(pairs.len() as u64));
+    let inputs = generator::tables::t4::ModelInputs::load(&suite::tables_dir()).unwrap();
+    let parsed = inputs.parse().unwrap();
+    let model_tables = parsed.tables();
     for material in &materials.materials {
+        let Some(l) = material.band_limit else {
+            continue;
+        };
         let bytes =
             std::fs::read(suite::tables_dir().join(format!("t4-{}.tbl", material.name))).unwrap();
         let buf = twoscale::format::aligned_copy(&bytes);
         let table = twoscale::ShBrdfTable::from_bytes(buf.bytes()).unwrap();
-        let name = format!("{} L={}", material.name, table.band_limit());
+        let name = format!("{} L={l}", material.name);
         group.bench_function(format!("sh eval_rgb {name}"), |b| {
             b.iter(|| {
                 for &(i, o) in &narrow {
@@ -310,8 +318,8 @@ fn sh_brdf(c: &mut Criterion) {
                 }
             })
         });
-        let brdf = generator::tables::t4::material_brdf(material, 0, 0.645).unwrap();
-        group.bench_function(format!("direct stand-in f64 {}", material.name), |b| {
+        let brdf = generator::tables::t4::two_scale_brdf(material, 0, 0.645, &model_tables);
+        group.bench_function(format!("direct two-scale {}", material.name), |b| {
             b.iter(|| {
                 for &(i, o) in &pairs {
                     black_box(brdf.eval(black_box(i), black_box(o)));

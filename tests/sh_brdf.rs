@@ -1,19 +1,22 @@
-//! T4 through the runtime: the committed files' shape, exact reciprocity, the
-//! absent coefficients, the f32 evaluation against the f64 projection, and
-//! the reflected radiance of a constant sky (directional albedo).
+//! T4 through the runtime: the committed files' shape, exact reciprocity and
+//! accuracy against the two-scale model they project, the asymmetry the
+//! two-scale model gives before symmetrising, the absent coefficients, the
+//! f32 evaluation against the f64 projection, and the reflected radiance of
+//! a constant sky (directional albedo).
 
 use generator::analytic::{BeckmannCt, Lambertian};
 use generator::sh::{IsotropicBrdf, Projection, default_quadrature, project};
 use generator::tables::TableKind;
-use generator::tables::t4::ShBrdf;
+use generator::tables::t4::{ModelInputs, Projected, ShBrdf};
 use twoscale::ShBrdfTable;
 use twoscale::format::aligned_copy;
 use twoscale::sh::{ProjectedModel, coefficient_count, normalized_legendre};
 
-/// Builds a one-material T4 file in memory from the materials text.
+/// Builds a one-material T4 file of the Beckmann stand-in in memory from
+/// the materials text.
 fn built(materials: &str) -> twoscale::format::AlignedBuf {
     let materials = generator::materials::Materials::parse(materials).unwrap();
-    let kind = &ShBrdf::all(&materials)[0];
+    let kind = &ShBrdf::all(&materials, &Projected::BeckmannStandIn)[0];
     let bytes = kind.build(&indicatif::ProgressBar::hidden()).unwrap();
     aligned_copy(&bytes)
 }
@@ -38,7 +41,7 @@ band_limit = 10
 fn committed_t4_files_read_and_are_reciprocal() {
     let buf = suite::read_table(twoscale::TableId::ShBrdf);
     let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
-    assert_eq!(table.model(), ProjectedModel::BeckmannStandIn);
+    assert_eq!(table.model(), ProjectedModel::TwoScale);
     assert_eq!(table.channels(), 3);
     let pairs = generator::tables::t4::verification_pairs(500, 3);
     for (wi, wo) in pairs {
@@ -82,7 +85,8 @@ fn runtime_eval_matches_the_f64_projection() {
     let buf = built(ROUGH);
     let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
     let materials = generator::materials::Materials::parse(ROUGH).unwrap();
-    let brdf = generator::tables::t4::material_brdf(&materials.materials[0], 1, 0.526).unwrap();
+    let brdf =
+        generator::tables::t4::material_brdf(&materials.materials[0], 1, 0.526, None).unwrap();
     let projection = project(brdf.as_ref(), 10, default_quadrature(10), None);
     let mut worst: f64 = 0.0;
     for (wi, wo) in generator::tables::t4::verification_pairs(2000, 5) {
@@ -190,3 +194,105 @@ fn table_from(projection: &Projection) -> twoscale::format::AlignedBuf {
     .unwrap();
     aligned_copy(&bytes)
 }
+
+/// The workspace's T1, T2, T5 and T3 (T4's inputs).
+fn model_inputs() -> ModelInputs {
+    ModelInputs::load(std::path::Path::new(
+        generator::tables::t4::WORKSPACE_TABLES,
+    ))
+    .unwrap()
+}
+
+/// `(rel RMS of f, p99 and max of |Δf| / max f)` of `rho_sh` against
+/// `rho` over `pairs`, `f = ρ cos θi cos θo`.
+fn f_errors(
+    pairs: &[([f64; 3], [f64; 3])],
+    rho: impl Fn([f64; 3], [f64; 3]) -> f64,
+    rho_sh: impl Fn([f64; 3], [f64; 3]) -> f64,
+) -> (f64, f64, f64) {
+    let values: Vec<(f64, f64)> = pairs
+        .iter()
+        .map(|&(i, o)| {
+            let cc = i[2] * o[2];
+            (rho(i, o) * cc, rho_sh(i, o) * cc)
+        })
+        .collect();
+    let peak = values.iter().fold(0.0f64, |m, v| m.max(v.0));
+    let norm: f64 = values.iter().map(|v| v.0 * v.0).sum();
+    let sum2: f64 = values.iter().map(|v| (v.1 - v.0).powi(2)).sum();
+    let mut errors: Vec<f64> = values.iter().map(|v| (v.1 - v.0).abs() / peak).collect();
+    errors.sort_by(f64::total_cmp);
+    (
+        (sum2 / norm).sqrt(),
+        errors[errors.len() * 99 / 100],
+        errors[errors.len() - 1],
+    )
+}
+
+#[test]
+fn committed_rough_file_matches_the_two_scale_model() {
+    let buf = suite::read_table(twoscale::TableId::ShBrdf);
+    let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/materials.toml");
+    let materials = generator::materials::Materials::load(std::path::Path::new(path)).unwrap();
+    let gold = materials
+        .materials
+        .iter()
+        .find(|m| m.name == "gold-rough")
+        .unwrap();
+    assert_eq!(Some(table.band_limit()), gold.band_limit);
+    // σs > 0: σrel(θi) makes the model non-reciprocal, and the header says so.
+    assert!(table.asymmetry() > 1e-4, "{:e}", table.asymmetry());
+    let inputs = model_inputs();
+    let parsed = inputs.parse().unwrap();
+    let tables = parsed.tables();
+    let pairs = generator::tables::t4::verification_pairs(4000, 21);
+    for (c, &lambda) in materials.wavelengths.iter().enumerate() {
+        let brdf = generator::tables::t4::two_scale_brdf(gold, c, lambda, &tables);
+        let (rms, p99, max) = f_errors(
+            &pairs,
+            |i, o| brdf.eval(i, o),
+            |i, o| f64::from(table.eval(c, i.map(|v| v as f32), o.map(|v| v as f32))),
+        );
+        eprintln!("gold-rough λ{c}: rel RMS {rms:.3e}, p99 {p99:.3e}, max {max:.3e}");
+        // Measured (README, T4): see the bounds' comment in the README table.
+        assert!(
+            rms < RMS_BOUND && p99 < P99_BOUND && max < MAX_BOUND,
+            "λ{c}"
+        );
+    }
+}
+
+#[test]
+fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
+    let inputs = model_inputs();
+    let parsed = inputs.parse().unwrap();
+    let tables = parsed.tables();
+    let text = ROUGH
+        .replace("base = \"plastic\"", "base = \"conductor\"")
+        .replace("albedo = [0.5, 0.2]\n", "")
+        .replace("k = [0.0, 0.0]", "k = [3.0, 3.0]");
+    let l = 8;
+    let mut asymmetry = Vec::new();
+    for sigma_s in ["0.0", "0.05"] {
+        let text = text.replace("sigma_s = 0.0", &format!("sigma_s = {sigma_s}"));
+        let materials = generator::materials::Materials::parse(&text).unwrap();
+        let brdf =
+            generator::tables::t4::two_scale_brdf(&materials.materials[0], 1, 0.526, &tables);
+        let (diff, norm) = project(&brdf, l, default_quadrature(l), None).asymmetry();
+        eprintln!("σs = {sigma_s}: ‖M − Mᵀ‖/‖M‖ = {:.3e}", diff / norm);
+        asymmetry.push(diff / norm);
+    }
+    // σs = 0: the EPD Cook–Torrance conductor, reciprocal up to the f32
+    // rounding of the model's arithmetic; σs > 0: σrel(θi) breaks reciprocity.
+    assert!(asymmetry[0] < 1e-6, "{:e}", asymmetry[0]);
+    assert!(asymmetry[1] > 1e3 * asymmetry[0].max(1e-9), "{asymmetry:?}");
+}
+
+// Bounds of `committed_rough_file_matches_the_two_scale_model`: the figures
+// measured on the committed gold-rough file (L = 24, 4000 pairs of seed 21;
+// worst channel, blue: rel RMS 3.58e-2, p99 3.43e-2, max 0.130) raised by
+// about 17%: a file projected at L = 16 (5.4e-2 RMS) or from another BRDF fails.
+const RMS_BOUND: f64 = 0.042;
+const P99_BOUND: f64 = 0.040;
+const MAX_BOUND: f64 = 0.15;

@@ -1,43 +1,101 @@
-//! T4 error against band limit L, for the README: relative RMS and p99 of
-//! |f_SH − f| / max f (f = ρ cos θi cos θo) over 20 000 random pairs, for a
-//! rough and a glossy Beckmann Cook–Torrance lobe (F = 1) and each band limit.
+//! T4 error against band limit L, for the README: relative RMS of
+//! `f = ρ cos θi cos θo` and p99 / max of `|f_SH − f| / max f` over 20 000
+//! random pairs (`t4::verification_pairs`), for each band limit, and the
+//! asymmetry `‖M − Mᵀ‖/‖M‖` before symmetrising (WAT92 26-27).
 //!
-//! `cargo run -p generator --release --example t4_study`
+//! `cargo run -p generator --release --example t4_study` projects the
+//! two-scale model (as T4 does: the runtime `TwoScale` with the workspace's
+//! T1, T2, T5 and T3b) of the rough and the glossy presets of `materials.toml`
+//! at the green channel (0.526 µm); `-- beckmann` the Beckmann Cook–Torrance
+//! lobes (F = 1) of the earlier study; `-- polished` a Beckmann lobe as
+//! narrow as the gold-polished preset's (α = β = 0.005) at L = 64 and 127,
+//! with 4× the default θ nodes so that the quadrature resolves the lobe.
 
 use generator::analytic::BeckmannCt;
+use generator::materials::Materials;
 use generator::sh::{IsotropicBrdf, default_quadrature, project};
-use generator::tables::t4::verification_pairs;
+use generator::tables::t4::{ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verification_pairs};
+use std::path::Path;
+use std::time::Instant;
+
+fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize], theta_factor: usize) {
+    let pairs = verification_pairs(20_000, 11);
+    let exact: Vec<f64> = pairs
+        .iter()
+        .map(|&(i, o)| brdf.eval(i, o) * i[2] * o[2])
+        .collect();
+    let peak = exact.iter().fold(0.0f64, |m, v| m.max(*v));
+    let norm: f64 = exact.iter().map(|v| v * v).sum::<f64>();
+    for &l in bands {
+        let start = Instant::now();
+        let mut quadrature = default_quadrature(l);
+        quadrature.theta_nodes *= theta_factor;
+        let projection = project(brdf, l, quadrature, None);
+        let seconds = start.elapsed().as_secs_f64();
+        let (diff, matrix_norm) = projection.asymmetry();
+        let mut errors = Vec::new();
+        let mut sum2 = 0.0;
+        for (k, &(i, o)) in pairs.iter().enumerate() {
+            let approx = projection.eval(i, o);
+            let e = approx * i[2] * o[2] - exact[k];
+            sum2 += e * e;
+            errors.push(e.abs() / peak);
+        }
+        errors.sort_by(f64::total_cmp);
+        println!(
+            "{name}, L = {l:3}: rel RMS of f {:.2e}, p99 |Δf|/max f {:.2e}, max {:.2e}, \
+             asymmetry {:.2e}, projection {seconds:.1} s",
+            (sum2 / norm).sqrt(),
+            errors[errors.len() * 99 / 100],
+            errors[errors.len() - 1],
+            diff / matrix_norm,
+        );
+    }
+}
 
 fn main() {
-    let pairs = verification_pairs(20_000, 11);
-    for (name, alpha, bands) in [
-        ("rough α = 0.35", 0.35, &[4usize, 8, 12, 16, 24, 32][..]),
-        ("glossy α = 0.0598", 0.0598, &[8, 16, 32, 48, 64, 96][..]),
-    ] {
-        let brdf = BeckmannCt { alpha, eta: None };
-        let exact: Vec<f64> = pairs
-            .iter()
-            .map(|&(i, o)| brdf.eval(i, o) * i[2] * o[2])
-            .collect();
-        let peak = exact.iter().fold(0.0f64, |m, v| m.max(*v));
-        let norm: f64 = exact.iter().map(|v| v * v).sum::<f64>();
-        for &l in bands {
-            let projection = project(&brdf, l, default_quadrature(l), None);
-            let mut errors = Vec::new();
-            let mut sum2 = 0.0;
-            for (k, &(i, o)) in pairs.iter().enumerate() {
-                let approx = projection.eval(i, o);
-                let e = approx * i[2] * o[2] - exact[k];
-                sum2 += e * e;
-                errors.push(e.abs() / peak);
-            }
-            errors.sort_by(f64::total_cmp);
-            println!(
-                "{name}, L = {l:3}: rel RMS of f {:.2e}, p99 |Δf|/max f {:.2e}, max {:.2e}",
-                (sum2 / norm).sqrt(),
-                errors[errors.len() * 99 / 100],
-                errors[errors.len() - 1],
-            );
+    if std::env::args().nth(1).as_deref() == Some("beckmann") {
+        for (name, alpha, bands) in [
+            (
+                "Beckmann rough α = 0.35",
+                0.35,
+                &[4usize, 8, 12, 16, 24, 32][..],
+            ),
+            (
+                "Beckmann glossy α = 0.0598",
+                0.0598,
+                &[8, 16, 32, 48, 64, 96][..],
+            ),
+        ] {
+            study(name, &BeckmannCt { alpha, eta: None }, bands, 1);
         }
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("polished") {
+        let brdf = BeckmannCt {
+            alpha: 0.005,
+            eta: None,
+        };
+        study("Beckmann polished α = 0.005", &brdf, &[64, 127], 4);
+        return;
+    }
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
+    let materials = Materials::load(Path::new(path)).expect("materials.toml");
+    let inputs = ModelInputs::load(Path::new(WORKSPACE_TABLES)).expect("T1, T2, T3, T5");
+    let parsed = inputs.parse().expect("valid tables");
+    let tables = parsed.tables();
+    let channel = 1;
+    let lambda = materials.wavelengths[channel];
+    for (name, bands) in [
+        ("gold-rough", &[4usize, 8, 12, 16, 24, 32][..]),
+        ("gold-hp17-geometry", &[8, 16, 32, 48, 64, 96][..]),
+    ] {
+        let material = materials
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .expect("preset in materials.toml");
+        let brdf = two_scale_brdf(material, channel, lambda, &tables);
+        study(&format!("two-scale {name} at {lambda} µm"), &brdf, bands, 1);
     }
 }

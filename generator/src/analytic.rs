@@ -1,13 +1,13 @@
 //! Closed-form isotropic BRDFs for testing the spherical-harmonic projection
-//! ([`crate::sh`]) and, for now, as the **stand-in** for the two-scale model in
-//! the T4 files.
+//! ([`crate::sh`]) and its convergence studies, where an analytic BRDF (and
+//! no table) is wanted.
 //!
 //! The stand-in ([`StandIn`]) is a Beckmann Cook–Torrance microfacet BRDF with
 //! the material's complex Fresnel factor and, for a plastic, the base layer of
 //! SPEC §2.6; it has no diffraction lobe, no EPD shape (`p` is ignored: the NDF
-//! is Beckmann with `α = β`), and no σs, b, c. It must be replaced by the
-//! two-scale f64 reference (`generator::reference::brdf`, SPEC §2.5) once that
-//! exists: see `tables::t4::material_brdf`, the one place to change.
+//! is Beckmann with `α = β`), and no σs, b, c. The committed T4 files project
+//! the two-scale model instead (`tables::t4`); the stand-in is
+//! `tables::t4::Projected::BeckmannStandIn` (header `brdf_model = 2`).
 
 use std::f64::consts::PI;
 

@@ -17,7 +17,8 @@ use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
 use generator::materials::Materials;
-use generator::tables::{self, Accuracy, TableKind, t4::ShBrdf};
+use generator::tables::t4::{Projected, ShBrdf};
+use generator::tables::{self, Accuracy, TableKind};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
@@ -60,6 +61,10 @@ enum Command {
         /// Materials file (T4: one table per material).
         #[arg(long, default_value = DEFAULT_MATERIALS)]
         materials: PathBuf,
+        /// Only these tables (names or prefixes as for `build`, e.g.
+        /// `--table t4`); all if none.
+        #[arg(long = "table")]
+        tables: Vec<String>,
         /// Random points per table.
         #[arg(long, default_value_t = 20_000)]
         points: usize,
@@ -127,10 +132,11 @@ fn main() -> ExitCode {
         Command::Verify {
             dir,
             materials,
+            tables,
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, &materials, points, seed)),
+        } => set_threads(threads).and_then(|()| verify(&dir, &materials, &tables, points, seed)),
         Command::SpotCheck {
             tables,
             dir,
@@ -160,10 +166,16 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
     Ok(())
 }
 
-/// The T4 builders of the materials file.
-fn material_tables(materials: &Path) -> Result<Vec<ShBrdf>, String> {
+/// The T4 builders of the materials file, projecting the two-scale model
+/// with the tables of `dir` (or the workspace's: `t4::input_dir`).
+fn material_tables(materials: &Path, dir: &Path) -> Result<Vec<ShBrdf>, String> {
     let materials = Materials::load(materials).map_err(|e| e.to_string())?;
-    Ok(ShBrdf::all(&materials))
+    Ok(ShBrdf::all(
+        &materials,
+        &Projected::TwoScale {
+            dir: dir.to_path_buf(),
+        },
+    ))
 }
 
 /// Every table: the fixed ones, then T4 per material.
@@ -205,12 +217,20 @@ fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableK
 }
 
 fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, String> {
-    let t4 = material_tables(materials)?;
+    let t4 = material_tables(materials, out)?;
     let kinds = selected(names, &t4)?;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let out = &std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     let total = Instant::now();
+    let mut announced = false;
     for kind in kinds {
+        if kind.id() == TableId::ShBrdf && !announced {
+            announced = true;
+            eprintln!(
+                "T4 projects the two-scale model reading T1, T2, T5, T3 from {}",
+                tables::t4::input_dir(out).display()
+            );
+        }
         let progress = ProgressBar::new(kind.work_items()).with_style(
             ProgressStyle::with_template(
                 "{prefix:>14} [{bar:40}] {pos}/{len} nodes, {elapsed}, eta {eta}",
@@ -282,7 +302,7 @@ fn spot_check(
     materials: &Path,
     nodes: usize,
 ) -> Result<ExitCode, String> {
-    let t4 = material_tables(materials)?;
+    let t4 = material_tables(materials, dir)?;
     let kinds = selected(names, &t4)?;
     let mut failed = false;
     let mut any = false;
@@ -326,10 +346,16 @@ fn spot_check(
     })
 }
 
-fn verify(dir: &Path, materials: &Path, points: usize, seed: u64) -> Result<ExitCode, String> {
-    let t4 = material_tables(materials)?;
+fn verify(
+    dir: &Path,
+    materials: &Path,
+    names: &[String],
+    points: usize,
+    seed: u64,
+) -> Result<ExitCode, String> {
+    let t4 = material_tables(materials, dir)?;
     let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
-    for kind in catalogue(&t4) {
+    for kind in selected(names, &t4)? {
         let id = kind.id();
         let stem = kind.file_stem();
         let path = dir.join(format!("{stem}.tbl"));

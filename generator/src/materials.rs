@@ -14,8 +14,9 @@
 //! c = 2.0                  # K-correlation exponent, (1, 100]
 //! n = [2.0, 1.8, 1.7]      # complex index n + ik per wavelength
 //! k = [3.8, 3.3, 2.8]
-//! base = "conductor"       # or "plastic" (then `albedo` per wavelength, and k = 0)
-//! band_limit = 48          # T4 band limit L, [2, 127]
+//! base = "conductor"       # or "plastic" / "subsurface" (then `albedo` per wavelength, and k = 0)
+//! lambertian = 0.0         # optional Lambertian term k_d ∈ [0, 1] (adds k_d/π); default 0
+//! band_limit = 48          # T4 band limit L, [2, 127]; absent: no T4 file for the material
 //! filter = { start = 40, width = 8 }   # optional half-Gaussian band filter (WAT92 §2.5)
 //! ```
 //!
@@ -48,6 +49,22 @@ pub enum Base {
         /// ρd per wavelength, in [0, 1).
         albedo: Vec<f64>,
     },
+    /// A varnish of index `n` (real) over a scattering medium of
+    /// single-scattering albedo α per wavelength (HP17 44-47).
+    Subsurface {
+        /// α per wavelength, in [0, 1).
+        albedo: Vec<f64>,
+    },
+}
+
+impl Base {
+    /// The albedo (ρd or α) at `channel`, 0 for a conductor.
+    pub fn albedo(&self, channel: usize) -> f64 {
+        match self {
+            Base::Conductor => 0.0,
+            Base::Plastic { albedo } | Base::Subsurface { albedo } => albedo[channel],
+        }
+    }
 }
 
 /// One material.
@@ -71,8 +88,10 @@ pub struct Material {
     pub k: Vec<f64>,
     /// Base layer.
     pub base: Base,
-    /// T4 band limit L.
-    pub band_limit: usize,
+    /// Lambertian term `k_d ∈ [0, 1]` (adds `k_d/π`; 0 if absent from the file).
+    pub lambertian: f64,
+    /// T4 band limit L; `None`: no T4 file (a lobe too narrow for SH).
+    pub band_limit: Option<usize>,
     /// Optional half-Gaussian band filter of T4.
     pub filter: Option<BandFilter>,
 }
@@ -110,7 +129,9 @@ struct RawMaterial {
     k: Vec<f64>,
     base: String,
     albedo: Option<Vec<f64>>,
-    band_limit: usize,
+    #[serde(default)]
+    lambertian: f64,
+    band_limit: Option<usize>,
     filter: Option<RawFilter>,
 }
 
@@ -218,10 +239,10 @@ impl RawMaterial {
             ("conductor", None) => Base::Conductor,
             ("conductor", Some(_)) => {
                 return Err(MaterialsError(format!(
-                    "material '{name}': albedo is only for base = \"plastic\""
+                    "material '{name}': albedo is only for base = \"plastic\" or \"subsurface\""
                 )));
             }
-            ("plastic", Some(albedo)) => {
+            (kind @ ("plastic" | "subsurface"), Some(albedo)) => {
                 if albedo.len() != channels {
                     return Err(MaterialsError(format!(
                         "material '{name}': albedo has {} values, one per wavelength ({channels}) needed",
@@ -233,27 +254,33 @@ impl RawMaterial {
                 }
                 if self.k.iter().any(|&k| k != 0.0) || self.n.iter().any(|&n| n < 1.0) {
                     return Err(MaterialsError(format!(
-                        "material '{name}': a plastic's varnish needs a real index n ≥ 1 (k = 0)"
+                        "material '{name}': a {kind} base's varnish needs a real index n ≥ 1 (k = 0)"
                     )));
                 }
-                Base::Plastic { albedo }
+                if kind == "plastic" {
+                    Base::Plastic { albedo }
+                } else {
+                    Base::Subsurface { albedo }
+                }
             }
-            ("plastic", None) => {
+            (kind @ ("plastic" | "subsurface"), None) => {
                 return Err(MaterialsError(format!(
-                    "material '{name}': base = \"plastic\" needs an albedo per wavelength"
+                    "material '{name}': base = \"{kind}\" needs an albedo per wavelength"
                 )));
             }
             (other, _) => {
                 return Err(MaterialsError(format!(
-                    "material '{name}': unknown base '{other}' (conductor or plastic)"
+                    "material '{name}': unknown base '{other}' (conductor, plastic or subsurface)"
                 )));
             }
         };
+        in_range(&name, "lambertian", self.lambertian, 0.0, 1.0, false)?;
         let max = twoscale::sh::MAX_BAND_LIMIT;
-        if !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&self.band_limit) {
+        if let Some(l) = self.band_limit
+            && !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&l)
+        {
             return Err(MaterialsError(format!(
-                "material '{name}': band_limit = {} is outside [2, {max}]",
-                self.band_limit
+                "material '{name}': band_limit = {l} is outside [2, {max}]"
             )));
         }
         let filter = match self.filter {
@@ -277,6 +304,7 @@ impl RawMaterial {
             n: self.n,
             k: self.k,
             base,
+            lambertian: self.lambertian,
             band_limit: self.band_limit,
             filter,
         })
@@ -322,6 +350,45 @@ band_limit = 16
         assert!(m.materials.len() >= 2);
     }
 
+    /// The repository file holds exactly the runtime presets
+    /// (`twoscale::materials::PRESETS`): same names, and every value equal
+    /// once rounded to the runtime's f32.
+    #[test]
+    fn the_file_holds_the_runtime_presets() {
+        use twoscale::brdf::{BaseLayer, RGB_WAVELENGTHS};
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
+        let file = Materials::load(Path::new(path)).unwrap();
+        let f = |v: f64| v as f32;
+        assert_eq!(
+            file.wavelengths.iter().map(|&w| f(w)).collect::<Vec<_>>(),
+            RGB_WAVELENGTHS
+        );
+        let names: Vec<&str> = file.materials.iter().map(|m| m.name.as_str()).collect();
+        let preset_names: Vec<&str> = twoscale::materials::PRESETS.iter().map(|p| p.0).collect();
+        assert_eq!(names, preset_names);
+        for (m, (name, preset)) in file.materials.iter().zip(twoscale::materials::PRESETS) {
+            let layer = preset.layer;
+            let s = layer.surface;
+            assert_eq!(
+                [f(m.beta), f(m.p), f(m.sigma_s), f(m.b), f(m.c)],
+                [s.beta, s.p, s.sigma_s, s.b, s.c],
+                "{name}: surface"
+            );
+            assert_eq!(f(m.lambertian), layer.lambertian, "{name}: lambertian");
+            for c in 0..3 {
+                let eta = preset.eta_rgb[c];
+                assert_eq!([f(m.n[c]), f(m.k[c])], [eta.re, eta.im], "{name}: η[{c}]");
+                let albedo = f(m.base.albedo(c));
+                let base = match m.base {
+                    Base::Conductor => BaseLayer::Conductor,
+                    Base::Plastic { .. } => BaseLayer::Plastic { albedo },
+                    Base::Subsurface { .. } => BaseLayer::Subsurface { albedo },
+                };
+                assert_eq!(base, layer.base, "{name}: base at channel {c}");
+            }
+        }
+    }
+
     #[test]
     fn rejects_unknown_keys_missing_fields_and_bad_values() {
         let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\ncolour = 1"));
@@ -340,6 +407,19 @@ band_limit = 16
         assert!(e.contains("unknown base"), "{e}");
         let e = error_of(&GOOD.replace("\"conductor\"", "\"plastic\""));
         assert!(e.contains("needs an albedo"), "{e}");
+        let subsurface = GOOD.replace(
+            "base = \"conductor\"",
+            "base = \"subsurface\"\nalbedo = [0.9, 0.9, 0.9]",
+        );
+        let e = error_of(&subsurface);
+        assert!(e.contains("real index"), "{e}");
+        let dielectric = subsurface.replace("k = [3.8, 3.3, 2.8]", "k = [0.0, 0.0, 0.0]");
+        let m = Materials::parse(&dielectric).unwrap();
+        assert_eq!(m.materials[0].base.albedo(2), 0.9);
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\nlambertian = 1.5"));
+        assert!(e.contains("lambertian"), "{e}");
+        let m = Materials::parse(&GOOD.replace("band_limit = 16\n", "")).unwrap();
+        assert_eq!(m.materials[0].band_limit, None);
         let e = error_of(&GOOD.replace("name = \"ni\"", "name = \"Ni 2\""));
         assert!(e.contains("a-z"), "{e}");
         let twice = format!("{GOOD}{}", &GOOD[GOOD.find("[[material]]").unwrap()..]);

@@ -344,9 +344,15 @@ pub enum ProjectedModel {
     /// A Lambertian `ρ = albedo/π` (tests and checks).
     Lambertian,
     /// A Beckmann Cook–Torrance stand-in with conductor Fresnel and no
-    /// diffraction: a placeholder until the two-scale reference is plugged in.
+    /// diffraction (`generator::analytic::StandIn`): analytic, for tests and
+    /// convergence studies.
     BeckmannStandIn,
-    /// The two-scale model of SPEC §2.5.
+    /// The two-scale model of SPEC §2.5–§2.6 as this runtime evaluates it
+    /// ([`crate::brdf::TwoScale`], default options: σrel(θi), separable G,
+    /// physical F and Q̄) with T1, T2, T5 and C from T3b
+    /// ([`crate::ConvTable`]), at the file's wavelengths. Not reciprocal
+    /// when σs > 0; the matrix is symmetrised and the header's `asymmetry`
+    /// says by how much it was not.
     TwoScale,
 }
 

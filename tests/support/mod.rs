@@ -15,10 +15,10 @@ pub fn tables_dir() -> PathBuf {
 }
 
 /// Reads a committed table file into a 64-byte-aligned buffer (for T4, which
-/// has one file per material, the rough aluminium's).
+/// has one file per material, the rough gold's).
 pub fn read_table(id: twoscale::TableId) -> twoscale::format::AlignedBuf {
     let name = match id {
-        twoscale::TableId::ShBrdf => "t4-rough-aluminium.tbl".to_string(),
+        twoscale::TableId::ShBrdf => "t4-gold-rough.tbl".to_string(),
         _ => generator::tables::file_name(id),
     };
     let path = tables_dir().join(name);

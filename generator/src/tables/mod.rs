@@ -191,6 +191,14 @@ pub enum BuildError {
         /// What went wrong.
         message: String,
     },
+    /// An input of the build (a table T4's BRDF reads, a material it cannot
+    /// model) is missing or unusable.
+    Input {
+        /// The file or material.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -201,6 +209,7 @@ impl fmt::Display for BuildError {
             }
             BuildError::Format(e) => write!(f, "{e}"),
             BuildError::Convolution { at, message } => write!(f, "{at}: {message}"),
+            BuildError::Input { path, message } => write!(f, "{path}: {message}"),
         }
     }
 }

@@ -3,51 +3,237 @@
 //! one channel per wavelength. Layout and conventions: `twoscale::sh`;
 //! projection: [`crate::sh`].
 //!
-//! **Stand-in.** The two-scale f64 reference BRDF (SPEC §2.5) is not written
-//! yet; [`material_brdf`] returns the Beckmann Cook–Torrance stand-in of
-//! [`crate::analytic::StandIn`] (no diffraction; `p`, σs, b, c unused), and
-//! the files record it (`brdf_model = 2`). Plugging in the two-scale
-//! reference means changing [`material_brdf`] (and [`MODEL`]) only.
+//! # What is projected
+//!
+//! The committed files project the **runtime two-scale model**
+//! (`twoscale::brdf::TwoScale`, SPEC §2.5–§2.6, default [`Options`]: the
+//! paper's `σrel(θi)`, separable G, physical F and Q̄) at each channel's
+//! wavelength, reading T1 (`t1-smith-g1.tbl`), T2 (`t2-sigma-ratio.tbl`), T5
+//! (`t5-diffuse-fresnel.tbl`) and C from T3b (`t3-convolution.tbl` through
+//! `twoscale::ConvTable`). The header records it as
+//! `brdf_model = 3` ([`ProjectedModel::TwoScale`]). The model's interface is
+//! f32: the projection's f64 directions are rounded to f32 and ρ comes back
+//! in f32 (relative rounding ~6e-8, far below the truncation error in L).
+//! The f64 reference (`crate::reference::brdf`, exact C) costs 1–30 ms per
+//! call; the projection needs ~10⁶ evaluations per channel, hence the runtime.
+//!
+//! **Where the input tables come from** ([`input_dir`]): the directory the
+//! T4 files are written to (`build --out`) or read from (`verify DIR`) when it
+//! holds all four input files, else the workspace's `tables/`. `build` writes
+//! T1, T2, T5, T3 before T4 (the order of [`super::all`], then the materials),
+//! so a full build into an empty directory projects the tables just built.
+//!
+//! The two-scale model with `σs > 0` is not reciprocal (σrel depends on θi
+//! only, SPEC §7): the asymmetry `‖M − Mᵀ‖/‖M‖` (WAT92 26-27) measured before
+//! symmetrising is written into the header (`asymmetry`).
+//!
+//! The Beckmann Cook–Torrance stand-in of [`crate::analytic::StandIn`]
+//! (`brdf_model = 2`; no diffraction, `p`, σs, b, c unused) stays available
+//! ([`Projected::BeckmannStandIn`]) for the tests and studies that need an
+//! analytic BRDF and no T3.
 
 use indicatif::ProgressBar;
 use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping};
+use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
-use twoscale::{ShBrdfTable, TableId};
+use twoscale::{
+    Complex, ConvTable, DiffuseFresnelTable, ShBrdfTable, SigmaRatioTable, SmithG1Table, TableId,
+    TwoScale,
+};
 
-use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind};
+use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind, file_name};
 use crate::analytic::{BeckmannCt, StandIn};
 use crate::materials::{Base, Material, Materials};
 use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
 use crate::sh::{IsotropicBrdf, default_quadrature, project};
 
-/// What the T4 files currently project (see the module docs).
-pub const MODEL: ProjectedModel = ProjectedModel::BeckmannStandIn;
+/// The workspace's table directory, where T4 falls back to for its inputs.
+pub const WORKSPACE_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
+
+/// The tables the two-scale model reads, in the order `build` writes them.
+pub const INPUTS: [TableId; 4] = [
+    TableId::SmithG1,
+    TableId::SigmaRatio,
+    TableId::DiffuseFresnel,
+    TableId::Convolution,
+];
 
 /// Verification target: `max |f_SH − f| / max f` over the random pairs, with
 /// `f = ρ cos θi cos θo` (what the matrix represents; dividing by the cosines
 /// magnifies any error near grazing, [WAT92] §5). The maximum is always at
 /// grazing incidence and exitance near the mirror azimuth, where the specular
-/// peak is narrower in `Δφ` than any band limit can follow (measured with
-/// the stand-in: 0.43 nickel L = 48, 0.12 rough aluminium L = 16, 0.40 rough
-/// plastic L = 16; p99 1.3%, 2.1%, 4.0%). The target, 0.5, only catches a
-/// broken table; the p99 and median are the figures to read (README, T4).
+/// peak is narrower in `Δφ` than any band limit can follow. The target, 0.5,
+/// only catches a broken table; the p99 and median are the figures to read
+/// (README, T4).
 pub const TARGET_MAX_REL_F_ERROR: f64 = 0.5;
 
-/// The BRDF of `material` at `channel` that T4 projects. **The one place to
-/// change** when the two-scale reference (`generator::reference::brdf`)
-/// exists: return it here (it must be isotropic and even in `φo − φi`) and
-/// set [`MODEL`] to [`ProjectedModel::TwoScale`].
-pub fn material_brdf(
+/// Which BRDF a T4 builder projects.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Projected {
+    /// The runtime two-scale model (module docs) reading its tables from
+    /// [`input_dir`]`(dir)`.
+    TwoScale {
+        /// The preferred directory of T1, T2, T3, T5.
+        dir: PathBuf,
+    },
+    /// The Beckmann Cook–Torrance stand-in (analytic, no tables).
+    BeckmannStandIn,
+}
+
+impl Projected {
+    /// The code written into the header.
+    pub fn model(&self) -> ProjectedModel {
+        match self {
+            Projected::TwoScale { .. } => ProjectedModel::TwoScale,
+            Projected::BeckmannStandIn => ProjectedModel::BeckmannStandIn,
+        }
+    }
+}
+
+/// `preferred` if it holds all of [`INPUTS`], else [`WORKSPACE_TABLES`].
+pub fn input_dir(preferred: &Path) -> PathBuf {
+    if INPUTS
+        .iter()
+        .all(|&id| preferred.join(file_name(id)).is_file())
+    {
+        preferred.to_path_buf()
+    } else {
+        PathBuf::from(WORKSPACE_TABLES)
+    }
+}
+
+/// T1, T2, T5 and T3 read from a directory (owned, 64-byte aligned).
+pub struct ModelInputs {
+    /// Where they were read from.
+    pub dir: PathBuf,
+    buffers: [AlignedBuf; 4],
+}
+
+/// [`ModelInputs`] validated: the runtime's views of the four tables.
+pub struct ModelTables<'a> {
+    smith: SmithG1Table<'a>,
+    sigma_ratio: SigmaRatioTable<'a>,
+    diffuse_fresnel: DiffuseFresnelTable<'a>,
+    conv: ConvTable<'a>,
+}
+
+impl ModelInputs {
+    /// Reads [`INPUTS`] from `dir` (no fallback: see [`input_dir`]).
+    pub fn load(dir: &Path) -> Result<ModelInputs, BuildError> {
+        let read = |id: TableId| {
+            let path = dir.join(file_name(id));
+            std::fs::read(&path)
+                .map(|bytes| aligned_copy(&bytes))
+                .map_err(|e| BuildError::Input {
+                    path: path.display().to_string(),
+                    message: format!("{e} (T4 projects the two-scale model, which reads it)"),
+                })
+        };
+        Ok(ModelInputs {
+            dir: dir.to_path_buf(),
+            buffers: [
+                read(INPUTS[0])?,
+                read(INPUTS[1])?,
+                read(INPUTS[2])?,
+                read(INPUTS[3])?,
+            ],
+        })
+    }
+
+    /// Validates the four files.
+    pub fn parse(&self) -> Result<ModelTables<'_>, BuildError> {
+        let [t1, t2, t5, t3] = &self.buffers;
+        Ok(ModelTables {
+            smith: SmithG1Table::from_bytes(t1.bytes())?,
+            sigma_ratio: SigmaRatioTable::from_bytes(t2.bytes())?,
+            diffuse_fresnel: DiffuseFresnelTable::from_bytes(t5.bytes())?,
+            conv: ConvTable::from_bytes(t3.bytes())?,
+        })
+    }
+}
+
+impl ModelTables<'_> {
+    /// The runtime's table set, C from T3b.
+    pub fn tables(&self) -> Tables<'_> {
+        Tables {
+            smith: self.smith,
+            sigma_ratio: self.sigma_ratio,
+            diffuse_fresnel: self.diffuse_fresnel,
+            convolution: &self.conv,
+        }
+    }
+}
+
+/// The runtime two-scale model as an [`IsotropicBrdf`]: `ρ(wi, wo)` =
+/// `TwoScale::eval` at the directions rounded to f32, widened to f64.
+#[derive(Clone, Copy)]
+pub struct TwoScaleBrdf<'a>(pub TwoScale<'a>);
+
+impl IsotropicBrdf for TwoScaleBrdf<'_> {
+    fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        f64::from(self.0.eval(wi.map(|v| v as f32), wo.map(|v| v as f32)))
+    }
+}
+
+/// The runtime layer of `material` at `channel`: the surface, the base with
+/// that channel's albedo, the Lambertian term.
+pub fn runtime_layer(material: &Material, channel: usize) -> Layer {
+    let f = |v: f64| v as f32;
+    let albedo = f(material.base.albedo(channel));
+    Layer {
+        surface: Surface {
+            beta: f(material.beta),
+            p: f(material.p),
+            sigma_s: f(material.sigma_s),
+            b: f(material.b),
+            c: f(material.c),
+        },
+        base: match material.base {
+            Base::Conductor => BaseLayer::Conductor,
+            Base::Plastic { .. } => BaseLayer::Plastic { albedo },
+            Base::Subsurface { .. } => BaseLayer::Subsurface { albedo },
+        },
+        lambertian: f(material.lambertian),
+    }
+}
+
+/// The two-scale model of `material` at `channel` (wavelength `wavelength`
+/// µm), default options, reading `tables`.
+pub fn two_scale_brdf<'a>(
     material: &Material,
     channel: usize,
-    _wavelength: f64,
-) -> Result<Box<dyn IsotropicBrdf>, BuildError> {
+    wavelength: f64,
+    tables: &Tables<'a>,
+) -> TwoScaleBrdf<'a> {
+    let eta = Complex::new(material.n[channel] as f32, material.k[channel] as f32);
+    TwoScaleBrdf(TwoScale::new(
+        tables,
+        runtime_layer(material, channel),
+        wavelength as f32,
+        eta,
+        Options::default(),
+    ))
+}
+
+/// The Beckmann Cook–Torrance stand-in of `material` at `channel`: α = β,
+/// the complex Fresnel factor, the plastic base; an error for a subsurface
+/// base or a Lambertian term, which it does not model.
+pub fn stand_in_brdf(material: &Material, channel: usize) -> Result<StandIn, BuildError> {
     let eta = Complex64::new(material.n[channel], material.k[channel]);
+    let unsupported = |what: &str| BuildError::Input {
+        path: format!("material {}", material.name),
+        message: format!("the Beckmann stand-in has no {what}"),
+    };
+    if material.lambertian != 0.0 {
+        return Err(unsupported("Lambertian term"));
+    }
     let base_factor = match &material.base {
         Base::Conductor => 0.0,
+        Base::Subsurface { .. } => return Err(unsupported("subsurface base")),
         Base::Plastic { albedo } => {
             let n = material.n[channel];
             let f_dr = fresnel::diffuse_internal(n).map_err(|source| BuildError::Quadrature {
@@ -58,32 +244,70 @@ pub fn material_brdf(
             rho_d / (std::f64::consts::PI * n * n * (1.0 - rho_d * f_dr))
         }
     };
-    Ok(Box::new(StandIn {
+    Ok(StandIn {
         lobe: BeckmannCt {
             alpha: material.beta,
             eta: Some(eta),
         },
         base_factor,
-    }))
+    })
+}
+
+/// The BRDF of `material` at `channel` that T4 projects: the two-scale
+/// model when `tables` is given, else the Beckmann stand-in.
+pub fn material_brdf<'a>(
+    material: &Material,
+    channel: usize,
+    wavelength: f64,
+    tables: Option<&Tables<'a>>,
+) -> Result<Box<dyn IsotropicBrdf + 'a>, BuildError> {
+    Ok(match tables {
+        Some(tables) => Box::new(two_scale_brdf(material, channel, wavelength, tables)),
+        None => Box::new(stand_in_brdf(material, channel)?),
+    })
 }
 
 /// The T4 builder of one material.
 pub struct ShBrdf {
     /// The material.
     pub material: Material,
+    /// Its band limit L.
+    pub band_limit: usize,
     /// The wavelengths of the channels, µm.
     pub wavelengths: Vec<f64>,
+    /// What is projected.
+    pub projected: Projected,
+}
+
+/// Runs `f` with the BRDF source of `projected`: the two-scale tables read
+/// from [`input_dir`] (for [`Projected::TwoScale`]) or none (the stand-in).
+fn with_source<T>(
+    projected: &Projected,
+    f: impl FnOnce(Option<&Tables<'_>>) -> Result<T, BuildError>,
+) -> Result<T, BuildError> {
+    match projected {
+        Projected::TwoScale { dir } => {
+            let inputs = ModelInputs::load(&input_dir(dir))?;
+            let parsed = inputs.parse()?;
+            f(Some(&parsed.tables()))
+        }
+        Projected::BeckmannStandIn => f(None),
+    }
 }
 
 impl ShBrdf {
-    /// One builder per material of the file.
-    pub fn all(materials: &Materials) -> Vec<ShBrdf> {
+    /// One builder per material of the file that has a band limit, each
+    /// projecting `projected`.
+    pub fn all(materials: &Materials, projected: &Projected) -> Vec<ShBrdf> {
         materials
             .materials
             .iter()
-            .map(|m| ShBrdf {
+            .filter_map(|m| Some((m, m.band_limit?)))
+            .map(|(m, band_limit)| ShBrdf {
                 material: m.clone(),
+                band_limit,
                 wavelengths: materials.wavelengths.clone(),
+                projected: projected.clone(),
             })
             .collect()
     }
@@ -92,10 +316,12 @@ impl ShBrdf {
         let m = &self.material;
         let base_albedo = match &m.base {
             Base::Conductor => 0.0,
-            Base::Plastic { albedo } => albedo.iter().sum::<f64>() / albedo.len() as f64,
+            Base::Plastic { albedo } | Base::Subsurface { albedo } => {
+                albedo.iter().sum::<f64>() / albedo.len() as f64
+            }
         };
         let mut aux = vec![
-            MODEL.code() as f32,
+            self.projected.model().code() as f32,
             phi_nodes as f32,
             m.beta as f32,
             m.p as f32,
@@ -123,26 +349,29 @@ impl TableKind for ShBrdf {
     }
 
     fn work_items(&self) -> u64 {
-        (default_quadrature(self.material.band_limit).theta_nodes * self.wavelengths.len()) as u64
+        (default_quadrature(self.band_limit).theta_nodes * self.wavelengths.len()) as u64
     }
 
     fn build(&self, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
         let m = &self.material;
-        let l = m.band_limit;
+        let l = self.band_limit;
         let quadrature = default_quadrature(l);
         let channels = self.wavelengths.len();
         let count = coefficient_count(l);
         let mut grid = vec![0.0f32; count * channels];
         let mut asymmetry: f64 = 0.0;
-        for (c, &lambda) in self.wavelengths.iter().enumerate() {
-            let brdf = material_brdf(m, c, lambda)?;
-            let projection = project(brdf.as_ref(), l, quadrature, Some(progress));
-            let (diff, norm) = projection.asymmetry();
-            asymmetry = asymmetry.max(if norm > 0.0 { diff / norm } else { 0.0 });
-            for (k, v) in projection.packed(m.filter).into_iter().enumerate() {
-                grid[k * channels + c] = v as f32;
+        with_source(&self.projected, |tables| {
+            for (c, &lambda) in self.wavelengths.iter().enumerate() {
+                let brdf = material_brdf(m, c, lambda, tables)?;
+                let projection = project(brdf.as_ref(), l, quadrature, Some(progress));
+                let (diff, norm) = projection.asymmetry();
+                asymmetry = asymmetry.max(if norm > 0.0 { diff / norm } else { 0.0 });
+                for (k, v) in projection.packed(m.filter).into_iter().enumerate() {
+                    grid[k * channels + c] = v as f32;
+                }
             }
-        }
+            Ok(())
+        })?;
         let mut params = vec![
             l as f64,
             m.filter.map_or(0.0, |f| f.start),
@@ -175,34 +404,37 @@ impl TableKind for ShBrdf {
         let table = ShBrdfTable::from_bytes(bytes)?;
         let mut out = Vec::new();
         let pairs = verification_pairs(points, seed);
-        for (c, &lambda) in self.wavelengths.iter().enumerate() {
-            let brdf = material_brdf(&self.material, c, lambda)?;
-            let values: Vec<(f64, f64, String)> = pairs
-                .par_iter()
-                .map(|&(wi, wo)| {
-                    let cc = wi[2] * wo[2];
-                    let exact = brdf.eval(wi, wo) * cc;
-                    let got = f64::from(table.eval(c, narrow(wi), narrow(wo))) * cc;
-                    let at = format!(
-                        "θi {:.1}°, θo {:.1}°, Δφ {:.1}°",
-                        wi[2].acos().to_degrees(),
-                        wo[2].acos().to_degrees(),
-                        wo[1].atan2(wo[0]).to_degrees()
-                    );
-                    (exact, got, at)
-                })
-                .collect();
-            let peak = values.iter().fold(0.0f64, |m, v| m.max(v.0.abs()));
-            let errors = values
-                .into_iter()
-                .map(|(exact, got, at)| ((got - exact).abs() / peak, at))
-                .collect();
-            out.push(Accuracy::from_errors(
-                &format!("λ{c} |f_SH-f|/max f, L={}", table.band_limit()),
-                TARGET_MAX_REL_F_ERROR,
-                errors,
-            ));
-        }
+        with_source(&self.projected, |tables| {
+            for (c, &lambda) in self.wavelengths.iter().enumerate() {
+                let brdf = material_brdf(&self.material, c, lambda, tables)?;
+                let values: Vec<(f64, f64, String)> = pairs
+                    .par_iter()
+                    .map(|&(wi, wo)| {
+                        let cc = wi[2] * wo[2];
+                        let exact = brdf.eval(wi, wo) * cc;
+                        let got = f64::from(table.eval(c, narrow(wi), narrow(wo))) * cc;
+                        let at = format!(
+                            "θi {:.1}°, θo {:.1}°, Δφ {:.1}°",
+                            wi[2].acos().to_degrees(),
+                            wo[2].acos().to_degrees(),
+                            wo[1].atan2(wo[0]).to_degrees()
+                        );
+                        (exact, got, at)
+                    })
+                    .collect();
+                let peak = values.iter().fold(0.0f64, |m, v| m.max(v.0.abs()));
+                let errors = values
+                    .into_iter()
+                    .map(|(exact, got, at)| ((got - exact).abs() / peak, at))
+                    .collect();
+                out.push(Accuracy::from_errors(
+                    &format!("λ{c} |f_SH-f|/max f, L={}", table.band_limit()),
+                    TARGET_MAX_REL_F_ERROR,
+                    errors,
+                ));
+            }
+            Ok(())
+        })?;
         Ok(out)
     }
 }
