@@ -7,14 +7,25 @@
 //! ```
 
 fn main() {
-    let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../tables/t3-convolution.tbl"))
-        .expect("tables/t3-convolution.tbl");
+    let bytes = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tables/t3-convolution.tbl"
+    ))
+    .expect("tables/t3-convolution.tbl");
     let buf = twoscale::format::aligned_copy(&bytes);
     let table = twoscale::ConvTable::from_bytes(buf.bytes()).expect("valid T3");
     let fit = table.fit();
-    for &(c, beta, p) in &[(2.0f32, 0.002f32, 1.0f32), (2.0, 0.05, 1.0), (2.0, 0.5, 1.0), (5.0, 0.05, 2.0), (1.1, 0.05, 0.5)] {
+    for &(c, beta, p) in &[
+        (2.0f32, 0.002f32, 1.0f32),
+        (2.0, 0.05, 1.0),
+        (2.0, 0.5, 1.0),
+        (5.0, 0.05, 2.0),
+        (1.1, 0.05, 0.5),
+    ] {
         println!("c = {c}, β = {beta}, p = {p}:   u β   g/u   g");
-        for &u in &[0.1f32, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0] {
+        for &u in &[
+            0.1f32, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0,
+        ] {
             let (_, g) = fit.parameters(u, c, beta, p);
             println!("  u = {u:<7} {:>9.3e} {:>7.3} {:>9.3}", u * beta, g / u, g);
         }
