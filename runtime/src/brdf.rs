@@ -145,6 +145,22 @@ pub enum ColourTerms {
     White,
 }
 
+/// Which `A` weighs the diffraction halo, `(1 − A)/σrel²` in `ρ_CTD`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HaloWeight {
+    /// `A = A_spec(θd)` at every `o`, as printed (HP17 32-33; the default).
+    /// The halo's normalisation by σrel(θi) assumes `1 − A(θi)`, so wherever
+    /// `cos θd > cos θi` it gets more: the model gains energy at oblique
+    /// incidence when the halo is strong (README, white furnace).
+    #[default]
+    Printed,
+    /// `A = A(θi) = exp(−(4π σrel cos θi / λ)²)` for the halo (the specular
+    /// lobe keeps `A_spec(θd)`): a flat facet's halo then carries exactly
+    /// `(1 − A(θi)) Q̄`, its specular peak `A(θi) F`. Not the paper's model;
+    /// offered because it keeps the white furnace ≤ 1 (measured in the README).
+    Incident,
+}
+
 /// Model options; `Options::default()` is the paper's model.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Options {
@@ -154,6 +170,8 @@ pub struct Options {
     pub sigma_rel: SigmaRelMode,
     /// Physical or white colour terms.
     pub colour: ColourTerms,
+    /// Which `A` weighs the halo.
+    pub halo_weight: HaloWeight,
 }
 
 /// The tables the model reads. `convolution` is the source of C: the T3b
@@ -458,9 +476,16 @@ impl<'a> TwoScale<'a> {
             };
             let sigma_s = f64::from(s.sigma_s);
             let b = f64::from(s.b);
+            let x_halo = match self.options.halo_weight {
+                HaloWeight::Printed => x,
+                HaloWeight::Incident => {
+                    let t = 4.0 * PI * cos_i / self.lambda;
+                    t * t
+                }
+            };
             let halo = (f64::from(s.c) - 1.0) * sigma_s * sigma_s * b * b
                 / (2.0 * PI * self.lambda * self.lambda)
-                * one_minus_exp_over(x, sigma_rel_sq);
+                * one_minus_exp_over(x_halo, sigma_rel_sq);
             let u = self.big_b * cos_d;
             let c_value = f64::from(self.conv.convolution_sin_cos(
                 sin_h as f32,

@@ -13,7 +13,7 @@
 
 use std::f64::consts::PI;
 
-use twoscale::brdf::{ColourTerms, Masking, Options, SigmaRelMode};
+use twoscale::brdf::{ColourTerms, HaloWeight, Masking, Options, SigmaRelMode};
 
 use crate::reference::{conv, epd, fresnel, kcorr};
 
@@ -141,10 +141,14 @@ pub fn two_scale(
         } else {
             fresnel::q_bar(eta, wi, wo).map_err(|e| err(&e))?
         };
-        // (1 − A)/σrel², → x as σrel → 0.
-        let t = x * sigma_rel_sq;
+        // (1 − A)/σrel², → x as σrel → 0; A at θd (printed) or θi.
+        let x_halo = match options.halo_weight {
+            HaloWeight::Printed => x,
+            HaloWeight::Incident => (4.0 * PI * cos_i / lambda).powi(2),
+        };
+        let t = x_halo * sigma_rel_sq;
         let one_minus_a_over = if t < 1e-8 {
-            x * (1.0 - 0.5 * t)
+            x_halo * (1.0 - 0.5 * t)
         } else {
             -(-t).exp_m1() / sigma_rel_sq
         };
