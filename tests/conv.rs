@@ -281,11 +281,13 @@ fn shipped_table_meets_the_median_targets() {
     assert!(quantile(&e_l2, 0.5) <= 0.01);
 }
 
-/// The issue's 95th-percentile target (≤ 5%): NOT met by the shipped table
-/// (measured 6–7% by `generator verify`, worst at small p; issue 4 stays
-/// open). Run with `--ignored` to see where it stands.
+/// The issue's 95th-percentile target: pointwise relative error ≤ 5% where
+/// C > 1e-3 C(0), at angles uniform in [0, π/2]. Borderline and
+/// sample-dependent with the shipped table: `generator verify --points 80000`
+/// (160 profiles, seed 2017) measures 2.8%, this test (48 profiles, seed
+/// 4243) 5.3%; so it is not claimed (issue 4 stays open). `--ignored` runs it.
 #[test]
-#[ignore = "known miss of the issue's p95 target; see README (T3)"]
+#[ignore = "borderline: 2.8% at 160 profiles, 5.3% at these 48; see README (T3)"]
 fn shipped_table_meets_the_p95_target() {
     let (errors, _) = pointwise_errors(48, 4243);
     let p95 = quantile(&errors, 0.95);
