@@ -12,9 +12,11 @@
 //! * [`ConvTable`] (**T3b**, the accurate form, the default): at every node of
 //!   the `(u, c, β, p)` grid, `ln C` at 32 evenly spaced values of a
 //!   normalised angle `ξ ∈ [0, 1]` ([`normalised_angle`]). A lookup blends
-//!   the four `ln C` values around `ξ(θh)` multilinearly over the 16 corners
-//!   of the parameter cell, then interpolates them along `ξ` by a monotone
-//!   cubic (Fritsch–Carlson), and exponentiates.
+//!   the four `ln C` values around `ξ(θh)` over the parameter cell
+//!   (Catmull–Rom in each parameter, quadratic in the first and last cell:
+//!   up to 4⁴ corners; [`ConvTable::with_cubic_axes`] switches axes to
+//!   linear), then interpolates them along `ξ` by a Catmull–Rom cubic, and
+//!   exponentiates.
 //! * [`ConvFitTable`] (**T3a**, the paper's form, HP17 39–41):
 //!   `C ≈ s · k(2 g sin θh)` with `ln s` and `ln(g² + g_offset)` blended
 //!   multilinearly.
@@ -389,8 +391,9 @@ impl<'a> ConvTable<'a> {
         ]
     }
 
-    /// `ln C` at `ξ` for already clamped parameters: multilinear blend of the
-    /// four channels around `ξ`, then a monotone cubic along `ξ`.
+    /// `ln C` at `ξ` for already clamped parameters: blend of the four
+    /// channels around `ξ` over the parameter cell, then a Catmull–Rom cubic
+    /// along `ξ` (one-sided slopes in the first and last interval).
     fn ln_c(&self, cells: [(usize, f32); 4], xi: f64) -> f32 {
         let n = self.angles;
         let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
@@ -406,7 +409,7 @@ impl<'a> ConvTable<'a> {
             window[(j - first).min(3)]
         };
         let (v0, v1, v2, v3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
-        // Secant slopes (per node spacing) and Fritsch–Carlson derivatives.
+        // Secant slopes (per node spacing); Catmull–Rom node derivatives.
         let s_left = if k == 0 { v2 - v1 } else { v1 - v0 };
         let s_mid = v2 - v1;
         let s_right = if k as usize + 2 >= n {
@@ -414,14 +417,7 @@ impl<'a> ConvTable<'a> {
         } else {
             v3 - v2
         };
-        let (d1, d2) = if ANGLE_CATMULL_ROM {
-            (0.5 * (s_left + s_mid), 0.5 * (s_mid + s_right))
-        } else {
-            (
-                monotone_derivative(s_left, s_mid),
-                monotone_derivative(s_mid, s_right),
-            )
-        };
+        let (d1, d2) = (0.5 * (s_left + s_mid), 0.5 * (s_mid + s_right));
         // Cubic Hermite on [v1, v2] with derivatives d1, d2 (unit spacing).
         let t2 = t * t;
         let t3 = t2 * t;
@@ -432,8 +428,8 @@ impl<'a> ConvTable<'a> {
         h00 * v1 + h10 * d1 + h01 * v2 + h11 * d2
     }
 
-    /// `C` from T3b at `τ = tan θh` (f64 inputs; the [`Convolution`] impl
-    /// takes `cos θh`).
+    /// `C` from T3b at `τ = tan θh` (the [`Convolution`] impl forms `τ` from
+    /// `sin θh / cos θh`).
     pub fn at_tan(&self, tau: f64, u: f32, c: f32, beta: f32, p: f32) -> f32 {
         let Some(k) = self.clamp(u, c, beta, p) else {
             return 0.0;
@@ -471,9 +467,6 @@ impl<'a> ConvTable<'a> {
 /// default (see the README for the measurement behind the choice).
 pub const DEFAULT_CUBIC_AXES: [bool; 4] = [true, true, true, true];
 
-/// Along `ξ`: Catmull–Rom derivatives (true) or Fritsch–Carlson (false).
-const ANGLE_CATMULL_ROM: bool = true;
-
 /// Catmull–Rom weights of nodes `i−1, i, i+1, i+2` at fraction `t` of cell `i`.
 #[inline]
 fn catmull_rom_weights(t: f32) -> [f32; 4] {
@@ -485,18 +478,6 @@ fn catmull_rom_weights(t: f32) -> [f32; 4] {
         0.5 * (-3.0 * t3 + 4.0 * t2 + t),
         0.5 * (t3 - t2),
     ]
-}
-
-/// The Fritsch–Carlson derivative at a node between secant slopes `a` and
-/// `b`: the harmonic mean when they agree in sign, else 0 (keeps the cubic
-/// monotone between monotone data).
-#[inline]
-fn monotone_derivative(a: f32, b: f32) -> f32 {
-    if a * b > 0.0 {
-        2.0 * a * b / (a + b)
-    } else {
-        0.0
-    }
 }
 
 /// `tan θh = sin θh / cos θh`, with non-positive cosines at the horizon (∞)

@@ -44,7 +44,7 @@ use twoscale::format::{AxisHeader, Kernel, Mapping};
 use twoscale::interp::node_value;
 use twoscale::{Table, TableId};
 
-use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind};
+use super::{Accuracy, BuildError, GENERATOR_VERSION, SpotCheck, TableKind};
 use crate::fit::{WidthFitOptions, fit_k_lobe};
 use crate::reference::conv::{ConvError, Params, ProfileRule, TARGET, convolution_profile};
 use crate::rng::SplitMix64;
@@ -242,8 +242,6 @@ impl TableKind for Conv {
         verify(bytes, profiles_for(points), seed)
     }
 }
-
-use super::SpotCheck;
 
 /// Recomputes `nodes` nodes spread evenly over the grid (first and last
 /// included) and compares their bits with the file's.
