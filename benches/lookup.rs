@@ -257,6 +257,39 @@ fn convolution(c: &mut Criterion) {
             })
         });
     }
+    // One material (c, β, p of the first point) at varying u and θh: the
+    // full lookup against its slice (built once, outside the timing).
+    let [_, _, _, mc, mbeta, mp] = points[0];
+    let slice = table.slice(mc, mbeta, mp).expect("T3 fits a slice");
+    group.bench_function("t3b_table_one_material", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for x in &points {
+                let x = black_box(*x);
+                sum += table.convolution_sin_cos(x[0], x[1], x[2], mc, mbeta, mp);
+            }
+            sum
+        })
+    });
+    group.bench_function("t3b_slice_one_material", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for x in &points {
+                let x = black_box(*x);
+                sum += slice.convolution_sin_cos(x[0], x[1], x[2]);
+            }
+            sum
+        })
+    });
+    group.finish();
+    let mut group = c.benchmark_group("convolution_setup");
+    group.bench_function("t3b_slice_build", |b| {
+        b.iter(|| {
+            table
+                .slice(black_box(mc), mbeta, mp)
+                .map(|s| s.at_tan(0.1, 1.0))
+        })
+    });
     group.finish();
 
     const REFERENCE_BATCH: usize = 8;

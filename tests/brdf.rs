@@ -833,3 +833,42 @@ fn narrow_grazing_specular_sampling() {
         check.success
     );
 }
+
+/// With T3b, `TwoScale` reads C through the per-material slice
+/// (`ConvTable::slice`); the values must be those of the full lookup. A
+/// wrapper that forwards to the table without offering a slice gives the
+/// full-lookup model to compare with.
+#[test]
+fn t3b_material_slice_gives_the_full_lookup_values() {
+    struct NoSlice<'a>(twoscale::conv::ConvTable<'a>);
+    impl twoscale::conv::Convolution for NoSlice<'_> {
+        fn convolution_sin_cos(&self, s: f32, c: f32, u: f32, k: f32, b: f32, p: f32) -> f32 {
+            self.0.convolution_sin_cos(s, c, u, k, b, p)
+        }
+    }
+    let buf = suite::read_table(twoscale::TableId::Convolution);
+    let table = twoscale::conv::ConvTable::from_bytes(buf.bytes()).unwrap();
+    let plain = NoSlice(table);
+    let owned = BrdfTables::load();
+    let (sliced_tables, plain_tables) = (owned.tables(&table), owned.tables(&plain));
+    let mut rng = SplitMix64::new(77);
+    let mut worst = 0.0f64;
+    for &(beta, p, c) in &[(0.0598, 1.0, 2.0), (0.3, 0.4, 1.2), (0.02, 4.0, 6.0)] {
+        let s = surface(beta, p, 0.05, 4.0, c);
+        let a = TwoScale::conductor(&sliced_tables, s, 0.55, NICKEL_LIKE);
+        let b = TwoScale::conductor(&plain_tables, s, 0.55, NICKEL_LIKE);
+        for _ in 0..2000 {
+            let (i, o) = (random_direction(&mut rng), random_direction(&mut rng));
+            let (x, y) = (
+                a.eval_lobes(i, o).diffraction,
+                b.eval_lobes(i, o).diffraction,
+            );
+            assert!(x.is_finite());
+            if y > 1e-30 {
+                worst = worst.max(f64::from(x / y - 1.0).abs());
+            }
+        }
+    }
+    eprintln!("diffraction lobe, slice vs full T3b lookup: max relative difference {worst:.2e}");
+    assert!(worst < 1e-4, "{worst}");
+}

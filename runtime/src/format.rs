@@ -144,7 +144,7 @@ impl TableId {
                 "ndf_exponent_cap",
                 "g_offset",
                 "value_floor",
-                "reference_target",
+                "ndf_softening",
             ],
             TableId::ShBrdf => &crate::sh::PARAM_NAMES,
         }
