@@ -25,6 +25,7 @@ the median or 5% at the 95th percentile of the points where C > 1e-3 C(0);
 prints the same figures for `fit` (T3a, the paper's form; no target).
 """
 import math
+import os
 import random
 import subprocess
 import sys
@@ -105,7 +106,7 @@ def main():
         theta_h = rng.uniform(0, 1.2)
         rows.append((u, c, beta, p, theta_h))
     csv = "u,c,beta,p,theta_h\n" + "".join(",".join(repr(x) for x in r) + "\n" for r in rows)
-    out = subprocess.run([str(ROOT / "target/release/generator"), "query", "conv"],
+    out = subprocess.run([os.environ.get("GENERATOR", str(ROOT / "target/release/generator")), "query", "conv"],
                          input=csv, capture_output=True, text=True, check=True).stdout
     ref_err, table_err, fit_err = [], [], []
     for r, line in zip(rows, out.strip().split("\n")[1:]):

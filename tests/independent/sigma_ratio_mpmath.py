@@ -14,6 +14,7 @@ features near φ = π/2 (widths ~cos θi and ~B cos²θi).
 Exits 1 if `table` misses 1e-4 relative or `reference` misses 1e-9 relative.
 """
 import math
+import os
 import random
 import subprocess
 import sys
@@ -53,7 +54,7 @@ def main():
         rows.append((theta, math.exp(rng.uniform(math.log(0.1), math.log(3000))),
                      1 + math.exp(rng.uniform(math.log(0.01), math.log(99)))))
     csv = "theta_i,B,c\n" + "".join(f"{t!r},{b!r},{c!r}\n" for t, b, c in rows)
-    out = subprocess.run([str(ROOT / "target/release/generator"), "query", "sigma-ratio"],
+    out = subprocess.run([os.environ.get("GENERATOR", str(ROOT / "target/release/generator")), "query", "sigma-ratio"],
                          input=csv, capture_output=True, text=True, check=True).stdout
     worst_table = worst_reference = 0.0
     for (t, b, c), line in zip(rows, out.strip().split("\n")[1:]):

@@ -9,10 +9,9 @@
 //! Each node needs the exact profile at its 32 angles (the reference
 //! `convolution_profile`: zonal harmonics when affordable, otherwise direct
 //! 2-D quadrature per angle; 1 ms to ~1 s per node). 23 040 nodes take
-//! ~25 min on 2 idle cores (~50 min when shared), so CI does not rebuild
-//! T3: it recomputes a spread
-//! of nodes and compares their bits with the committed file
-//! (`generator spot-check`).
+//! 32–37 min on the 2-core machine (~50 min when shared), so CI does not
+//! rebuild T3: it recomputes a spread of nodes and compares their bits with
+//! the committed file (`generator spot-check`).
 //!
 //! # The fit of T3a
 //!
@@ -25,14 +24,14 @@
 //!
 //! # Grid
 //!
-//! u: 16 nodes in ln(u + 0.1) over [0, 3000]; c: 10 in ln(c − 1) over
+//! u: 16 nodes in ln(u + 0.1) over [0, 3000]; c: 10 in ln(c − 1) + c/2 over
 //! [1.01, 10]; β: 12 in ln β over [0.002, 1]; p: 12 in p^−½ over [0.2, 5].
 //! 23 040 nodes × 34 channels × 4 bytes = 2.99 MiB, so that T1–T3 stay within
 //! SPEC's 4 MiB (3.91 MiB). The first layout (20 × 8 × 14 × 9, from the design
 //! study `examples/t3_study.rs`) was measured with its nodes snapped to the
 //! grid one axis at a time: snapping p cut the mean e_L2 from 0.76% to 0.47%,
 //! c to 0.67%, u and β to 0.74–0.75%; so p and c got the nodes, u and β gave
-//! some up.
+//! some up. The c mapping's linear term is documented at [`C_AXIS`].
 
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
@@ -46,7 +45,7 @@ use twoscale::{Table, TableId};
 
 use super::{Accuracy, BuildError, GENERATOR_VERSION, SpotCheck, TableKind};
 use crate::fit::{WidthFitOptions, fit_k_lobe};
-use crate::reference::conv::{ConvError, Params, ProfileRule, TARGET, convolution_profile};
+use crate::reference::conv::{ConvError, Params, ProfileRule, convolution_profile};
 use crate::rng::SplitMix64;
 
 /// u ∈ [0, 3000], evenly spaced in ln(u + 0.1).
@@ -59,14 +58,22 @@ pub const U_AXIS: AxisHeader = AxisHeader {
     param2: 0.0,
 };
 
-/// c ∈ [1.01, 10], evenly spaced in ln(c − 1).
+/// c ∈ [1.01, 10], evenly spaced in ln(c − 1) + c/2: logarithmic near
+/// c = 1, where the narrow-kernel limit `ln C ≈ ln D − ln(c − 1) + …` is linear
+/// in ln(c − 1), and linear for large c, where the kernel's tail
+/// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in c. Measured along c
+/// alone (`examples/t3_spline_study.rs`, `T3_AXIS_STUDY`, 40 random
+/// (u, β, p), 80 random c, 32 angles each; Catmull–Rom): the 95th percentile
+/// of the relative error where 1e-9 < C/C(0) < 1e-3 is 18% with pure
+/// ln(c − 1) spacing, 7.8% with slope ¼, 2.7% with ½ (1.7% on
+/// `brdf_scipy.py`'s distribution), while where C > 1e-3 C(0) it stays ≤ 1.3%.
 pub const C_AXIS: AxisHeader = AxisHeader {
     nodes: 10,
     mapping: Mapping::LogOffset,
     lo: 1.01,
     hi: 10.0,
     param: -1.0,
-    param2: 0.0,
+    param2: 0.5,
 };
 
 /// β ∈ [0.002, 1], evenly spaced in ln β.
@@ -93,12 +100,16 @@ pub const P_AXIS: AxisHeader = AxisHeader {
 pub const ANGLES: usize = 32;
 
 /// The normalised angle's constants (`twoscale::conv`): `τ_max = 1e4`,
-/// `u_floor = 1`, `λ = 1`, `Y = 30` (the study's choice).
+/// `u_floor = 1`, `λ = 1`, `Y = 30` (the design study's choice), `κ = 1`
+/// (`examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`: of κ ∈ {0, ½, 1, 2, 4},
+/// 1 gave the lowest ξ-interpolation error on `brdf_scipy.py`'s parameter
+/// distribution, e_L2 max 5.1% → 1.0%, and verify's max 3.5% → 1.6%).
 pub const ANGLE: AngleParams = AngleParams {
     tau_max: 1e4,
     kernel_scale_floor: 1.0,
     ndf_weight: 1.0,
     ndf_exponent_cap: 30.0,
+    ndf_softening: 1.0,
 };
 
 /// T3a stores `ln(g² + G_OFFSET)`: smooth through `g → 0` (flat profiles).
@@ -205,7 +216,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
             ANGLE.ndf_exponent_cap,
             G_OFFSET,
             VALUE_FLOOR,
-            TARGET,
+            ANGLE.ndf_softening,
         ],
         grid,
         aux: &[],
@@ -437,10 +448,7 @@ pub fn verify(bytes: &[u8], profiles: usize, seed: u64) -> Result<Vec<Accuracy>,
     Ok(vec![
         // The acceptance figures for T3b: pointwise where C > 1e-3 C(0).
         Accuracy::from_errors("T3b rel err (C>1e-3C0) p50", 0.01, pointwise.clone()).gated_at(0.5),
-        // Near the target and sample-dependent (README): reported, not gated.
-        Accuracy::from_errors("T3b rel err (C>1e-3C0) p95", 0.05, pointwise)
-            .gated_at(0.95)
-            .report_only(),
+        Accuracy::from_errors("T3b rel err (C>1e-3C0) p95", 0.05, pointwise).gated_at(0.95),
         // SPEC §3's targets, reported (not met everywhere; see the README).
         Accuracy::from_errors(
             "T3b e_L2 vs exact C",
