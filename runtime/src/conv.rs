@@ -48,7 +48,10 @@
 //! `p'` spends the nodes on the profile's real width instead. (With `κ = 0`,
 //! 32 angles left `e_L2` of ξ interpolation alone at 5.1% for `p = 5`,
 //! `c ≈ 5`; `κ = 1` brings the worst of 60 such profiles to 1.0%:
-//! `examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`.) Everything is known at
+//! `examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`.) For `u_e β ≪ p`, `p'`
+//! tends to 0 and the NDF term keeps growing down to `τ ~ 1e-59`, so the
+//! first few angles of such nodes hold `C(0)` (where `C` is flat): wasted,
+//! not wrong; a floor on `p'` would avoid it at the next rebuild. Everything is known at
 //! lookup time. `τ_max`, `u_floor`, `λ`, `Y` and `κ` are stored in the header
 //! (`params`), so the file is self-describing.
 //!
