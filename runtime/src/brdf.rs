@@ -304,6 +304,8 @@ pub struct TwoScale<'a> {
 
 impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
+    /// Construct once per material and wavelength: with σs > 0 and T3b this
+    /// pre-blends C over the material's (c, β, p) ([`ConvSlice`], ~80 µs).
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
     /// or ≤ 1 → no diffraction (σs = 0); λ NaN or ≤ 0 → 0.526 µm, λ clamped to
