@@ -304,7 +304,7 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * q).round() as usize]
 }
 
-/// The acceptance figure for T3b that is met: the median pointwise
+/// The median acceptance figure for T3b: the median pointwise
 /// relative error where C > 1e-3 C(0), at random parameter points and angles
 /// uniform in [0, π/2] (as `verify` measures it, at other points), ≤ 1%; and
 /// the median e_L2 ≤ 1%.
