@@ -149,10 +149,10 @@ fn each_bad_field_gets_its_own_error() {
     assert!(matches!(
         case(
             "value type",
-            &|b| put_u32(b, offset_of!(Header, value_type), 2),
+            &|b| put_u32(b, offset_of!(Header, value_type), 7),
             true
         ),
-        UnknownValueType(2)
+        UnknownValueType(7)
     ));
     assert!(matches!(
         case(
@@ -291,5 +291,86 @@ fn t1_rejects_impossible_values() {
     assert!(matches!(
         SmithG1Table::from_bytes(buf.bytes()),
         Err(FormatError::Shape(_))
+    ));
+}
+
+/// A per-node quantised (`ValueType::U16`) table decodes every value within
+/// half its node's step (plus f32 rounding of the decode), keeps its codes and
+/// scales where the reader expects them, and is refused (with an error, not a
+/// panic) by readers that need f32 values, and when its payload is cut.
+#[test]
+fn u16_tables_round_trip_within_half_a_step() {
+    use twoscale::format::write::{TableSpec, encode};
+    use twoscale::format::{Kernel, Mapping, ValueType};
+    let axis = |nodes| AxisHeader {
+        nodes,
+        mapping: Mapping::Uniform,
+        lo: 0.0,
+        hi: 1.0,
+        param: 0.0,
+        param2: 0.0,
+    };
+    let axes = [axis(5), axis(7)];
+    let channels = 9;
+    let mut rng = generator::rng::SplitMix64::new(3);
+    // Node ranges from 0 (a constant node) to ~60, values of either sign.
+    let grid: Vec<f32> = (0..35)
+        .flat_map(|node| {
+            let spread = if node == 4 {
+                0.0
+            } else {
+                rng.uniform_in(0.0, 60.0)
+            };
+            let centre = rng.uniform_in(-40.0, 10.0);
+            (0..channels)
+                .map(|_| (centre + spread * rng.uniform_in(-0.5, 0.5)) as f32)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let aux = [1.5f32, -2.0];
+    let bytes = encode(&TableSpec {
+        table_id: TableId::SmithG1,
+        channels,
+        kernel: Kernel::Multilinear,
+        value_type: ValueType::U16,
+        axes: &axes,
+        params: &vec![0.0; TableId::SmithG1.param_names().len()],
+        grid: &grid,
+        aux: &aux,
+        generator_version: "test",
+    })
+    .unwrap();
+    // Scales and aux as f32, codes as u16: 35·2·4 + 2·4 + 35·9·2 bytes.
+    let buf = aligned_copy(&bytes);
+    let table = Table::from_bytes(buf.bytes()).unwrap();
+    assert_eq!(table.header().payload_len, 35 * 8 + 8 + 35 * 9 * 2);
+    assert_eq!(table.aux(), &aux);
+    assert!(table.grid().is_empty());
+    let q = table.quantised().unwrap();
+    assert_eq!(q.nodes(), 35);
+    let mut worst = 0.0f64;
+    for node in 0..35 {
+        let step = f64::from(q.scales[2 * node + 1]);
+        for k in 0..channels as usize {
+            let want = f64::from(grid[node * channels as usize + k]);
+            let got = f64::from(q.value(node, k));
+            // half a step, and a few f32 ulps of values up to ~70
+            let bound = 0.5 * step + 3.0 * 70.0 * f64::from(f32::EPSILON);
+            worst = worst.max((got - want).abs() / bound);
+        }
+        if node == 4 {
+            assert_eq!(step, 0.0, "a constant node has step 0");
+        }
+    }
+    assert!(worst <= 1.0, "worst error / bound = {worst}");
+    assert_eq!(q.value(35, 0), 0.0, "outside the grid");
+    // An f32 reader refuses it with an error.
+    assert!(SmithG1Table::from_bytes(buf.bytes()).is_err());
+    // Cut codes: the payload length no longer matches.
+    let mut cut = bytes.clone();
+    cut.truncate(bytes.len() - 2);
+    assert!(matches!(
+        reject(&cut, "cut codes"),
+        FormatError::Truncated { .. }
     ));
 }

@@ -185,6 +185,7 @@ fn table_from(projection: &Projection) -> twoscale::format::AlignedBuf {
         table_id: twoscale::TableId::ShBrdf,
         channels: 1,
         kernel: Kernel::Multilinear,
+        value_type: twoscale::format::ValueType::F32,
         axes: &[axis],
         params: &[l as f64, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 40.0],
         grid: &grid,

@@ -17,7 +17,7 @@
 //! * `T3_SNAP=ucbp` (any subset): snap those parameters of the points to their
 //!   nearest nodes, isolating the other axes' (and ξ's) error;
 //! * `T3_BRDF_POINTS=1`: draw points as `tests/independent/brdf_scipy.py` does;
-//! * `T3_AXIS_STUDY=n T3_AXIS=c|p`: one axis's mapping alone, candidates
+//! * `T3_AXIS_STUDY=n T3_AXIS=u|c|p`: one axis's mapping alone, candidates
 //!   compared on `n` random points (exact profiles at the candidate nodes);
 //! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone.
 
@@ -286,7 +286,7 @@ fn axis_study(
             let profile = |x: f64| -> Vec<f64> {
                 let mut q = base;
                 q[axis] = x;
-                let (thetas, _) = if axis == 3 {
+                let (thetas, _) = if axis == 3 || axis == 0 {
                     t3::angle_rule(q[0], q[2], q[3])
                 } else {
                     (thetas.clone(), vec![])
@@ -512,6 +512,19 @@ fn main() {
                     with(c, 12, Mapping::LogOffset, -1.0, 0.5),
                 ],
             )
+        } else if which == "u" {
+            let u = t3::U_AXIS;
+            (
+                0,
+                vec![
+                    with(u, 16, Mapping::LogOffset, 0.1, 0.0),
+                    with(u, 16, Mapping::LogOffset, 1.0, 0.0),
+                    with(u, 16, Mapping::LogOffset, 3.0, 0.0),
+                    with(u, 20, Mapping::LogOffset, 1.0, 0.0),
+                    with(u, 28, Mapping::LogOffset, 0.1, 0.0),
+                    with(u, 28, Mapping::LogOffset, 1.0, 0.0),
+                ],
+            )
         } else {
             let p = t3::P_AXIS;
             (
@@ -541,15 +554,11 @@ fn main() {
     let buf = twoscale::format::aligned_copy(&bytes);
     let table = ConvTable::from_bytes(buf.bytes()).expect("valid T3");
     let raw = twoscale::Table::from_bytes(buf.bytes()).unwrap();
-    let grid = raw.grid();
+    let grid = raw.quantised().expect("T3 is stored quantised");
     let channels = FIT_CHANNELS + t3::ANGLES;
-    let nodes = grid.len() / channels;
+    let nodes = grid.nodes();
     let ln_c: Vec<f64> = (0..nodes)
-        .flat_map(|i| {
-            grid[i * channels + FIT_CHANNELS..(i + 1) * channels]
-                .iter()
-                .map(|&x| f64::from(x))
-        })
+        .flat_map(|i| (FIT_CHANNELS..channels).map(move |k| f64::from(grid.value(i, k))))
         .collect();
     let mut dims: Vec<usize> = AXES.iter().map(|a| a.nodes as usize).collect();
     dims.push(t3::ANGLES);

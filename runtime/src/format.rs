@@ -1,15 +1,20 @@
 //! The table file format: defined here, once, and used by the generator to write.
 //!
 //! A table file is a fixed-size [`Header`] followed by a 64-byte-aligned payload
-//! of little-endian `f32` values:
+//! of little-endian values. With [`ValueType::F32`] (every table but T3):
 //!
 //! ```text
 //! offset 0                         Header (HEADER_SIZE bytes, #[repr(C)], read in place)
 //! offset HEADER_SIZE .. 64k        zero padding
-//! offset payload_offset            grid values, row-major (last axis fastest), channels innermost
-//!                                  then `aux_count` auxiliary values (meaning fixed per table id)
+//! offset payload_offset            grid values (f32), row-major (last axis fastest), channels innermost
+//!                                  then `aux_count` auxiliary f32 values (meaning fixed per table id)
 //! end = payload_offset + payload_len   (nothing may follow)
 //! ```
+//!
+//! With [`ValueType::U16`] (per-node quantised, T3), the payload is the nodes'
+//! `(offset, step)` f32 pairs, then the aux f32 values, then the grid's u16
+//! codes (row-major, channels innermost); see [`Quantised`]. Both sections
+//! are viewed in place (`&[f32]`, `&[u16]`).
 //!
 //! Every field is validated by [`Table::from_bytes`]; any malformed input returns a
 //! [`FormatError`] that says what is wrong, and no input can make it panic.
@@ -151,13 +156,91 @@ impl TableId {
     }
 }
 
-/// Type of the stored values. Only `f32` is defined: the `f16` round-trip error
-/// (4.9e-4) exceeds every accuracy target of the project.
+/// Type of the stored grid values. `f16` is not offered: its round-trip error
+/// (4.9e-4 relative) exceeds the accuracy targets, and on T3's `ln C` (values
+/// up to ~40) it would be ~2e-2 absolute, i.e. 2% on `C`.
 #[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
 pub enum ValueType {
     /// IEEE 754 binary32, little-endian.
     F32 = 1,
+    /// Per-node quantised: node `n`'s values are `offset_n + q · step_n` for
+    /// u16 codes `q`, with `step_n = (max − min) / 65535` over the node's
+    /// channels ([`quantise_node`]). The rounding error is at most
+    /// `step_n / 2` (plus f32 rounding of the decode), i.e. 7.6e-6 of the
+    /// node's value range: for T3's `ln C` (range ≤ ~30) ≤ 2.3e-4, a relative
+    /// error of 0.023% on `C`, at half the bytes of f32. See [`Quantised`].
+    U16 = 2,
+}
+
+impl ValueType {
+    /// Every value type, in tag order.
+    pub const ALL: [ValueType; 2] = [ValueType::F32, ValueType::U16];
+
+    /// The value type with this tag, if any.
+    pub fn from_tag(tag: u32) -> Option<ValueType> {
+        Self::ALL.into_iter().find(|v| *v as u32 == tag)
+    }
+}
+
+/// Quantises one node's values for [`ValueType::U16`]: returns
+/// `[offset, step]` and writes the codes, so that
+/// `offset + code · step` is within `step / 2` of each value (before f32
+/// rounding). `offset` is the minimum, `step = (max − min) / 65535`
+/// (0 for a constant node, whose codes are all 0). Deterministic: the same
+/// values always give the same bits. `codes` must be as long as `values`
+/// (extra entries of either are ignored).
+pub fn quantise_node(values: &[f32], codes: &mut [u16]) -> [f32; 2] {
+    let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        codes.iter_mut().for_each(|c| *c = 0);
+        return [0.0, 0.0];
+    }
+    let step = ((f64::from(hi) - f64::from(lo)) / 65535.0) as f32;
+    for (code, &v) in codes.iter_mut().zip(values) {
+        *code = if step > 0.0 {
+            let q = (f64::from(v) - f64::from(lo)) / f64::from(step);
+            // round half up; q ∈ [0, 65535 + rounding]
+            (q + 0.5).floor().clamp(0.0, 65535.0) as u16
+        } else {
+            0
+        };
+    }
+    [lo, step]
+}
+
+/// The grid of a [`ValueType::U16`] table, viewed in place: per node an
+/// `(offset, step)` pair and `channels` u16 codes.
+#[derive(Clone, Copy, Debug)]
+pub struct Quantised<'a> {
+    /// `[offset_0, step_0, offset_1, step_1, …]`, one pair per node.
+    pub scales: &'a [f32],
+    /// The codes, row-major (last axis fastest), channels innermost.
+    pub codes: &'a [u16],
+    /// Values per node.
+    pub channels: usize,
+}
+
+impl Quantised<'_> {
+    /// Number of nodes.
+    pub fn nodes(&self) -> usize {
+        self.scales.len() / 2
+    }
+
+    /// Value `channel` of node `node` (0 outside the grid).
+    #[inline]
+    pub fn value(&self, node: usize, channel: usize) -> f32 {
+        let (Some(&offset), Some(&step)) =
+            (self.scales.get(2 * node), self.scales.get(2 * node + 1))
+        else {
+            return 0.0;
+        };
+        match self.codes.get(node * self.channels + channel) {
+            Some(&q) if channel < self.channels => offset + f32::from(q) * step,
+            _ => 0.0,
+        }
+    }
 }
 
 /// How the payload is interpolated, which also fixes what it holds.
@@ -310,7 +393,8 @@ pub struct Header {
     pub axis_count: u32,
     /// The axes, in storage order (the last varies fastest).
     pub axes: [AxisHeader; MAX_AXES],
-    /// Number of auxiliary `f32` values after the grid (meaning fixed per table id).
+    /// Number of auxiliary `f32` values (after the grid; for [`ValueType::U16`]
+    /// after the node scales, before the codes). Meaning fixed per table id.
     pub aux_count: u32,
     /// How the grid is interpolated (and so how many values each axis stores).
     pub kernel: Kernel,
@@ -320,7 +404,7 @@ pub struct Header {
     pub params: [f64; PARAM_COUNT],
     /// Byte offset of the payload from the start of the file (a multiple of 64).
     pub payload_offset: u64,
-    /// Payload length in bytes (grid and aux values).
+    /// Payload length in bytes (grid, aux and, for [`ValueType::U16`], scales).
     pub payload_len: u64,
     /// FNV-1a 64 of every byte of the file except this field.
     pub checksum: u64,
@@ -563,6 +647,7 @@ pub struct Table<'a> {
     header: &'a Header,
     grid: &'a [f32],
     aux: &'a [f32],
+    quantised: Option<Quantised<'a>>,
 }
 
 impl<'a> Table<'a> {
@@ -623,14 +708,46 @@ impl<'a> Table<'a> {
         let payload = bytes
             .get(offset as usize..end as usize)
             .ok_or(FormatError::BadHeader("payload out of bounds"))?;
-        let values = <[f32]>::ref_from_bytes(payload)
+        // The f32 part: everything (F32), or the scales and aux (U16).
+        let (floats, codes) = match header.value_type {
+            ValueType::F32 => (payload, &[][..]),
+            ValueType::U16 => {
+                let nodes = header.grid_values().unwrap_or(0) as usize;
+                let float_bytes = (2 * nodes + header.aux_count as usize) * 4;
+                payload
+                    .split_at_checked(float_bytes)
+                    .ok_or(FormatError::BadHeader("payload shorter than its scales"))?
+            }
+        };
+        let values = <[f32]>::ref_from_bytes(floats)
             .map_err(|_| FormatError::BadHeader("payload is not a whole number of aligned f32"))?;
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             return Err(FormatError::NonFinite { index });
         }
-        let grid_len = values.len() - header.aux_count as usize;
-        let (grid, aux) = values.split_at(grid_len);
-        Ok(Table { header, grid, aux })
+        let split = values.len() - header.aux_count as usize;
+        let (head_values, aux) = values.split_at(split);
+        let (grid, quantised) = match header.value_type {
+            ValueType::F32 => (head_values, None),
+            ValueType::U16 => {
+                if head_values.chunks_exact(2).any(|pair| !(pair[1] >= 0.0)) {
+                    return Err(FormatError::BadHeader("a quantisation step is negative"));
+                }
+                let codes = <[u16]>::ref_from_bytes(codes)
+                    .map_err(|_| FormatError::BadHeader("codes are not whole aligned u16"))?;
+                let quantised = Quantised {
+                    scales: head_values,
+                    codes,
+                    channels: header.channels as usize,
+                };
+                (&[][..], Some(quantised))
+            }
+        };
+        Ok(Table {
+            header,
+            grid,
+            aux,
+            quantised,
+        })
     }
 
     /// Like [`Table::from_bytes`], and also checks the table id.
@@ -654,9 +771,16 @@ impl<'a> Table<'a> {
         self.header
     }
 
-    /// The grid values, row-major, channels innermost.
+    /// The grid values of a [`ValueType::F32`] table, row-major, channels
+    /// innermost (empty for a [`ValueType::U16`] table: see
+    /// [`Table::quantised`]).
     pub fn grid(&self) -> &'a [f32] {
         self.grid
+    }
+
+    /// The grid of a [`ValueType::U16`] table (`None` for f32 tables).
+    pub fn quantised(&self) -> Option<Quantised<'a>> {
+        self.quantised
     }
 
     /// The auxiliary values (meaning fixed per table id).
@@ -680,7 +804,7 @@ fn diagnose_tags(head: &[u8]) -> FormatError {
         return FormatError::UnknownTableId(table_tag);
     }
     let value_tag = read_u32(head, offset_of!(Header, value_type));
-    if value_tag != ValueType::F32 as u32 {
+    if ValueType::from_tag(value_tag).is_none() {
         return FormatError::UnknownValueType(value_tag);
     }
     let kernel_tag = read_u32(head, offset_of!(Header, kernel));
@@ -744,12 +868,7 @@ pub fn validate_header(header: &Header) -> Result<(), FormatError> {
             "payload offset is not a multiple of 64 past the header",
         ));
     }
-    let expected = header
-        .grid_values()
-        .and_then(|n| n.checked_mul(u64::from(header.channels)))
-        .and_then(|n| n.checked_add(u64::from(header.aux_count)))
-        .and_then(|n| n.checked_mul(4))
-        .ok_or(FormatError::BadHeader("node counts overflow"))?;
+    let expected = payload_bytes(header).ok_or(FormatError::BadHeader("node counts overflow"))?;
     if expected != header.payload_len {
         return Err(FormatError::PayloadLength {
             expected,
@@ -757,6 +876,22 @@ pub fn validate_header(header: &Header) -> Result<(), FormatError> {
         });
     }
     Ok(())
+}
+
+/// Payload bytes implied by the node counts, channels, aux count and value
+/// type (`None` on overflow).
+fn payload_bytes(header: &Header) -> Option<u64> {
+    let nodes = header.grid_values()?;
+    let values = nodes.checked_mul(u64::from(header.channels))?;
+    let aux = u64::from(header.aux_count);
+    match header.value_type {
+        ValueType::F32 => values.checked_add(aux)?.checked_mul(4),
+        ValueType::U16 => nodes
+            .checked_mul(2)?
+            .checked_add(aux)?
+            .checked_mul(4)?
+            .checked_add(values.checked_mul(2)?),
+    }
 }
 
 fn validate_axis(axis: usize, a: &AxisHeader) -> Result<(), FormatError> {
@@ -803,6 +938,9 @@ pub mod write {
         pub channels: u32,
         /// The interpolation kernel (B-spline grids hold prefiltered coefficients).
         pub kernel: Kernel,
+        /// How `grid` is stored: as is ([`ValueType::F32`]) or quantised per
+        /// node by [`quantise_node`] ([`ValueType::U16`]).
+        pub value_type: ValueType,
         /// Used axes, in storage order.
         pub axes: &'v [AxisHeader],
         /// Generation parameters, in the order of [`TableId::param_names`].
@@ -839,13 +977,37 @@ pub mod write {
         let mut generator_version = [0u8; 16];
         generator_version[..version.len()].copy_from_slice(version);
         let payload_offset = HEADER_SIZE.next_multiple_of(PAYLOAD_ALIGN);
-        let payload_len = (spec.grid.len() + spec.aux.len()) * 4;
+        let channels = spec.channels as usize;
+        if channels == 0 || spec.grid.len() % channels != 0 {
+            return Err(FormatError::BadHeader(
+                "grid length is not a multiple of the channel count",
+            ));
+        }
+        // The f32 values and (U16) the codes, in payload order.
+        let (floats, codes): (Vec<f32>, Vec<u16>) = match spec.value_type {
+            ValueType::F32 => (spec.grid.iter().chain(spec.aux).copied().collect(), vec![]),
+            ValueType::U16 => {
+                let nodes = spec.grid.len() / channels;
+                let mut scales = Vec::with_capacity(2 * nodes + spec.aux.len());
+                let mut codes = vec![0u16; spec.grid.len()];
+                for (values, node_codes) in spec
+                    .grid
+                    .chunks_exact(channels)
+                    .zip(codes.chunks_exact_mut(channels))
+                {
+                    scales.extend_from_slice(&quantise_node(values, node_codes));
+                }
+                scales.extend_from_slice(spec.aux);
+                (scales, codes)
+            }
+        };
+        let payload_len = floats.len() * 4 + codes.len() * 2;
         let mut header = Header {
             magic: MAGIC,
             format_version: FORMAT_VERSION,
             header_size: HEADER_SIZE as u32,
             table_id: spec.table_id,
-            value_type: ValueType::F32,
+            value_type: spec.value_type,
             channels: spec.channels,
             axis_count: spec.axes.len() as u32,
             axes,
@@ -861,8 +1023,11 @@ pub mod write {
         let mut file = Vec::with_capacity(payload_offset + payload_len);
         file.extend_from_slice(header.as_bytes());
         file.resize(payload_offset, 0);
-        for v in spec.grid.iter().chain(spec.aux) {
+        for v in &floats {
             file.extend_from_slice(&v.to_le_bytes());
+        }
+        for q in &codes {
+            file.extend_from_slice(&q.to_le_bytes());
         }
         header.checksum = checksum(&file);
         file[..HEADER_SIZE].copy_from_slice(header.as_bytes());

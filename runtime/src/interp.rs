@@ -205,6 +205,11 @@ impl<'a> Grid<'a> {
                 other => other,
             })?;
         }
+        if header.value_type != crate::format::ValueType::F32 {
+            return Err(FormatError::Shape(
+                "this table must be stored as f32 (the file holds quantised values)",
+            ));
+        }
         let channels = header.channels as usize;
         let mut strides = [0; MAX_AXES];
         let mut stride = channels;

@@ -400,6 +400,9 @@ impl<'a> ShBrdfTable<'a> {
         let params = header.params;
         let axes = header.used_axes();
         let channels = header.channels as usize;
+        if header.value_type != crate::format::ValueType::F32 {
+            return Err(FormatError::Shape("T4 must be stored as f32"));
+        }
         if axes.len() != 1 || header.kernel != Kernel::Multilinear || channels > MAX_CHANNELS {
             return Err(FormatError::Shape(
                 "T4 has one axis (coefficient), 1 to 3 channels and no interpolation",

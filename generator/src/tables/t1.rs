@@ -85,6 +85,7 @@ impl TableKind for SmithG1 {
             table_id: TableId::SmithG1,
             channels: 1,
             kernel: Kernel::Multilinear,
+            value_type: twoscale::format::ValueType::F32,
             axes: &[P_AXIS, SCALED_AXIS],
             params: &[epd::LAMBDA_TOL.rel, epd::LAMBDA_TOL.abs],
             grid: &grid,

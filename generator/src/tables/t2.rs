@@ -101,6 +101,7 @@ impl TableKind for SigmaRatio {
             table_id: TableId::SigmaRatio,
             channels: 1,
             kernel: Kernel::CubicBSpline,
+            value_type: twoscale::format::ValueType::F32,
             axes: &[COS_AXIS, B_AXIS, C_AXIS],
             params: &[kcorr::SIGMA_RATIO_TOL.rel, C_MINUS_1_AT_FIRST_NODE],
             grid: &coefficients,

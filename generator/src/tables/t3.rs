@@ -8,8 +8,8 @@
 //!
 //! Each node needs the exact profile at its 32 angles (the reference
 //! `convolution_profile`: zonal harmonics when affordable, otherwise direct
-//! 2-D quadrature per angle; 1 ms to ~1 s per node). 23 040 nodes take
-//! 32–37 min on the 2-core machine (~50 min when shared), so CI does not
+//! 2-D quadrature per angle; 1 ms to ~1 s per node). 40 320 nodes take
+//! 57 min on the 2-core machine (16 u nodes took 33–37 min), so CI does not
 //! rebuild T3: it recomputes a spread of nodes and compares their bits with
 //! the committed file (`generator spot-check`).
 //!
@@ -24,10 +24,19 @@
 //!
 //! # Grid
 //!
-//! u: 16 nodes in ln(u + 0.1) over [0, 3000]; c: 10 in ln(c − 1) + c/2 over
+//! u: 28 nodes in ln(u + 0.1) over [0, 3000]; c: 10 in ln(c − 1) + c/2 over
 //! [1.01, 10]; β: 12 in ln β over [0.002, 1]; p: 12 in p^−½ over [0.2, 5].
-//! 23 040 nodes × 34 channels × 4 bytes = 2.99 MiB, so that T1–T3 stay within
-//! SPEC's 4 MiB (3.91 MiB). The first layout (20 × 8 × 14 × 9, from the design
+//! 40 320 nodes × 34 channels, stored quantised per node (`ValueType::U16`:
+//! 34 u16 codes and an f32 offset and step per node, 76 bytes instead of
+//! 136; error ≤ 2.3e-4 in ln C) = 3.06 MB, so that T1–T3 stay within SPEC's
+//! 4 MiB. The u axis got the nodes that quantisation freed: measured along u
+//! alone (`examples/t3_spline_study.rs`, `T3_AXIS_STUDY=30 T3_AXIS=u`, 30
+//! random (c, β, p), exact profiles), 16 → 28 nodes cut the 95th percentile
+//! of the pointwise error where C > 1e-3 C(0) from 2.4% to 0.31% on
+//! `brdf_scipy.py`'s distribution (1.3% → 0.16% on verify's), and where
+//! 1e-9 < C/C(0) < 1e-3 from 3.2% to 0.46% (5.7% → 1.4%). Moving the offset
+//! to ln(u + 1) or ln(u + 3) made it worse (p95 12% and 40% at 16 nodes):
+//! the profile changes fastest for u ≲ 1. The first layout (20 × 8 × 14 × 9, from the design
 //! study `examples/t3_study.rs`) was measured with its nodes snapped to the
 //! grid one axis at a time: snapping p cut the mean e_L2 from 0.76% to 0.47%,
 //! c to 0.67%, u and β to 0.74–0.75%; so p and c got the nodes, u and β gave
@@ -39,7 +48,7 @@ use twoscale::conv::{
     AngleParams, ConvTable, Convolution, FIT_CHANNELS, kernel, tan_of_normalised_angle,
 };
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping};
+use twoscale::format::{AxisHeader, Kernel, Mapping, quantise_node};
 use twoscale::interp::node_value;
 use twoscale::{Table, TableId};
 
@@ -50,7 +59,7 @@ use crate::rng::SplitMix64;
 
 /// u ∈ [0, 3000], evenly spaced in ln(u + 0.1).
 pub const U_AXIS: AxisHeader = AxisHeader {
-    nodes: 16,
+    nodes: 28,
     mapping: Mapping::LogOffset,
     lo: 0.0,
     hi: 3000.0,
@@ -207,6 +216,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
         table_id: TableId::Convolution,
         channels: CHANNELS as u32,
         kernel: Kernel::Multilinear,
+        value_type: twoscale::format::ValueType::U16,
         axes: &AXES,
         params: &[
             ANGLES as f64,
@@ -258,14 +268,16 @@ impl TableKind for Conv {
 /// included) and compares their bits with the file's.
 pub fn spot_check(bytes: &[u8], nodes: usize) -> Result<SpotCheck, BuildError> {
     let table = Table::from_bytes_expecting(bytes, TableId::Convolution)?;
-    let stored = table.grid();
     let total = node_count();
-    if stored.len() != total * CHANNELS {
+    let Some(stored) = table
+        .quantised()
+        .filter(|q| q.codes.len() == total * CHANNELS)
+    else {
         return Err(BuildError::Convolution {
             at: "T3 spot check".into(),
             message: "the file's grid does not have this generator's layout".into(),
         });
-    }
+    };
     let nodes = nodes.clamp(1, total);
     let indices: Vec<usize> = (0..nodes)
         .map(|k| {
@@ -279,12 +291,13 @@ pub fn spot_check(bytes: &[u8], nodes: usize) -> Result<SpotCheck, BuildError> {
     let mismatches = indices
         .par_iter()
         .map(|&i| {
+            // The stored form: the node's quantisation pair and its codes.
             let fresh = node_values(i)?;
-            let old = &stored[i * CHANNELS..(i + 1) * CHANNELS];
-            let same = fresh
-                .iter()
-                .zip(old)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
+            let mut codes = [0u16; CHANNELS];
+            let scale = quantise_node(&fresh, &mut codes);
+            let bits = |x: &[f32]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let same = stored.scales.get(2 * i..2 * i + 2).map(bits) == Some(bits(&scale))
+                && stored.codes.get(i * CHANNELS..(i + 1) * CHANNELS) == Some(&codes[..]);
             Ok(if same { None } else { Some(i) })
         })
         .collect::<Result<Vec<_>, BuildError>>()?;

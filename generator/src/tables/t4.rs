@@ -392,6 +392,7 @@ impl TableKind for ShBrdf {
             table_id: TableId::ShBrdf,
             channels: channels as u32,
             kernel: Kernel::Multilinear,
+            value_type: twoscale::format::ValueType::F32,
             axes: &[axis],
             params: &params,
             grid: &grid,

@@ -73,6 +73,7 @@ impl TableKind for DiffuseFresnel {
             table_id: TableId::DiffuseFresnel,
             channels: 1,
             kernel: Kernel::CubicBSpline,
+            value_type: twoscale::format::ValueType::F32,
             axes: &[ETA_AXIS],
             params: &[fresnel::DIFFUSE_TOL.rel, fresnel::DIFFUSE_TOL.abs],
             grid: &coefficients,
