@@ -19,7 +19,9 @@
 //! * `T3_BRDF_POINTS=1`: draw points as `tests/independent/brdf_scipy.py` does;
 //! * `T3_AXIS_STUDY=n T3_AXIS=u|c|p`: one axis's mapping alone, candidates
 //!   compared on `n` random points (exact profiles at the candidate nodes);
-//! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone.
+//! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone;
+//! * `T3_ANGLE_VARIABLE_STUDY=n`: a kernel term in `sin θh` with a horizon
+//!   term (candidate for the next rebuild), ξ alone, including θh uniform.
 
 use generator::reference::conv::{Params, ProfileRule, convolution_profile};
 use generator::tables::t3;
@@ -486,7 +488,159 @@ fn angle_study(profiles: usize, kappas: &[f64]) {
     }
 }
 
+/// A candidate normalised angle for the next rebuild: the kernel term in
+/// `sin θh` (the kernel's own variable: the far tail
+/// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in `asinh(2u sin θh)`)
+/// plus `w_h · ½ ln(1 + τ²) = −w_h ln cos θh` for the `cos²θh` fall at the
+/// horizon, and the shipped NDF term (κ = 1). `w_h < 0`: the shipped angle.
+fn angle_g(tau: f64, u: f64, beta: f64, p: f64, horizon: f64) -> f64 {
+    if horizon < 0.0 {
+        return angle_f(tau, u, beta, p, t3::ANGLE.ndf_softening);
+    }
+    let a = t3::ANGLE;
+    let ue = (u * u + a.kernel_scale_floor * a.kernel_scale_floor).sqrt();
+    let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
+    let y = if tau > 0.0 {
+        (2.0 * p_eff * (tau / beta).ln()).exp()
+    } else {
+        0.0
+    };
+    let cap = a.ndf_exponent_cap;
+    let sin = tau / (1.0 + tau * tau).sqrt();
+    (2.0 * ue * sin).asinh()
+        + horizon * 0.5 * (tau * tau).ln_1p()
+        + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
+}
+
+/// ξ-only error (parameters exact, 32 angles) of the candidate angles
+/// ([`angle_g`]) on `brdf_scipy.py`'s parameter distribution, at the
+/// profile rule's nodes and at θh uniform in [0, 1.3] (where the BRDF check
+/// reads C: both directions within 75°).
+fn angle_variable_study(profiles: usize, horizons: &[f64]) {
+    let mut rng = generator::rng::SplitMix64::new(57);
+    let points: Vec<[f64; 4]> = (0..profiles)
+        .map(|_| {
+            let u = rng.log_uniform_in(0.5, 50.0);
+            let c = rng.uniform_in(1.2, 6.0);
+            let beta = rng.log_uniform_in(0.05, 1.0);
+            let p = rng.uniform_in(0.5, 5.0);
+            [u, c, beta, p]
+        })
+        .collect();
+    let uniform: Vec<f64> = (0..64).map(|k| 1.3 * (k as f64 + 0.5) / 64.0).collect();
+    // Per point, per variant: (e_L2 on the rule, [(approx, exact)] on the rule
+    // and on the uniform angles, C(0)).
+    type Row = Vec<(f64, Vec<(f64, f64)>, Vec<(f64, f64)>, f64)>;
+    let rows: Vec<Row> = points
+        .par_iter()
+        .map(|&[u, c, beta, p]| {
+            let params = Params::new(u, c, beta, p).unwrap();
+            let rule = ProfileRule::with_order(ProfileRule::width_for(&params), 8);
+            let exact_rule = convolution_profile(u, c, beta, p, &rule.nodes).unwrap();
+            let exact_uniform = convolution_profile(u, c, beta, p, &uniform).unwrap();
+            let c0 = convolution_profile(u, c, beta, p, &[0.0]).unwrap()[0];
+            horizons
+                .iter()
+                .map(|&h| {
+                    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, h);
+                    let n = t3::ANGLES;
+                    let thetas: Vec<f64> = (0..n)
+                        .map(|k| {
+                            let target = k as f64 / (n - 1) as f64 * top;
+                            let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
+                            for _ in 0..100 {
+                                let mid = 0.5 * (lo + hi);
+                                if angle_g(mid.exp_m1(), u, beta, p, h) < target {
+                                    lo = mid;
+                                } else {
+                                    hi = mid;
+                                }
+                            }
+                            (0.5 * (lo + hi)).exp_m1().atan()
+                        })
+                        .collect();
+                    let v = convolution_profile(u, c, beta, p, &thetas).unwrap();
+                    let peak = v.iter().cloned().fold(0.0f64, f64::max);
+                    let ln_v: Vec<f64> = v
+                        .iter()
+                        .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
+                        .collect();
+                    let at = |theta: f64| {
+                        let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, h) / top;
+                        let (start, w) = weights(
+                            Scheme::CatmullRomSecantEnds,
+                            n,
+                            (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
+                        );
+                        (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
+                    };
+                    let on_rule: Vec<(f64, f64)> = rule
+                        .nodes
+                        .iter()
+                        .map(|&t| at(t))
+                        .zip(exact_rule.iter().copied())
+                        .collect();
+                    let on_uniform: Vec<(f64, f64)> = uniform
+                        .iter()
+                        .map(|&t| at(t))
+                        .zip(exact_uniform.iter().copied())
+                        .collect();
+                    let (mut num, mut den) = (0.0, 0.0);
+                    for ((a, e), w) in on_rule.iter().zip(&rule.weights) {
+                        num += w * (a - e) * (a - e);
+                        den += w * e * e;
+                    }
+                    ((num / den).sqrt(), on_rule, on_uniform, c0)
+                })
+                .collect()
+        })
+        .collect();
+    for (vi, h) in horizons.iter().enumerate() {
+        let (mut el2, mut core, mut tail, mut far) = (vec![], vec![], vec![], vec![]);
+        for row in &rows {
+            let (e, on_rule, on_uniform, c0) = &row[vi];
+            el2.push(*e);
+            for (a, x) in on_rule {
+                let rel = ((a - x) / x).abs();
+                if *x > 1e-3 * c0 {
+                    core.push(rel);
+                } else if *x > 1e-9 * c0 {
+                    tail.push(rel);
+                }
+            }
+            for (a, x) in on_uniform {
+                if *x > 1e-12 * c0 {
+                    far.push(((a - x) / x).abs());
+                }
+            }
+        }
+        let pct = |x: f64| format!("{:.2}%", 100.0 * x);
+        println!(
+            "{}: e_L2 median/p90/max {} {} {} | rule core p95/max {} {} | rule tail p95/max {} {} | θh uniform ≤ 1.3 (C > 1e-12 C0) median/p95/max {} {} {}",
+            if *h < 0.0 {
+                "shipped (tan θh)".to_string()
+            } else {
+                format!("sin θh, w_h {h}")
+            },
+            pct(quantile(&mut el2, 0.5)),
+            pct(quantile(&mut el2, 0.9)),
+            pct(quantile(&mut el2, 1.0)),
+            pct(quantile(&mut core, 0.95)),
+            pct(quantile(&mut core, 1.0)),
+            pct(quantile(&mut tail, 0.95)),
+            pct(quantile(&mut tail, 1.0)),
+            pct(quantile(&mut far, 0.5)),
+            pct(quantile(&mut far, 0.95)),
+            pct(quantile(&mut far, 1.0)),
+        );
+    }
+}
+
 fn main() {
+    if let Ok(n) = std::env::var("T3_ANGLE_VARIABLE_STUDY") {
+        angle_variable_study(n.parse().unwrap_or(60), &[-1.0, 0.25, 0.5, 1.0]);
+        return;
+    }
     if let Ok(n) = std::env::var("T3_ANGLE_STUDY") {
         angle_study(n.parse().unwrap_or(60), &[0.0, 0.5, 1.0, 2.0, 4.0]);
         return;

@@ -202,7 +202,7 @@ pub fn quantise_node(values: &[f32], codes: &mut [u16]) -> [f32; 2] {
         *code = if step > 0.0 {
             let q = (f64::from(v) - f64::from(lo)) / f64::from(step);
             // round half up; q ∈ [0, 65535 + rounding]
-            (q + 0.5).floor().clamp(0.0, 65535.0) as u16
+            crate::math::floor(q + 0.5).clamp(0.0, 65535.0) as u16
         } else {
             0
         };
