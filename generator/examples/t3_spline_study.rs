@@ -492,8 +492,10 @@ fn angle_study(profiles: usize, kappas: &[f64]) {
 /// `sin θh` (the kernel's own variable: the far tail
 /// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in `asinh(2u sin θh)`)
 /// plus `w_h · ½ ln(1 + τ²) = −w_h ln cos θh` for the `cos²θh` fall at the
-/// horizon, and the shipped NDF term (κ = 1). `w_h < 0`: the shipped angle.
-fn angle_g(tau: f64, u: f64, beta: f64, p: f64, horizon: f64) -> f64 {
+/// horizon, `w_e · asinh(2 u_e sin(θh − θe)₊)` for the tail beyond the NDF's
+/// edge θe (where the NDF term saturates), and the shipped NDF term (κ = 1).
+/// `w_h < 0`: the shipped angle.
+fn angle_g(tau: f64, u: f64, beta: f64, p: f64, (horizon, edge): (f64, f64)) -> f64 {
     if horizon < 0.0 {
         return angle_f(tau, u, beta, p, t3::ANGLE.ndf_softening);
     }
@@ -507,8 +509,13 @@ fn angle_g(tau: f64, u: f64, beta: f64, p: f64, horizon: f64) -> f64 {
     };
     let cap = a.ndf_exponent_cap;
     let sin = tau / (1.0 + tau * tau).sqrt();
+    // Beyond the NDF's edge θe (where y = Y), C falls like the kernel's tail
+    // measured from the edge: ln C ≈ −(c+1) ln(2u sin(θh − θe)).
+    let theta_e = (beta * cap.powf(1.0 / (2.0 * p_eff))).atan();
+    let beyond = (tau.atan() - theta_e).max(0.0).sin();
     (2.0 * ue * sin).asinh()
         + horizon * 0.5 * (tau * tau).ln_1p()
+        + edge * (2.0 * ue * beyond).asinh()
         + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
 }
 
@@ -516,7 +523,7 @@ fn angle_g(tau: f64, u: f64, beta: f64, p: f64, horizon: f64) -> f64 {
 /// ([`angle_g`]) on `brdf_scipy.py`'s parameter distribution, at the
 /// profile rule's nodes and at θh uniform in [0, 1.3] (where the BRDF check
 /// reads C: both directions within 75°).
-fn angle_variable_study(profiles: usize, horizons: &[f64]) {
+fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
     let mut rng = generator::rng::SplitMix64::new(57);
     let points: Vec<[f64; 4]> = (0..profiles)
         .map(|_| {
@@ -597,7 +604,8 @@ fn angle_variable_study(profiles: usize, horizons: &[f64]) {
         .collect();
     for (vi, h) in horizons.iter().enumerate() {
         let (mut el2, mut core, mut tail, mut far) = (vec![], vec![], vec![], vec![]);
-        for row in &rows {
+        let mut worst = (0.0f64, [0.0; 4], 0.0, 0.0);
+        for (row, point) in rows.iter().zip(&points) {
             let (e, on_rule, on_uniform, c0) = &row[vi];
             el2.push(*e);
             for (a, x) in on_rule {
@@ -608,19 +616,23 @@ fn angle_variable_study(profiles: usize, horizons: &[f64]) {
                     tail.push(rel);
                 }
             }
-            for (a, x) in on_uniform {
-                if *x > 1e-12 * c0 {
-                    far.push(((a - x) / x).abs());
+            for ((a, x), theta) in on_uniform.iter().zip(&uniform) {
+                if *x > 1e-9 * c0 {
+                    let rel = ((a - x) / x).abs();
+                    far.push(rel);
+                    if rel > worst.0 {
+                        worst = (rel, *point, *theta, x / c0);
+                    }
                 }
             }
         }
         let pct = |x: f64| format!("{:.2}%", 100.0 * x);
         println!(
-            "{}: e_L2 median/p90/max {} {} {} | rule core p95/max {} {} | rule tail p95/max {} {} | θh uniform ≤ 1.3 (C > 1e-12 C0) median/p95/max {} {} {}",
-            if *h < 0.0 {
+            "{}: e_L2 median/p90/max {} {} {} | rule core p95/max {} {} | rule tail p95/max {} {} | θh uniform ≤ 1.3 (C > 1e-9 C0) median/p95/max {} {} {} (worst at u,c,β,p {:?}, θh {:.3}, C/C0 {:.1e})",
+            if h.0 < 0.0 {
                 "shipped (tan θh)".to_string()
             } else {
-                format!("sin θh, w_h {h}")
+                format!("sin θh, w_h {}, w_e {}", h.0, h.1)
             },
             pct(quantile(&mut el2, 0.5)),
             pct(quantile(&mut el2, 0.9)),
@@ -632,13 +644,19 @@ fn angle_variable_study(profiles: usize, horizons: &[f64]) {
             pct(quantile(&mut far, 0.5)),
             pct(quantile(&mut far, 0.95)),
             pct(quantile(&mut far, 1.0)),
+            worst.1,
+            worst.2,
+            worst.3,
         );
     }
 }
 
 fn main() {
     if let Ok(n) = std::env::var("T3_ANGLE_VARIABLE_STUDY") {
-        angle_variable_study(n.parse().unwrap_or(60), &[-1.0, 0.25, 0.5, 1.0]);
+        angle_variable_study(
+            n.parse().unwrap_or(60),
+            &[(-1.0, 0.0), (0.5, 0.0), (0.5, 1.0), (0.5, 2.0), (1.0, 1.0)],
+        );
         return;
     }
     if let Ok(n) = std::env::var("T3_ANGLE_STUDY") {
