@@ -366,6 +366,15 @@ fn u16_tables_round_trip_within_half_a_step() {
     assert_eq!(q.value(35, 0), 0.0, "outside the grid");
     // An f32 reader refuses it with an error.
     assert!(SmithG1Table::from_bytes(buf.bytes()).is_err());
+    // A step that decodes beyond f32 (resealed, so only that is wrong).
+    let mut huge = bytes.clone();
+    let at = table.header().payload_offset as usize + 4; // node 0's step
+    huge[at..at + 4].copy_from_slice(&f32::MAX.to_le_bytes());
+    reseal(&mut huge);
+    assert!(matches!(
+        reject(&huge, "huge step"),
+        FormatError::BadHeader(_)
+    ));
     // Cut codes: the payload length no longer matches.
     let mut cut = bytes.clone();
     cut.truncate(bytes.len() - 2);

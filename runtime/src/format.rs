@@ -169,7 +169,9 @@ pub enum ValueType {
     /// channels ([`quantise_node`]). The rounding error is at most
     /// `step_n / 2` (plus f32 rounding of the decode), i.e. 7.6e-6 of the
     /// node's value range: for T3's `ln C` (range ≤ ~30) ≤ 2.3e-4, a relative
-    /// error of 0.023% on `C`, at half the bytes of f32. See [`Quantised`].
+    /// error of 0.023% on `C`, at half the bytes of f32. The reader checks
+    /// that every step is ≥ 0 and every decodable value finite. See
+    /// [`Quantised`].
     U16 = 2,
 }
 
@@ -729,8 +731,14 @@ impl<'a> Table<'a> {
         let (grid, quantised) = match header.value_type {
             ValueType::F32 => (head_values, None),
             ValueType::U16 => {
-                if head_values.chunks_exact(2).any(|pair| !(pair[1] >= 0.0)) {
-                    return Err(FormatError::BadHeader("a quantisation step is negative"));
+                // Every decoded value must be finite too, like an f32 table's.
+                if head_values
+                    .chunks_exact(2)
+                    .any(|pair| !(pair[1] >= 0.0 && (pair[0] + 65535.0 * pair[1]).is_finite()))
+                {
+                    return Err(FormatError::BadHeader(
+                        "a quantisation step is negative or decodes beyond f32",
+                    ));
                 }
                 let codes = <[u16]>::ref_from_bytes(codes)
                     .map_err(|_| FormatError::BadHeader("codes are not whole aligned u16"))?;
