@@ -143,3 +143,40 @@ fn spectrum_and_closed_form() {
         assert!(rel(got, want) < 1e-4, "{got} vs {want}");
     });
 }
+
+/// A per-material slice gives the full lookup's values (same spline,
+/// blended in another order: f32 rounding only), inside the table's B and c
+/// ranges and, by deferring to the full lookup, outside them.
+#[test]
+fn material_slice_matches_the_full_lookup() {
+    with_t2(|t2| {
+        let mut rng = generator::rng::SplitMix64::new(41);
+        let mut worst = (0.0f64, 0.0f32, 0.0f32, 0.0f32);
+        for k in 0..300 {
+            // Mostly inside [0.05, 3000] × (1, 100], some outside both.
+            let big_b = rng.log_uniform_in(0.01, 8000.0) as f32;
+            let c = (1.0 + rng.log_uniform_in(1e-3, 150.0)) as f32;
+            let slice = t2.slice(big_b, c);
+            for j in 0..40 {
+                let cos = match (k + j) % 20 {
+                    0 => 0.0,
+                    1 => 1.0,
+                    _ => rng.uniform() as f32,
+                };
+                let full = f64::from(t2.sigma_ratio_cos(cos, big_b, c));
+                let sliced = f64::from(slice.sigma_ratio_cos(cos));
+                assert!(sliced.is_finite());
+                let diff = if full > 0.0 {
+                    rel(sliced, full)
+                } else {
+                    sliced.abs()
+                };
+                if diff > worst.0 {
+                    worst = (diff, cos, big_b, c);
+                }
+            }
+        }
+        println!("T2 slice vs full lookup: max relative difference {worst:?}");
+        assert!(worst.0 <= 2e-6, "{worst:?}");
+    });
+}

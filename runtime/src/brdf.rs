@@ -48,7 +48,7 @@
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::Epd;
 use crate::fresnel::{Complex, DiffuseFresnelTable, fresnel, q_bar};
-use crate::kcorr::SigmaRatioTable;
+use crate::kcorr::{SigmaRatioSlice, SigmaRatioTable};
 use crate::math;
 use crate::smith::SmithG1Table;
 use core::f64::consts::PI;
@@ -284,7 +284,9 @@ fn one_minus_exp_over(x: f64, s: f64) -> f64 {
 #[derive(Clone, Copy)]
 pub struct TwoScale<'a> {
     ndf: Epd<'a>,
-    sigma_ratio: SigmaRatioTable<'a>,
+    /// T2 restricted to this material's (B, c): a 4-tap 1-D spline per
+    /// lookup instead of 64 taps, same values.
+    sigma_ratio: SigmaRatioSlice<'a>,
     conv: &'a (dyn Convolution + Sync),
     /// `conv` restricted to this material's (c, β, p), when it offers one
     /// (T3b does: 16 taps per lookup instead of 1024, same values).
@@ -349,7 +351,9 @@ impl<'a> TwoScale<'a> {
         };
         TwoScale {
             ndf,
-            sigma_ratio: tables.sigma_ratio,
+            sigma_ratio: tables
+                .sigma_ratio
+                .slice((f64::from(surface.b) / lambda) as f32, surface.c),
             conv: tables.convolution,
             conv_slice: if surface.sigma_s > 0.0 {
                 tables
@@ -410,12 +414,7 @@ impl<'a> TwoScale<'a> {
     /// `σrel² (µm²)` for the incidence `cos θi` (and `cos θo` when symmetrised).
     fn sigma_rel_sq(&self, cos_i: f64, cos_o: f64) -> f64 {
         let s = &self.surface;
-        let ratio = |cos: f64| {
-            f64::from(
-                self.sigma_ratio
-                    .sigma_ratio_cos(cos as f32, self.big_b as f32, s.c),
-            )
-        };
+        let ratio = |cos: f64| f64::from(self.sigma_ratio.sigma_ratio_cos(cos as f32));
         let ratio_sq = match self.options.sigma_rel {
             SigmaRelMode::Incident => {
                 let r = ratio(cos_i);
