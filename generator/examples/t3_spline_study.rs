@@ -21,7 +21,9 @@
 //!   compared on `n` random points (exact profiles at the candidate nodes);
 //! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone;
 //! * `T3_ANGLE_VARIABLE_STUDY=n`: a kernel term in `sin θh` with a horizon
-//!   term (candidate for the next rebuild), ξ alone, including θh uniform.
+//!   term (candidate for the next rebuild), ξ alone, including θh uniform;
+//! * `T3_XI_AT_POINTS=file.csv` (`u,c,beta,p,theta_h`): exact C and its
+//!   ξ-only interpolation with the shipped and the candidate angle, per point.
 
 use generator::reference::conv::{Params, ProfileRule, convolution_profile};
 use generator::tables::t3;
@@ -651,7 +653,71 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
     }
 }
 
+/// ξ-only C at given points (`u,c,beta,p,theta_h` lines of a CSV file,
+/// e.g. the BRDF check's points): exact C, and C from 32 exact node values
+/// interpolated along ξ with the shipped angle and with the candidate of
+/// [`angle_g`] (w_h = ½, w_e = 1). Prints `exact,shipped,candidate` per point.
+fn xi_only_at_points(path: &str) {
+    let text = std::fs::read_to_string(path).expect("readable CSV");
+    let points: Vec<[f64; 5]> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<f64> = l.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            (v.len() == 5).then(|| [v[0], v[1], v[2], v[3], v[4]])
+        })
+        .collect();
+    let rows: Vec<[f64; 3]> = points
+        .par_iter()
+        .map(|&[u, c, beta, p, theta]| {
+            let exact = convolution_profile(u, c, beta, p, &[theta]).unwrap()[0];
+            let mut out = [exact, 0.0, 0.0];
+            for (slot, form) in [(1, (-1.0, 0.0)), (2, (0.5, 1.0))] {
+                let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
+                let n = t3::ANGLES;
+                let thetas: Vec<f64> = (0..n)
+                    .map(|k| {
+                        let target = k as f64 / (n - 1) as f64 * top;
+                        let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
+                        for _ in 0..100 {
+                            let mid = 0.5 * (lo + hi);
+                            if angle_g(mid.exp_m1(), u, beta, p, form) < target {
+                                lo = mid;
+                            } else {
+                                hi = mid;
+                            }
+                        }
+                        (0.5 * (lo + hi)).exp_m1().atan()
+                    })
+                    .collect();
+                let v = convolution_profile(u, c, beta, p, &thetas).unwrap();
+                let peak = v.iter().cloned().fold(0.0f64, f64::max);
+                let ln_v: Vec<f64> = v
+                    .iter()
+                    .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
+                    .collect();
+                let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
+                let (start, w) = weights(
+                    Scheme::CatmullRomSecantEnds,
+                    n,
+                    (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
+                );
+                out[slot] = (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp();
+            }
+            out
+        })
+        .collect();
+    println!("exact,shipped,candidate");
+    for r in rows {
+        println!("{},{},{}", r[0], r[1], r[2]);
+    }
+}
+
 fn main() {
+    if let Ok(path) = std::env::var("T3_XI_AT_POINTS") {
+        xi_only_at_points(&path);
+        return;
+    }
     if let Ok(n) = std::env::var("T3_ANGLE_VARIABLE_STUDY") {
         angle_variable_study(
             n.parse().unwrap_or(60),
