@@ -29,7 +29,7 @@
 //! `[ln s, ln(g² + g_offset), ln C(ξ_0), …, ln C(ξ_31)]`) because the generator
 //! computes both from the same exact profile at each node. The file is stored
 //! quantised per node ([`ValueType::U16`]: an f32 offset and step and 34 u16
-//! codes per node, error ≤ half a step, ≤ 2.3e-4 in `ln C`), which halves
+//! codes per node, error ≤ half a step, ≤ 3.4e-4 in `ln C`), which halves
 //! its size and paid for 28 `u` nodes instead of 16; a blend reads the
 //! codes in place (`Σ w·offset + Σ (w·step)·code`).
 //!
@@ -282,7 +282,7 @@ impl<'a> ConvTable<'a> {
             ));
         }
         // T3 is stored quantised per node (half the bytes of f32 for twice
-        // the u nodes; `ValueType::U16` states the error, ≤ 0.023% on C).
+        // the u nodes; `ValueType::U16` states the error, ≤ 0.034% on C).
         let values = match (header.value_type, table.quantised()) {
             (ValueType::U16, Some(q)) => q,
             _ => {

@@ -168,8 +168,9 @@ pub enum ValueType {
     /// u16 codes `q`, with `step_n = (max − min) / 65535` over the node's
     /// channels ([`quantise_node`]). The rounding error is at most
     /// `step_n / 2` (plus f32 rounding of the decode), i.e. 7.6e-6 of the
-    /// node's value range: for T3's `ln C` (range ≤ ~30) ≤ 2.3e-4, a relative
-    /// error of 0.023% on `C`, at half the bytes of f32. The reader checks
+    /// node's value range: in the shipped T3 (node ranges up to 44: `ln C`
+    /// and the fit channels) ≤ 3.4e-4 in `ln C`, 0.034% on `C`, at half the
+    /// bytes of f32. The reader checks
     /// that every step is ≥ 0 and every decodable value finite. See
     /// [`Quantised`].
     U16 = 2,
