@@ -521,6 +521,47 @@ fn angle_g(tau: f64, u: f64, beta: f64, p: f64, (horizon, edge): (f64, f64)) -> 
         + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
 }
 
+/// C at the angles `thetas` from the exact values at the 32 nodes of the
+/// angle `form` ([`angle_g`]; the node angles by bisection on `ln(1 + τ)`),
+/// interpolated along ξ as the lookup does: the ξ-only part of T3b's error.
+fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: (f64, f64), thetas: &[f64]) -> Vec<f64> {
+    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
+    let n = t3::ANGLES;
+    let nodes: Vec<f64> = (0..n)
+        .map(|k| {
+            let target = k as f64 / (n - 1) as f64 * top;
+            let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if angle_g(mid.exp_m1(), u, beta, p, form) < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            (0.5 * (lo + hi)).exp_m1().atan()
+        })
+        .collect();
+    let v = convolution_profile(u, c, beta, p, &nodes).unwrap();
+    let peak = v.iter().cloned().fold(0.0f64, f64::max);
+    let ln_v: Vec<f64> = v
+        .iter()
+        .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
+        .collect();
+    thetas
+        .iter()
+        .map(|&theta| {
+            let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
+            let (start, w) = weights(
+                Scheme::CatmullRomSecantEnds,
+                n,
+                (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
+            );
+            (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
+        })
+        .collect()
+}
+
 /// ξ-only error (parameters exact, 32 angles) of the candidate angles
 /// ([`angle_g`]) on `brdf_scipy.py`'s parameter distribution, at the
 /// profile rule's nodes and at θh uniform in [0, 1.3] (where the BRDF check
@@ -551,47 +592,14 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
             horizons
                 .iter()
                 .map(|&h| {
-                    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, h);
-                    let n = t3::ANGLES;
-                    let thetas: Vec<f64> = (0..n)
-                        .map(|k| {
-                            let target = k as f64 / (n - 1) as f64 * top;
-                            let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
-                            for _ in 0..100 {
-                                let mid = 0.5 * (lo + hi);
-                                if angle_g(mid.exp_m1(), u, beta, p, h) < target {
-                                    lo = mid;
-                                } else {
-                                    hi = mid;
-                                }
-                            }
-                            (0.5 * (lo + hi)).exp_m1().atan()
-                        })
-                        .collect();
-                    let v = convolution_profile(u, c, beta, p, &thetas).unwrap();
-                    let peak = v.iter().cloned().fold(0.0f64, f64::max);
-                    let ln_v: Vec<f64> = v
-                        .iter()
-                        .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
-                        .collect();
-                    let at = |theta: f64| {
-                        let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, h) / top;
-                        let (start, w) = weights(
-                            Scheme::CatmullRomSecantEnds,
-                            n,
-                            (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
-                        );
-                        (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
-                    };
-                    let on_rule: Vec<(f64, f64)> = rule
-                        .nodes
-                        .iter()
-                        .map(|&t| at(t))
+                    let at_rule = xi_only(u, c, beta, p, h, &rule.nodes);
+                    let at_uniform = xi_only(u, c, beta, p, h, &uniform);
+                    let on_rule: Vec<(f64, f64)> = at_rule
+                        .into_iter()
                         .zip(exact_rule.iter().copied())
                         .collect();
-                    let on_uniform: Vec<(f64, f64)> = uniform
-                        .iter()
-                        .map(|&t| at(t))
+                    let on_uniform: Vec<(f64, f64)> = at_uniform
+                        .into_iter()
                         .zip(exact_uniform.iter().copied())
                         .collect();
                     let (mut num, mut den) = (0.0, 0.0);
@@ -673,36 +681,7 @@ fn xi_only_at_points(path: &str) {
             let exact = convolution_profile(u, c, beta, p, &[theta]).unwrap()[0];
             let mut out = [exact, 0.0, 0.0];
             for (slot, form) in [(1, (-1.0, 0.0)), (2, (0.5, 1.0))] {
-                let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
-                let n = t3::ANGLES;
-                let thetas: Vec<f64> = (0..n)
-                    .map(|k| {
-                        let target = k as f64 / (n - 1) as f64 * top;
-                        let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
-                        for _ in 0..100 {
-                            let mid = 0.5 * (lo + hi);
-                            if angle_g(mid.exp_m1(), u, beta, p, form) < target {
-                                lo = mid;
-                            } else {
-                                hi = mid;
-                            }
-                        }
-                        (0.5 * (lo + hi)).exp_m1().atan()
-                    })
-                    .collect();
-                let v = convolution_profile(u, c, beta, p, &thetas).unwrap();
-                let peak = v.iter().cloned().fold(0.0f64, f64::max);
-                let ln_v: Vec<f64> = v
-                    .iter()
-                    .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
-                    .collect();
-                let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
-                let (start, w) = weights(
-                    Scheme::CatmullRomSecantEnds,
-                    n,
-                    (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
-                );
-                out[slot] = (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp();
+                out[slot] = xi_only(u, c, beta, p, form, &[theta])[0];
             }
             out
         })

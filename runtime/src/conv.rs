@@ -225,8 +225,6 @@ pub struct ConvTable<'a> {
     g_offset: f32,
     u_max: f32,
     domain: [(f32, f32); 4],
-    /// Node counts of the parameter axes.
-    nodes: [usize; 4],
     /// Per parameter axis: Catmull–Rom (4 nodes) instead of linear (2 nodes).
     cubic: [bool; 4],
 }
@@ -294,14 +292,12 @@ impl<'a> ConvTable<'a> {
         if header.kernel != Kernel::Multilinear {
             return Err(FormatError::Shape("T3 stores node values (kernel 1)"));
         }
-        let placeholder = Axis::new(&used[0])?;
-        let mut axes = [placeholder; 4];
-        for (d, axis) in axes.iter_mut().enumerate() {
-            *axis = Axis::new(&used[d]).map_err(|e| match e {
-                FormatError::BadAxis { reason, .. } => FormatError::BadAxis { axis: d, reason },
-                other => other,
-            })?;
-        }
+        let axes = [
+            Axis::numbered(0, &used[0])?,
+            Axis::numbered(1, &used[1])?,
+            Axis::numbered(2, &used[2])?,
+            Axis::numbered(3, &used[3])?,
+        ];
         let node_total: usize = used.iter().map(|a| a.nodes as usize).product();
         if values.nodes() != node_total || values.codes.len() != node_total * channels {
             return Err(FormatError::Shape("T3 grid length disagrees with the axes"));
@@ -316,10 +312,6 @@ impl<'a> ConvTable<'a> {
                 "T3 domain must have c > 1, beta > 0, p > 0, u >= 0",
             ));
         }
-        let mut nodes = [0; 4];
-        for (d, n) in nodes.iter_mut().enumerate() {
-            *n = used[d].nodes as usize;
-        }
         Ok(ConvTable {
             axes,
             values,
@@ -328,7 +320,6 @@ impl<'a> ConvTable<'a> {
             g_offset: header.params[5] as f32,
             u_max: domain[0].1,
             domain,
-            nodes,
             cubic: DEFAULT_CUBIC_AXES,
         })
     }
@@ -348,7 +339,7 @@ impl<'a> ConvTable<'a> {
     #[inline]
     fn axis_weights(&self, d: usize, cell: (usize, f32)) -> (usize, usize, [f32; 4]) {
         let (i, t) = cell;
-        let n = self.nodes[d];
+        let n = self.axes[d].nodes();
         if self.cubic[d] && i >= 1 && i + 2 < n {
             (i - 1, 4, catmull_rom_weights(t))
         } else if self.cubic[d] && n >= 3 && i == 0 {
@@ -380,7 +371,7 @@ impl<'a> ConvTable<'a> {
     /// the shipped table: `cargo bench --bench lookup -- convolution_setup`).
     pub fn slice(&self, c: f32, beta: f32, p: f32) -> Option<ConvSlice<'a>> {
         let k = self.clamp(0.0, c, beta, p)?;
-        let (u_nodes, angles) = (self.nodes[0], self.angles);
+        let (u_nodes, angles) = (self.axes[0].nodes(), self.angles);
         if u_nodes * angles > SLICE_CAPACITY {
             return None;
         }
@@ -426,7 +417,7 @@ impl<'a> ConvTable<'a> {
             (start[d], count[d], weights[d]) = self.axis_weights(d, cells[d]);
         }
         let Quantised { scales, codes, .. } = self.values;
-        let [_, n1, n2, n3] = self.nodes;
+        let [n1, n2, n3] = [1, 2, 3].map(|d| self.axes[d].nodes());
         let mut sum = [0.0f32; N];
         // Σ w (offset + q step) = Σ w offset + Σ (w step) q.
         let mut offsets = 0.0f32;

@@ -66,6 +66,15 @@ impl Axis {
         })
     }
 
+    /// [`Axis::new`] for axis `d` of a table: a [`FormatError::BadAxis`]
+    /// names that axis.
+    pub fn numbered(d: usize, header: &AxisHeader) -> Result<Axis, FormatError> {
+        Axis::new(header).map_err(|e| match e {
+            FormatError::BadAxis { reason, .. } => FormatError::BadAxis { axis: d, reason },
+            other => other,
+        })
+    }
+
     /// First node (physical units).
     pub fn lo(&self) -> f32 {
         self.lo
@@ -200,10 +209,7 @@ impl<'a> Grid<'a> {
         };
         let mut axes = [placeholder; MAX_AXES];
         for (d, a) in used.iter().enumerate() {
-            axes[d] = Axis::new(a).map_err(|e| match e {
-                FormatError::BadAxis { reason, .. } => FormatError::BadAxis { axis: d, reason },
-                other => other,
-            })?;
+            axes[d] = Axis::numbered(d, a)?;
         }
         if header.value_type != crate::format::ValueType::F32 {
             return Err(FormatError::Shape(
