@@ -71,6 +71,10 @@ fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f
             t3::G_OFFSET,
             t3::VALUE_FLOOR,
             1e-6,
+            a.horizon_weight,
+            a.edge_weight,
+            a.edge_smoothing,
+            a.edge_fade_tan,
         ],
         grid: &grid,
         aux: &[],
@@ -223,16 +227,64 @@ fn beyond_u_max_follows_the_narrow_kernel_limit() {
     assert!(s2 < 0.3 * s1);
 }
 
+/// `(u, β, p)` at the corners of the domain and inside it, for the
+/// normalised angle's tests.
+const ANGLE_CASES: [(f64, f64, f64); 6] = [
+    (0.0, 0.002, 0.2),
+    (3000.0, 0.002, 5.0),
+    (30.0, 0.3, 1.0),
+    (3000.0, 1.0, 0.2),
+    (0.5, 1.0, 5.0),
+    (15.0, 0.05, 3.0),
+];
+
+/// The runtime's `F(τ)` against its formula written directly with angles:
+/// kernel term `asinh(2 u_e sin θh)`, horizon term `½ ln(1 + τ²)`, edge term
+/// `asinh(2 u_e sin x̃)` with `x̃` the smoothed positive part of `θh − θe`,
+/// `θe = atan(β Y^(1/(2p')))`, faded by `1 / (1 + (tan θe / τ_f)²)`, NDF
+/// term `ln(1 + Y(1 − e^(−y/Y)))`. (The runtime forms `θh − θe` by one
+/// `atan` of `(τ − τe) / (1 + τ τe)`.)
+#[test]
+fn normalised_angle_matches_its_formula() {
+    let a = t3::ANGLE;
+    let direct = |tau: f64, u: f64, beta: f64, p: f64| -> f64 {
+        let ue = (u * u + a.kernel_scale_floor.powi(2)).sqrt();
+        let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
+        let theta = tau.atan();
+        let y = (tau / beta).powf(2.0 * p_eff);
+        let cap = a.ndf_exponent_cap;
+        let theta_e = (beta * cap.powf(1.0 / (2.0 * p_eff))).atan();
+        let fade = 1.0 / (1.0 + (theta_e.tan() / a.edge_fade_tan).powi(2));
+        let x = theta - theta_e;
+        let delta = a.edge_smoothing / (2.0 * ue);
+        let smoothed =
+            (0.5 * (x + (x * x + delta * delta).sqrt())).min(std::f64::consts::FRAC_PI_2);
+        (2.0 * ue * theta.sin()).asinh()
+            + a.horizon_weight * 0.5 * (tau * tau).ln_1p()
+            + a.edge_weight * fade * (2.0 * ue * smoothed.sin()).asinh()
+            + a.ndf_weight * (cap * -(-y / cap).exp_m1()).ln_1p()
+    };
+    let mut worst = 0.0f64;
+    for &(u, beta, p) in &ANGLE_CASES {
+        let top = direct(a.tau_max, u, beta, p);
+        for k in 0..=400 {
+            let theta = 1.5706 * k as f64 / 400.0;
+            let tau = theta.tan();
+            let want = direct(tau, u, beta, p) / top;
+            let got = normalised_angle(tau, u, beta, p, &a);
+            worst = worst.max((got - want).abs());
+        }
+    }
+    assert!(
+        worst < 1e-12,
+        "normalised angle off its formula by {worst:e}"
+    );
+}
+
 #[test]
 fn normalised_angle_inverts_and_is_monotone() {
     let a = t3::ANGLE;
-    for &(u, beta, p) in &[
-        (0.0, 0.002, 0.2),
-        (3000.0, 0.002, 5.0),
-        (30.0, 0.3, 1.0),
-        (3000.0, 1.0, 0.2),
-        (0.5, 1.0, 5.0),
-    ] {
+    for &(u, beta, p) in &ANGLE_CASES {
         let mut last = -1.0;
         for k in 0..=200 {
             let xi = k as f64 / 200.0;

@@ -4,7 +4,7 @@
 
 use std::mem::offset_of;
 use twoscale::format::{
-    AxisHeader, FormatError, HEADER_SIZE, Header, TableId, aligned_copy, checksum,
+    AxisHeader, FORMAT_VERSION, FormatError, HEADER_SIZE, Header, TableId, aligned_copy, checksum,
 };
 use twoscale::{SmithG1Table, Table};
 
@@ -125,10 +125,19 @@ fn each_bad_field_gets_its_own_error() {
     assert!(matches!(
         case(
             "version",
-            &|b| put_u32(b, offset_of!(Header, format_version), 2),
+            &|b| put_u32(b, offset_of!(Header, format_version), FORMAT_VERSION + 1),
             false
         ),
-        UnsupportedVersion { found: 2 }
+        UnsupportedVersion { found } if found == FORMAT_VERSION + 1
+    ));
+    // A file of the previous version (eight generation parameters) is refused.
+    assert!(matches!(
+        case(
+            "old version",
+            &|b| put_u32(b, offset_of!(Header, format_version), FORMAT_VERSION - 1),
+            false
+        ),
+        UnsupportedVersion { found } if found == FORMAT_VERSION - 1
     ));
     assert!(matches!(
         case(

@@ -20,10 +20,15 @@
 //! * `T3_AXIS_STUDY=n T3_AXIS=u|c|p`: one axis's mapping alone, candidates
 //!   compared on `n` random points (exact profiles at the candidate nodes);
 //! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone;
-//! * `T3_ANGLE_VARIABLE_STUDY=n`: a kernel term in `sin θh` with a horizon
-//!   term (candidate for the next rebuild), ξ alone, including θh uniform;
+//! * `T3_ANGLE_VARIABLE_STUDY=n`: forms of the angle ([`angle_g`]: kernel
+//!   term in `sin θh`, horizon and edge terms), ξ alone, including θh
+//!   uniform; `T3_FULL_DOMAIN=1` draws verify's profiles instead of the BRDF
+//!   check's;
 //! * `T3_XI_AT_POINTS=file.csv` (`u,c,beta,p,theta_h`): exact C and its
-//!   ξ-only interpolation with the shipped and the candidate angle, per point.
+//!   ξ-only interpolation with the previous (format 1) and the shipped
+//!   (format 2) angle, per point;
+//! * `T3_FORMS="w_h,w_e,smoothing,τ_f;…"`: the forms those two compare
+//!   (`w_h < 0`: format 1's angle).
 
 use generator::reference::conv::{Params, ProfileRule, convolution_profile};
 use generator::tables::t3;
@@ -268,15 +273,7 @@ fn axis_study(
 ) {
     let mut rng = generator::rng::SplitMix64::new(7 + axis as u64 + 100 * brdf as u64);
     let points: Vec<[f64; 4]> = if brdf {
-        (0..triples * 3)
-            .map(|_| {
-                let u = rng.log_uniform_in(0.5, 50.0);
-                let c = rng.uniform_in(1.2, 6.0);
-                let beta = rng.log_uniform_in(0.05, 1.0);
-                let p = rng.uniform_in(0.5, 5.0);
-                [u, c, beta, p]
-            })
-            .collect()
+        brdf_check_profiles(&mut rng, triples * 3)
     } else {
         t3::verification_points(triples * 3, 7 + axis as u64)
     };
@@ -364,7 +361,7 @@ fn axis_study(
 
 /// The normalised angle with the NDF exponent softened where the kernel is
 /// wider than the NDF: `2p → 2p / (1 + κ p r)`, `r = 1/(2 u_e β)`
-/// (κ = 0: the shipped angle).
+/// (κ = 0: the first tables' angle; κ = 1: format 1's).
 fn angle_f(tau: f64, u: f64, beta: f64, p: f64, kappa: f64) -> f64 {
     let a = t3::ANGLE;
     let ue = (u * u + a.kernel_scale_floor * a.kernel_scale_floor).sqrt();
@@ -393,21 +390,27 @@ fn tau_of_xi(xi: f64, u: f64, beta: f64, p: f64, kappa: f64) -> f64 {
     (0.5 * (lo + hi)).exp_m1()
 }
 
+/// `(u, c, β, p)` of `profiles` profiles drawn from `brdf_scipy.py`'s
+/// parameter distribution (u log-uniform in [0.5, 50]).
+fn brdf_check_profiles(rng: &mut generator::rng::SplitMix64, profiles: usize) -> Vec<[f64; 4]> {
+    (0..profiles)
+        .map(|_| {
+            let u = rng.log_uniform_in(0.5, 50.0);
+            let c = rng.uniform_in(1.2, 6.0);
+            let beta = rng.log_uniform_in(0.05, 1.0);
+            let p = rng.uniform_in(0.5, 5.0);
+            [u, c, beta, p]
+        })
+        .collect()
+}
+
 /// ξ-only error (parameters exact) of 32 angles under the angle function
 /// with each κ, on the same distributions as `axis_study`.
 fn angle_study(profiles: usize, kappas: &[f64]) {
     for brdf in [false, true] {
         let mut rng = generator::rng::SplitMix64::new(31 + brdf as u64);
         let points: Vec<[f64; 4]> = if brdf {
-            (0..profiles)
-                .map(|_| {
-                    let u = rng.log_uniform_in(0.5, 50.0);
-                    let c = rng.uniform_in(1.2, 6.0);
-                    let beta = rng.log_uniform_in(0.05, 1.0);
-                    let p = rng.uniform_in(0.5, 5.0);
-                    [u, c, beta, p]
-                })
-                .collect()
+            brdf_check_profiles(&mut rng, profiles)
         } else {
             t3::verification_points(profiles, 31)
         };
@@ -490,14 +493,42 @@ fn angle_study(profiles: usize, kappas: &[f64]) {
     }
 }
 
+/// The forms of `T3_FORMS="w_h,w_e,smooth,τ_cut;…"` ([`Form`]), or `default`.
+fn forms_from_env_or(default: &[Form]) -> Vec<Form> {
+    std::env::var("T3_FORMS")
+        .map(|v| {
+            v.split(';')
+                .filter_map(|f| {
+                    let mut x = [0.0; 4];
+                    for (slot, v) in x.iter_mut().zip(f.split(',')) {
+                        *slot = v.trim().parse().ok()?;
+                    }
+                    Some(x)
+                })
+                .collect()
+        })
+        .unwrap_or_else(|_| default.to_vec())
+}
+
+/// The angle variable study's forms: `T3_FORMS`, or the first study's five.
+fn forms_from_env() -> Vec<Form> {
+    forms_from_env_or(
+        &[(-1.0, 0.0), (0.5, 0.0), (0.5, 1.0), (0.5, 2.0), (1.0, 1.0)]
+            .map(|(h, e)| [h, e, 0.0, 0.0]),
+    )
+}
+
+/// An angle form for [`angle_g`]: `[w_h, w_e, smooth, τ_cut]`.
+type Form = [f64; 4];
+
 /// A candidate normalised angle for the next rebuild: the kernel term in
 /// `sin θh` (the kernel's own variable: the far tail
 /// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in `asinh(2u sin θh)`)
 /// plus `w_h · ½ ln(1 + τ²) = −w_h ln cos θh` for the `cos²θh` fall at the
 /// horizon, `w_e · asinh(2 u_e sin(θh − θe)₊)` for the tail beyond the NDF's
 /// edge θe (where the NDF term saturates), and the shipped NDF term (κ = 1).
-/// `w_h < 0`: the shipped angle.
-fn angle_g(tau: f64, u: f64, beta: f64, p: f64, (horizon, edge): (f64, f64)) -> f64 {
+/// `w_h < 0`: the previous angle (format 1; `angle_f` with κ = 1).
+fn angle_g(tau: f64, u: f64, beta: f64, p: f64, [horizon, edge, smooth, tau_cut]: Form) -> f64 {
     if horizon < 0.0 {
         return angle_f(tau, u, beta, p, t3::ANGLE.ndf_softening);
     }
@@ -514,17 +545,35 @@ fn angle_g(tau: f64, u: f64, beta: f64, p: f64, (horizon, edge): (f64, f64)) -> 
     // Beyond the NDF's edge θe (where y = Y), C falls like the kernel's tail
     // measured from the edge: ln C ≈ −(c+1) ln(2u sin(θh − θe)).
     let theta_e = (beta * cap.powf(1.0 / (2.0 * p_eff))).atan();
-    let beyond = (tau.atan() - theta_e).max(0.0).sin();
+    let offset = tau.atan() - theta_e;
+    // `smooth > 0`: the onset x₊ softened over `smooth / (2 u_e)` (the
+    // kernel's width), x₊ ≈ (x + √(x² + δ²)) / 2.
+    let beyond = if smooth > 0.0 {
+        let delta = smooth / (2.0 * ue);
+        (0.5 * (offset + (offset * offset + delta * delta).sqrt()))
+            .min(std::f64::consts::FRAC_PI_2)
+            .sin()
+    } else {
+        offset.max(0.0).sin()
+    };
+    // `tau_cut > 0`: the edge term faded out for edges near the horizon,
+    // by 1 / (1 + (τe / τ_cut)²).
+    let tau_e = theta_e.tan();
+    let fade = if tau_cut > 0.0 {
+        1.0 / (1.0 + (tau_e / tau_cut).powi(2))
+    } else {
+        1.0
+    };
     (2.0 * ue * sin).asinh()
         + horizon * 0.5 * (tau * tau).ln_1p()
-        + edge * (2.0 * ue * beyond).asinh()
+        + edge * fade * (2.0 * ue * beyond).asinh()
         + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
 }
 
 /// C at the angles `thetas` from the exact values at the 32 nodes of the
 /// angle `form` ([`angle_g`]; the node angles by bisection on `ln(1 + τ)`),
 /// interpolated along ξ as the lookup does: the ξ-only part of T3b's error.
-fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: (f64, f64), thetas: &[f64]) -> Vec<f64> {
+fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec<f64> {
     let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
     let n = t3::ANGLES;
     let nodes: Vec<f64> = (0..n)
@@ -566,18 +615,18 @@ fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: (f64, f64), thetas: &[f64]) 
 /// ([`angle_g`]) on `brdf_scipy.py`'s parameter distribution, at the
 /// profile rule's nodes and at θh uniform in [0, 1.3] (where the BRDF check
 /// reads C: both directions within 75°).
-fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
+fn angle_variable_study(profiles: usize, horizons: &[Form]) {
     let mut rng = generator::rng::SplitMix64::new(57);
-    let points: Vec<[f64; 4]> = (0..profiles)
-        .map(|_| {
-            let u = rng.log_uniform_in(0.5, 50.0);
-            let c = rng.uniform_in(1.2, 6.0);
-            let beta = rng.log_uniform_in(0.05, 1.0);
-            let p = rng.uniform_in(0.5, 5.0);
-            [u, c, beta, p]
-        })
-        .collect();
-    let uniform: Vec<f64> = (0..64).map(|k| 1.3 * (k as f64 + 0.5) / 64.0).collect();
+    // `T3_FULL_DOMAIN=1`: verify's distribution over the whole table domain
+    // (`generator::tables::t3`, verify) instead of the BRDF check's.
+    let full_domain = std::env::var("T3_FULL_DOMAIN").is_ok();
+    let points: Vec<[f64; 4]> = if full_domain {
+        t3::verification_points(profiles, 57)
+    } else {
+        brdf_check_profiles(&mut rng, profiles)
+    };
+    let horizon = if full_domain { 1.55 } else { 1.3 };
+    let uniform: Vec<f64> = (0..64).map(|k| horizon * (k as f64 + 0.5) / 64.0).collect();
     // Per point, per variant: (e_L2 on the rule, [(approx, exact)] on the rule
     // and on the uniform angles, C(0)).
     type Row = Vec<(f64, Vec<(f64, f64)>, Vec<(f64, f64)>, f64)>;
@@ -615,6 +664,7 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
     for (vi, h) in horizons.iter().enumerate() {
         let (mut el2, mut core, mut tail, mut far) = (vec![], vec![], vec![], vec![]);
         let mut worst = (0.0f64, [0.0; 4], 0.0, 0.0);
+        let mut worst_core = (0.0f64, [0.0; 4]);
         for (row, point) in rows.iter().zip(&points) {
             let (e, on_rule, on_uniform, c0) = &row[vi];
             el2.push(*e);
@@ -622,6 +672,9 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
                 let rel = ((a - x) / x).abs();
                 if *x > 1e-3 * c0 {
                     core.push(rel);
+                    if rel > worst_core.0 {
+                        worst_core = (rel, *point);
+                    }
                 } else if *x > 1e-9 * c0 {
                     tail.push(rel);
                 }
@@ -638,11 +691,14 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
         }
         let pct = |x: f64| format!("{:.2}%", 100.0 * x);
         println!(
-            "{}: e_L2 median/p90/max {} {} {} | rule core p95/max {} {} | rule tail p95/max {} {} | θh uniform ≤ 1.3 (C > 1e-9 C0) median/p95/max {} {} {} (worst at u,c,β,p {:?}, θh {:.3}, C/C0 {:.1e})",
-            if h.0 < 0.0 {
-                "shipped (tan θh)".to_string()
+            "{}: e_L2 median/p90/max {} {} {} | rule core p95/max {} {} | rule tail p95/max {} {} | θh uniform ≤ {horizon} (C > 1e-9 C0) median/p95/max {} {} {} (worst at u,c,β,p {:?}, θh {:.3}, C/C0 {:.1e}; worst core at {:?})",
+            if h[0] < 0.0 {
+                "previous (tan θh, format 1)".to_string()
             } else {
-                format!("sin θh, w_h {}, w_e {}", h.0, h.1)
+                format!(
+                    "sin θh, w_h {}, w_e {}, smooth {}, τ_cut {}",
+                    h[0], h[1], h[2], h[3]
+                )
             },
             pct(quantile(&mut el2, 0.5)),
             pct(quantile(&mut el2, 0.9)),
@@ -657,14 +713,16 @@ fn angle_variable_study(profiles: usize, horizons: &[(f64, f64)]) {
             worst.1,
             worst.2,
             worst.3,
+            worst_core.1,
         );
     }
 }
 
 /// ξ-only C at given points (`u,c,beta,p,theta_h` lines of a CSV file,
 /// e.g. the BRDF check's points): exact C, and C from 32 exact node values
-/// interpolated along ξ with the shipped angle and with the candidate of
-/// [`angle_g`] (w_h = ½, w_e = 1). Prints `exact,shipped,candidate` per point.
+/// interpolated along ξ with the previous angle (format 1) and with the
+/// form of [`angle_g`] shipped since format 2 (`[½, ½, 2, 3]`), or the
+/// forms of `T3_FORMS`. Prints the exact value and one column per form.
 fn xi_only_at_points(path: &str) {
     let text = std::fs::read_to_string(path).expect("readable CSV");
     let points: Vec<[f64; 5]> = text
@@ -675,20 +733,26 @@ fn xi_only_at_points(path: &str) {
             (v.len() == 5).then(|| [v[0], v[1], v[2], v[3], v[4]])
         })
         .collect();
-    let rows: Vec<[f64; 3]> = points
+    let forms = forms_from_env_or(&[[-1.0, 0.0, 0.0, 0.0], [0.5, 0.5, 2.0, 3.0]]);
+    let rows: Vec<Vec<f64>> = points
         .par_iter()
         .map(|&[u, c, beta, p, theta]| {
             let exact = convolution_profile(u, c, beta, p, &[theta]).unwrap()[0];
-            let mut out = [exact, 0.0, 0.0];
-            for (slot, form) in [(1, (-1.0, 0.0)), (2, (0.5, 1.0))] {
-                out[slot] = xi_only(u, c, beta, p, form, &[theta])[0];
+            let mut out = vec![exact];
+            for &form in &forms {
+                out.push(xi_only(u, c, beta, p, form, &[theta])[0]);
             }
             out
         })
         .collect();
-    println!("exact,shipped,candidate");
+    let names: Vec<String> = forms
+        .iter()
+        .map(|f| format!("{f:?}").replace(", ", " "))
+        .collect();
+    println!("exact,{}", names.join(","));
     for r in rows {
-        println!("{},{},{}", r[0], r[1], r[2]);
+        let cells: Vec<String> = r.iter().map(|x| x.to_string()).collect();
+        println!("{}", cells.join(","));
     }
 }
 
@@ -698,10 +762,10 @@ fn main() {
         return;
     }
     if let Ok(n) = std::env::var("T3_ANGLE_VARIABLE_STUDY") {
-        angle_variable_study(
-            n.parse().unwrap_or(60),
-            &[(-1.0, 0.0), (0.5, 0.0), (0.5, 1.0), (0.5, 2.0), (1.0, 1.0)],
-        );
+        // `T3_FORMS="w_h,w_e;…"` overrides the forms compared (w_h < 0: the
+        // previous angle).
+        let forms = forms_from_env();
+        angle_variable_study(n.parse().unwrap_or(60), &forms);
         return;
     }
     if let Ok(n) = std::env::var("T3_ANGLE_STUDY") {
@@ -821,15 +885,7 @@ fn main() {
     // T3_BRDF_POINTS: draw the points as brdf_scipy.py does (see axis_study).
     let drawn: Vec<[f64; 4]> = if std::env::var("T3_BRDF_POINTS").is_ok() {
         let mut rng = generator::rng::SplitMix64::new(seed);
-        (0..profiles)
-            .map(|_| {
-                let u = rng.log_uniform_in(0.5, 50.0);
-                let c = rng.uniform_in(1.2, 6.0);
-                let beta = rng.log_uniform_in(0.05, 1.0);
-                let p = rng.uniform_in(0.5, 5.0);
-                [u, c, beta, p]
-            })
-            .collect()
+        brdf_check_profiles(&mut rng, profiles)
     } else {
         t3::verification_points(profiles, seed)
     };

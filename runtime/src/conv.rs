@@ -35,29 +35,50 @@
 //!
 //! # The normalised angle
 //!
-//! With `τ = tan θh`, `u_e = √(u² + u_floor²)`, `y = (τ/β)^(2p')` and
-//! `p' = p / (1 + κ p / (2 u_e β))`,
+//! With `τ = tan θh`, `u_e = √(u² + u_floor²)`, `y = (τ/β)^(2p')`,
+//! `p' = p / (1 + κ p / (2 u_e β))` and the NDF's edge `tan θe = β Y^(1/(2p'))`
+//! (where `y = Y`),
 //!
 //! ```text
-//!   F(τ) = asinh(2 u_e τ) + λ · ln(1 + Y (1 − e^(−y/Y))),     ξ = F(τ) / F(τ_max)
+//!   F(τ) = asinh(2 u_e sin θh)                      kernel
+//!        + w_h · ½ ln(1 + τ²)                        horizon
+//!        + w_e · f_e · asinh(2 u_e sin x̃)            edge
+//!        + λ · ln(1 + Y (1 − e^(−y/Y)))              NDF
+//!   x̃ = min((x + √(x² + δ²)) / 2, π/2),  x = θh − θe,  δ = s_e / (2 u_e)
+//!   f_e = 1 / (1 + (tan θe / τ_f)²)
+//!   ξ = F(τ) / F(τ_max)
 //! ```
 //!
-//! The first term is the kernel's own variable (linear in `θh` inside the
-//! kernel width `1/(2u)`, logarithmic in `tan θh` beyond it, up to the horizon
-//! where small-`p` NDFs peak); the second is the NDF's exponent
-//! (`ln D = const − y + 2 ln(1 + τ²)`), which puts nodes across the cliff of
-//! large-`p` lobes and saturates where `D` has fallen by `e^−Y`. Where the
-//! kernel is wider than the NDF (`1/(2u_e) ≳ β`), it smooths that cliff over
-//! `Δ ln τ ≈ 1/(2 u_e β)`, and `C` shows no cliff: the softened exponent
-//! `p'` spends the nodes on the profile's real width instead. (With `κ = 0`,
-//! 32 angles left `e_L2` of ξ interpolation alone at 5.1% for `p = 5`,
-//! `c ≈ 5`; `κ = 1` brings the worst of 60 such profiles to 1.0%:
-//! `examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`.) For `u_e β ≪ p`, `p'`
-//! tends to 0 and the NDF term keeps growing down to `τ ~ 1e-59`, so the
-//! first few angles of such nodes hold `C(0)` (where `C` is flat): wasted,
-//! not wrong; a floor on `p'` would avoid it at the next rebuild. Everything is known at
-//! lookup time. `τ_max`, `u_floor`, `λ`, `Y` and `κ` are stored in the header
-//! (`params`), so the file is self-describing.
+//! Each term follows one way `ln C` changes with `θh`:
+//!
+//! * **kernel**: the kernel's own variable, `ln k = −(c+1)/2 · ln(1 + 4u² sin²θh)`
+//!   is linear in it: linear in `θh` inside the kernel width `1/(2u)`,
+//!   logarithmic beyond.
+//! * **horizon**: `−ln cos θh`, for the `cos²` factor and small-`p` NDFs that
+//!   peak towards the horizon. (Before format version 2 the kernel term was
+//!   `asinh(2 u_e tan θh)`, which does both but spends about half of the ξ
+//!   range beyond 70° for `u` = 15–35.)
+//! * **edge**: just beyond the NDF's support, `C` falls like the kernel's
+//!   tail measured from that edge, `ln C ≈ −(c+1) ln(2u sin(θh − θe))`. Its
+//!   onset is smoothed over `s_e` kernel widths (a kink in `ξ(θh)` costs
+//!   accuracy), and it fades out for edges near the horizon (`θe` within
+//!   0.1° of it for small `p`, where `C` falls steeply for other reasons).
+//! * **NDF**: the NDF's exponent (`ln D = const − y + 2 ln(1 + τ²)`), which
+//!   puts nodes across the cliff of large-`p` lobes and saturates where `D`
+//!   has fallen by `e^−Y`. Where the kernel is wider than the NDF
+//!   (`1/(2u_e) ≳ β`), it smooths that cliff over `Δ ln τ ≈ 1/(2 u_e β)`, and
+//!   `C` shows no cliff: the softened exponent `p'` spends the nodes on the
+//!   profile's real width instead. (With `κ = 0`, 32 angles left `e_L2` of ξ
+//!   interpolation alone at 5.1% for `p = 5`, `c ≈ 5`; `κ = 1` brings the
+//!   worst of 60 such profiles to 1.0%: `examples/t3_spline_study.rs`,
+//!   `T3_ANGLE_STUDY`.) For `u_e β ≪ p`, `p'` tends to 0 and the NDF term
+//!   keeps growing down to `τ ~ 1e-59`, so the first few angles of such
+//!   nodes hold `C(0)` (where `C` is flat): wasted, not wrong.
+//!
+//! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3` were chosen with
+//! `examples/t3_spline_study.rs` (README, T3). Everything is known at lookup
+//! time. `τ_max`, `u_floor`, `λ`, `Y`, `κ`, `w_h`, `w_e`, `s_e` and `τ_f` are
+//! stored in the header (`params`), so the file is self-describing.
 //!
 //! # Out of the domain
 //!
@@ -126,7 +147,7 @@ pub fn kernel(x: f32, c: f32) -> f32 {
 pub const FIT_CHANNELS: usize = 2;
 
 /// The constants of the normalised angle (see the module documentation),
-/// as stored in the header's `params[1..5]` and `params[7]`.
+/// as stored in the header's `params[1..5]` and `params[7..12]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AngleParams {
     /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
@@ -140,6 +161,16 @@ pub struct AngleParams {
     /// `κ`: softening of the NDF exponent where the kernel is wider than the
     /// NDF (`2p → 2p / (1 + κ p / (2 u_e β))`; 0 = none).
     pub ndf_softening: f64,
+    /// `w_h`: weight of the horizon term `½ ln(1 + τ²) = −ln cos θh`.
+    pub horizon_weight: f64,
+    /// `w_e`: weight of the edge term.
+    pub edge_weight: f64,
+    /// `s_e`: the edge term's onset is smoothed over `δ = s_e / (2 u_e)`
+    /// (in units of the kernel's width).
+    pub edge_smoothing: f64,
+    /// `τ_f`: the edge term fades out for edges near the horizon, by
+    /// `1 / (1 + (tan θe / τ_f)²)`.
+    pub edge_fade_tan: f64,
 }
 
 /// `asinh x` for `x ≥ 0`, accurate for small `x`.
@@ -152,7 +183,10 @@ fn asinh_pos(x: f64) -> f64 {
 #[inline]
 fn angle_function(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
     let ue = math::sqrt(u * u + a.kernel_scale_floor * a.kernel_scale_floor);
-    let kernel_term = asinh_pos(2.0 * ue * tau);
+    // sec θh = √(1 + τ²); sin θh = τ / sec θh.
+    let secant = math::sqrt(1.0 + tau * tau);
+    let kernel_term = asinh_pos(2.0 * ue * tau / secant);
+    let horizon_term = 0.5 * math::ln_1p(tau * tau);
     // The kernel (width ~1/(2u_e)) smooths the NDF's cliff at τ ≈ β over
     // Δln τ ≈ 1/(2 u_e β): soften the exponent to match.
     let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
@@ -164,7 +198,26 @@ fn angle_function(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
     let cap = a.ndf_exponent_cap;
     // 1 − e^(−y/Y), with y = ∞ giving 1.
     let saturated = -math::exp_m1(-(y / cap));
-    kernel_term + a.ndf_weight * math::ln_1p(cap * saturated)
+    let ndf_term = math::ln_1p(cap * saturated);
+    // The NDF's edge θe, where y = Y: tan θe = β Y^(1/(2p')) (∞ for tiny p').
+    let tau_edge = beta * math::exp(math::ln(cap) / (2.0 * p_eff));
+    let fade = 1.0 / (1.0 + (tau_edge / a.edge_fade_tan) * (tau_edge / a.edge_fade_tan));
+    let edge_term = if fade > 0.0 {
+        // θh − θe = atan((τ − τe) / (1 + τ τe)), in (−π/2, π/2); its positive
+        // part smoothed, (x + √(x² + δ²)) / 2, and held ≤ π/2 so that the
+        // sine (and F) keeps increasing.
+        let offset = math::atan((tau - tau_edge) / (1.0 + tau * tau_edge));
+        let delta = a.edge_smoothing / (2.0 * ue);
+        let beyond = (0.5 * (offset + math::sqrt(offset * offset + delta * delta)))
+            .min(core::f64::consts::FRAC_PI_2);
+        fade * asinh_pos(2.0 * ue * math::sin(beyond))
+    } else {
+        0.0
+    };
+    kernel_term
+        + a.horizon_weight * horizon_term
+        + a.edge_weight * edge_term
+        + a.ndf_weight * ndf_term
 }
 
 /// The normalised angle `ξ ∈ [0, 1]` of `τ = tan θh` for the parameters
@@ -268,15 +321,23 @@ impl<'a> ConvTable<'a> {
             ndf_weight: header.params[3],
             ndf_exponent_cap: header.params[4],
             ndf_softening: header.params[7],
+            horizon_weight: header.params[8],
+            edge_weight: header.params[9],
+            edge_smoothing: header.params[10],
+            edge_fade_tan: header.params[11],
         };
         // NaN fails every comparison, so it is rejected too.
         let valid = angle.tau_max > 0.0
             && angle.ndf_exponent_cap > 0.0
             && header.params[5] > 0.0
-            && (0.0..1e6).contains(&angle.ndf_softening);
+            && (0.0..1e6).contains(&angle.ndf_softening)
+            && (0.0..1e6).contains(&angle.horizon_weight)
+            && (0.0..1e6).contains(&angle.edge_weight)
+            && (0.0..1e6).contains(&angle.edge_smoothing)
+            && angle.edge_fade_tan > 0.0;
         if !valid {
             return Err(FormatError::Shape(
-                "T3 angle parameters must be positive (softening finite, ≥ 0)",
+                "T3 angle parameters must be positive (softening and term weights finite, ≥ 0)",
             ));
         }
         // T3 is stored quantised per node (half the bytes of f32 for twice

@@ -38,11 +38,15 @@ compile_error!(
 /// The eight bytes every table file starts with.
 pub const MAGIC: [u8; 8] = *b"TWOSCALE";
 /// The format version this crate reads and writes.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// * 1: eight generation parameters.
+/// * 2: sixteen (T3's normalised angle gained its horizon and edge terms;
+///   four slots spare). Version 1 files are refused: rebuild them.
+pub const FORMAT_VERSION: u32 = 2;
 /// The largest number of axes a table may have (T3 is four-dimensional).
 pub const MAX_AXES: usize = 4;
 /// Number of table-specific generation parameters in the header.
-pub const PARAM_COUNT: usize = 8;
+pub const PARAM_COUNT: usize = 16;
 /// Alignment of the payload, and of the start of the file in memory.
 pub const PAYLOAD_ALIGN: usize = 64;
 /// Size of [`Header`] in bytes.
@@ -150,6 +154,10 @@ impl TableId {
                 "g_offset",
                 "value_floor",
                 "ndf_softening",
+                "horizon_weight",
+                "edge_weight",
+                "edge_smoothing",
+                "edge_fade_tan",
             ],
             TableId::ShBrdf => &crate::sh::PARAM_NAMES,
         }

@@ -61,6 +61,8 @@ forward! {
     sin(x) -> f64 = sin / sin;
     /// cos x (f64).
     cos(x) -> f64 = cos / cos;
+    /// arctan x (f64).
+    atan(x) -> f64 = atan / atan;
     /// arccos x (f64), NaN outside [−1, 1] (callers clamp).
     acos(x) -> f64 = acos / acos;
 }

@@ -383,7 +383,7 @@ impl ProjectedModel {
 pub struct ShBrdfTable<'a> {
     coefficients: &'a [f32],
     aux: &'a [f32],
-    params: [f64; 8],
+    params: [f64; crate::format::PARAM_COUNT],
     band_limit: usize,
     channels: usize,
 }

@@ -112,13 +112,23 @@ pub const ANGLES: usize = 32;
 /// `u_floor = 1`, `λ = 1`, `Y = 30` (the design study's choice), `κ = 1`
 /// (`examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`: of κ ∈ {0, ½, 1, 2, 4},
 /// 1 gave the lowest ξ-interpolation error on `brdf_scipy.py`'s parameter
-/// distribution, e_L2 max 5.1% → 1.0%, and verify's max 3.5% → 1.6%).
+/// distribution, e_L2 max 5.1% → 1.0%, and verify's max 3.5% → 1.6%), and
+/// the horizon and edge terms `w_h = ½`, `w_e = ½`, smoothed over 2 kernel
+/// widths, faded with `τ_f = 3` (`T3_XI_AT_POINTS` and
+/// `T3_ANGLE_VARIABLE_STUDY`, ξ interpolation alone: at the BRDF check's 400
+/// points p95 4.3% → 0.37%, max 11% → 3.7% against format 1's angle; on
+/// verify's distribution e_L2 max 0.99% → 0.46%, pointwise p95 0.46% →
+/// 0.77%; README, T3).
 pub const ANGLE: AngleParams = AngleParams {
     tau_max: 1e4,
     kernel_scale_floor: 1.0,
     ndf_weight: 1.0,
     ndf_exponent_cap: 30.0,
     ndf_softening: 1.0,
+    horizon_weight: 0.5,
+    edge_weight: 0.5,
+    edge_smoothing: 2.0,
+    edge_fade_tan: 3.0,
 };
 
 /// T3a stores `ln(g² + G_OFFSET)`: smooth through `g → 0` (flat profiles).
@@ -227,6 +237,10 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
             G_OFFSET,
             VALUE_FLOOR,
             ANGLE.ndf_softening,
+            ANGLE.horizon_weight,
+            ANGLE.edge_weight,
+            ANGLE.edge_smoothing,
+            ANGLE.edge_fade_tan,
         ],
         grid,
         aux: &[],
