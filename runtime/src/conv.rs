@@ -179,45 +179,81 @@ fn asinh_pos(x: f64) -> f64 {
     math::ln_1p(x + x * x / (1.0 + math::sqrt(1.0 + x * x)))
 }
 
-/// `F(τ)` of the normalised angle (module documentation), `τ ≥ 0`.
-#[inline]
-fn angle_function(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
-    let ue = math::sqrt(u * u + a.kernel_scale_floor * a.kernel_scale_floor);
-    // sec θh = √(1 + τ²); sin θh = τ / sec θh.
-    let secant = math::sqrt(1.0 + tau * tau);
-    let kernel_term = asinh_pos(2.0 * ue * tau / secant);
-    let horizon_term = 0.5 * math::ln_1p(tau * tau);
-    // The kernel (width ~1/(2u_e)) smooths the NDF's cliff at τ ≈ β over
-    // Δln τ ≈ 1/(2 u_e β): soften the exponent to match.
-    let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
-    let y = if tau > 0.0 {
-        math::exp(2.0 * p_eff * math::ln(tau / beta))
-    } else {
-        0.0
-    };
-    let cap = a.ndf_exponent_cap;
-    // 1 − e^(−y/Y), with y = ∞ giving 1.
-    let saturated = -math::exp_m1(-(y / cap));
-    let ndf_term = math::ln_1p(cap * saturated);
-    // The NDF's edge θe, where y = Y: tan θe = β Y^(1/(2p')) (∞ for tiny p').
-    let tau_edge = beta * math::exp(math::ln(cap) / (2.0 * p_eff));
-    let fade = 1.0 / (1.0 + (tau_edge / a.edge_fade_tan) * (tau_edge / a.edge_fade_tan));
-    let edge_term = if fade > 0.0 {
-        // θh − θe = atan((τ − τe) / (1 + τ τe)), in (−π/2, π/2); its positive
-        // part smoothed, (x + √(x² + δ²)) / 2, and held ≤ π/2 so that the
-        // sine (and F) keeps increasing.
-        let offset = math::atan((tau - tau_edge) / (1.0 + tau * tau_edge));
+/// The parts of `F` that depend on `(u, β, p)` only, computed once per
+/// lookup (`F` is evaluated at `τ` and at `τ_max`, and many times by the
+/// inverse).
+struct AngleShape<'a> {
+    a: &'a AngleParams,
+    beta: f64,
+    /// `u_e = √(u² + u_floor²)`.
+    ue: f64,
+    /// The softened exponent `p'`.
+    p_eff: f64,
+    /// `tan θe`, the NDF's edge (∞ for tiny `p'`).
+    tau_edge: f64,
+    /// The edge term's fade `f_e`.
+    fade: f64,
+    /// The edge term's smoothing width `δ = s_e / (2 u_e)`.
+    delta: f64,
+}
+
+impl<'a> AngleShape<'a> {
+    #[inline]
+    fn new(u: f64, beta: f64, p: f64, a: &'a AngleParams) -> Self {
+        let ue = math::sqrt(u * u + a.kernel_scale_floor * a.kernel_scale_floor);
+        // The kernel (width ~1/(2u_e)) smooths the NDF's cliff at τ ≈ β over
+        // Δln τ ≈ 1/(2 u_e β): soften the exponent to match.
+        let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
+        // The NDF's edge θe, where y = Y: tan θe = β Y^(1/(2p')).
+        let tau_edge = beta * math::exp(math::ln(a.ndf_exponent_cap) / (2.0 * p_eff));
+        let fade = 1.0 / (1.0 + (tau_edge / a.edge_fade_tan) * (tau_edge / a.edge_fade_tan));
         let delta = a.edge_smoothing / (2.0 * ue);
-        let beyond = (0.5 * (offset + math::sqrt(offset * offset + delta * delta)))
-            .min(core::f64::consts::FRAC_PI_2);
-        fade * asinh_pos(2.0 * ue * math::sin(beyond))
-    } else {
-        0.0
-    };
-    kernel_term
-        + a.horizon_weight * horizon_term
-        + a.edge_weight * edge_term
-        + a.ndf_weight * ndf_term
+        AngleShape {
+            a,
+            beta,
+            ue,
+            p_eff,
+            tau_edge,
+            fade,
+            delta,
+        }
+    }
+
+    /// `F(τ)` of the normalised angle (module documentation), `τ ≥ 0`.
+    #[inline]
+    fn f(&self, tau: f64) -> f64 {
+        let (a, ue) = (self.a, self.ue);
+        // sec θh = √(1 + τ²); sin θh = τ / sec θh.
+        let secant = math::sqrt(1.0 + tau * tau);
+        let kernel_term = asinh_pos(2.0 * ue * tau / secant);
+        let horizon_term = 0.5 * math::ln_1p(tau * tau);
+        let y = if tau > 0.0 {
+            math::exp(2.0 * self.p_eff * math::ln(tau / self.beta))
+        } else {
+            0.0
+        };
+        let cap = a.ndf_exponent_cap;
+        // 1 − e^(−y/Y), with y = ∞ giving 1.
+        let saturated = -math::exp_m1(-(y / cap));
+        let ndf_term = math::ln_1p(cap * saturated);
+        let edge_term = if self.fade > 0.0 {
+            // θh − θe = atan((τ − τe) / (1 + τ τe)), in (−π/2, π/2); its
+            // positive part smoothed, (x + √(x² + δ²)) / 2, and held ≤ π/2
+            // so that the sine (and F) keeps increasing.
+            let tau_edge = self.tau_edge;
+            let offset = math::atan((tau - tau_edge) / (1.0 + tau * tau_edge));
+            let delta = self.delta;
+            let beyond = (0.5 * (offset + math::sqrt(offset * offset + delta * delta)))
+                .min(core::f64::consts::FRAC_PI_2);
+            self.fade * asinh_pos(2.0 * ue * math::sin(beyond))
+        } else {
+            0.0
+        };
+        kernel_term
+            + a.horizon_weight * horizon_term
+            + a.edge_weight * edge_term
+            + a.ndf_weight * ndf_term
+    }
 }
 
 /// The normalised angle `ξ ∈ [0, 1]` of `τ = tan θh` for the parameters
@@ -226,8 +262,8 @@ fn angle_function(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
 /// finite with `β, p > 0`, `u ≥ 0`; `τ < 0` is treated as 0.
 pub fn normalised_angle(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
     let tau = tau.max(0.0).min(a.tau_max);
-    let top = angle_function(a.tau_max, u, beta, p, a);
-    (angle_function(tau, u, beta, p, a) / top).max(0.0).min(1.0)
+    let shape = AngleShape::new(u, beta, p, a);
+    (shape.f(tau) / shape.f(a.tau_max)).max(0.0).min(1.0)
 }
 
 /// The inverse of [`normalised_angle`]: `τ(ξ)` by bisection on `[0, τ_max]`
@@ -239,15 +275,15 @@ pub fn tan_of_normalised_angle(xi: f64, u: f64, beta: f64, p: f64, a: &AnglePara
     if xi >= 1.0 {
         return a.tau_max;
     }
-    let top = angle_function(a.tau_max, u, beta, p, a);
-    let target = xi * top;
+    let shape = AngleShape::new(u, beta, p, a);
+    let target = xi * shape.f(a.tau_max);
     let (mut lo, mut hi) = (0.0f64, math::ln_1p(a.tau_max));
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
         }
-        if angle_function(math::exp_m1(mid), u, beta, p, a) < target {
+        if shape.f(math::exp_m1(mid)) < target {
             lo = mid;
         } else {
             hi = mid;
