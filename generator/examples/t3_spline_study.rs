@@ -521,7 +521,7 @@ fn forms_from_env() -> Vec<Form> {
 /// An angle form for [`angle_g`]: `[w_h, w_e, smooth, τ_cut]`.
 type Form = [f64; 4];
 
-/// A candidate normalised angle for the next rebuild: the kernel term in
+/// A form of the normalised angle (format 2 ships `[½, ½, 2, 3]`): the kernel term in
 /// `sin θh` (the kernel's own variable: the far tail
 /// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in `asinh(2u sin θh)`)
 /// plus `w_h · ½ ln(1 + τ²) = −w_h ln cos θh` for the `cos²θh` fall at the
