@@ -27,14 +27,17 @@
 //! * `T3_XI_AT_POINTS=file.csv` (`u,c,beta,p,theta_h`): exact C and its
 //!   ξ-only interpolation with the previous (format 1) and the shipped
 //!   (format 2) angle, per point;
-//! * `T3_FORMS="w_h,w_e,smoothing,τ_f;…"`: the forms those two compare
+//! * `T3_PATCH_STUDY=n`: the angle forms with β and p interpolated too (the
+//!   4 × 4 β, p nodes around each of `n` verify profiles, u and c exact),
+//!   against ξ alone; `T3_PATCH=1` does the same at `T3_XI_AT_POINTS`;
+//! * `T3_FORMS="w_h,w_e,smoothing,τ_f;…"`: the forms those three compare
 //!   (`w_h < 0`: format 1's angle).
 
 use generator::reference::conv::{Params, ProfileRule, convolution_profile};
 use generator::tables::t3;
 use rayon::prelude::*;
 use twoscale::conv::{ConvTable, FIT_CHANNELS, normalised_angle};
-use twoscale::interp::coordinate_f64;
+use twoscale::interp::{coordinate_f64, node_value};
 
 const AXES: [twoscale::format::AxisHeader; 4] = [t3::U_AXIS, t3::C_AXIS, t3::BETA_AXIS, t3::P_AXIS];
 
@@ -248,6 +251,15 @@ struct Exact {
     rule: ProfileRule,
     values: Vec<f64>,
     c0: f64,
+}
+
+/// The `qs` quantiles of `v` as percentages, space-separated.
+fn percentiles(v: &mut [f64], qs: &[f64]) -> String {
+    let cells: Vec<String> = qs
+        .iter()
+        .map(|&q| format!("{:.2}%", 100.0 * quantile(v, q)))
+        .collect();
+    cells.join(" ")
 }
 
 fn quantile(v: &mut [f64], q: f64) -> f64 {
@@ -475,19 +487,12 @@ fn angle_study(profiles: usize, kappas: &[f64]) {
                     }
                 }
             }
-            let pct = |x: f64| format!("{:.2}%", 100.0 * x);
             println!(
-                "{} kappa {kappa:4}: e_L2 median/p90/max {} {} {} | core median/p95/max {} {} {} | tail {} {} {}",
+                "{} kappa {kappa:4}: e_L2 median/p90/max {} | core median/p95/max {} | tail {}",
                 if brdf { "brdf  " } else { "verify" },
-                pct(quantile(&mut el2, 0.5)),
-                pct(quantile(&mut el2, 0.9)),
-                pct(quantile(&mut el2, 1.0)),
-                pct(quantile(&mut core, 0.5)),
-                pct(quantile(&mut core, 0.95)),
-                pct(quantile(&mut core, 1.0)),
-                pct(quantile(&mut tail, 0.5)),
-                pct(quantile(&mut tail, 0.95)),
-                pct(quantile(&mut tail, 1.0)),
+                percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+                percentiles(&mut core, &[0.5, 0.95, 1.0]),
+                percentiles(&mut tail, &[0.5, 0.95, 1.0]),
             );
         }
     }
@@ -574,6 +579,20 @@ fn angle_g(tau: f64, u: f64, beta: f64, p: f64, [horizon, edge, smooth, tau_cut]
 /// angle `form` ([`angle_g`]; the node angles by bisection on `ln(1 + τ)`),
 /// interpolated along ξ as the lookup does: the ξ-only part of T3b's error.
 fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec<f64> {
+    let ln_v = node_ln_values(u, c, beta, p, form);
+    thetas
+        .iter()
+        .map(|&theta| {
+            let (start, w) = xi_weights(u, beta, p, form, theta);
+            (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
+        })
+        .collect()
+}
+
+/// ln C (floored as the table stores it) at the 32 node angles of the angle
+/// `form` for the parameters `(u, c, β, p)`: one node of a table built with
+/// that form.
+fn node_ln_values(u: f64, c: f64, beta: f64, p: f64, form: Form) -> Vec<f64> {
     let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
     let n = t3::ANGLES;
     let nodes: Vec<f64> = (0..n)
@@ -593,22 +612,108 @@ fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec
         .collect();
     let v = convolution_profile(u, c, beta, p, &nodes).unwrap();
     let peak = v.iter().cloned().fold(0.0f64, f64::max);
-    let ln_v: Vec<f64> = v
-        .iter()
+    v.iter()
         .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
-        .collect();
+        .collect()
+}
+
+/// The lookup's Catmull–Rom weights along ξ at `θh` for the parameters
+/// `(u, β, p)` under the angle `form`.
+fn xi_weights(u: f64, beta: f64, p: f64, form: Form, theta: f64) -> (usize, [f64; 4]) {
+    let n = t3::ANGLES;
+    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
+    let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
+    weights(
+        Scheme::CatmullRomSecantEnds,
+        n,
+        (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
+    )
+}
+
+/// C at the angles `thetas` as a table built with the angle `form` would
+/// give it with u and c exact and β, p interpolated: the 4 × 4 β, p nodes
+/// around the point (exact profiles at their own 32 node angles), blended
+/// by the lookup's Catmull–Rom weights at equal ξ, then Catmull–Rom along ξ
+/// at the point's own ξ(θh). Isolates what β and p interpolation adds to
+/// the ξ-only error.
+fn beta_p_patch(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec<f64> {
+    let (bn, pn) = (t3::BETA_AXIS.nodes as usize, t3::P_AXIS.nodes as usize);
+    let (b0, wb) = weights(Scheme::CatmullRom, bn, position(2, beta));
+    let (p0, wp) = weights(Scheme::CatmullRom, pn, position(3, p));
+    let mut corners = Vec::new();
+    for (i, &w_beta) in wb.iter().enumerate() {
+        for (j, &w_p) in wp.iter().enumerate() {
+            if w_beta * w_p != 0.0 {
+                let node_beta = node_value(&t3::BETA_AXIS, b0 + i);
+                let node_p = node_value(&t3::P_AXIS, p0 + j);
+                corners.push((w_beta * w_p, node_ln_values(u, c, node_beta, node_p, form)));
+            }
+        }
+    }
     thetas
         .iter()
         .map(|&theta| {
-            let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
-            let (start, w) = weights(
-                Scheme::CatmullRomSecantEnds,
-                n,
-                (xi * (n - 1) as f64).clamp(0.0, (n - 1) as f64),
-            );
-            (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
+            let (start, w) = xi_weights(u, beta, p, form, theta);
+            corners
+                .iter()
+                .map(|(weight, ln_v)| weight * (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>())
+                .sum::<f64>()
+                .exp()
         })
         .collect()
+}
+
+/// ξ-only and β, p-patch errors of the angle forms on verify's profiles
+/// (u and c exact): pointwise on the profile rule's nodes where
+/// C > 1e-3 C(0), and e_L2.
+fn patch_study(profiles: usize, forms: &[Form]) {
+    let points = t3::verification_points(profiles, 61);
+    type Row = Vec<[(f64, Vec<f64>); 2]>;
+    let rows: Vec<(Row, Vec<f64>, Vec<f64>, f64)> = points
+        .par_iter()
+        .map(|&[u, c, beta, p]| {
+            let params = Params::new(u, c, beta, p).unwrap();
+            let rule = ProfileRule::with_order(ProfileRule::width_for(&params), 8);
+            let exact = convolution_profile(u, c, beta, p, &rule.nodes).unwrap();
+            let c0 = convolution_profile(u, c, beta, p, &[0.0]).unwrap()[0];
+            let per_form = forms
+                .iter()
+                .map(|&form| {
+                    let xi = xi_only(u, c, beta, p, form, &rule.nodes);
+                    let patch = beta_p_patch(u, c, beta, p, form, &rule.nodes);
+                    let e_l2 = |approx: &[f64]| {
+                        let (mut num, mut den) = (0.0, 0.0);
+                        for ((a, e), w) in approx.iter().zip(&exact).zip(&rule.weights) {
+                            num += w * (a - e) * (a - e);
+                            den += w * e * e;
+                        }
+                        (num / den).sqrt()
+                    };
+                    [(e_l2(&xi), xi), (e_l2(&patch), patch)]
+                })
+                .collect();
+            (per_form, exact, rule.weights.clone(), c0)
+        })
+        .collect();
+    for (fi, form) in forms.iter().enumerate() {
+        for (which, name) in ["ξ only", "β, p patch"].iter().enumerate() {
+            let (mut el2, mut core) = (vec![], vec![]);
+            for (per_form, exact, _, c0) in &rows {
+                let (e, approx) = &per_form[fi][which];
+                el2.push(*e);
+                for (a, x) in approx.iter().zip(exact) {
+                    if *x > 1e-3 * c0 {
+                        core.push(((a - x) / x).abs());
+                    }
+                }
+            }
+            println!(
+                "{form:?} {name:10}: e_L2 median/p90/max {} | core median/p95/max {}",
+                percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+                percentiles(&mut core, &[0.5, 0.95, 1.0]),
+            );
+        }
+    }
 }
 
 /// ξ-only error (parameters exact, 32 angles) of the candidate angles
@@ -734,13 +839,19 @@ fn xi_only_at_points(path: &str) {
         })
         .collect();
     let forms = forms_from_env_or(&[[-1.0, 0.0, 0.0, 0.0], [0.5, 0.5, 2.0, 3.0]]);
+    // `T3_PATCH=1`: β and p interpolated too ([`beta_p_patch`]).
+    let patch = std::env::var("T3_PATCH").is_ok();
     let rows: Vec<Vec<f64>> = points
         .par_iter()
         .map(|&[u, c, beta, p, theta]| {
             let exact = convolution_profile(u, c, beta, p, &[theta]).unwrap()[0];
             let mut out = vec![exact];
             for &form in &forms {
-                out.push(xi_only(u, c, beta, p, form, &[theta])[0]);
+                out.push(if patch {
+                    beta_p_patch(u, c, beta, p, form, &[theta])[0]
+                } else {
+                    xi_only(u, c, beta, p, form, &[theta])[0]
+                });
             }
             out
         })
@@ -759,6 +870,11 @@ fn xi_only_at_points(path: &str) {
 fn main() {
     if let Ok(path) = std::env::var("T3_XI_AT_POINTS") {
         xi_only_at_points(&path);
+        return;
+    }
+    if let Ok(n) = std::env::var("T3_PATCH_STUDY") {
+        let forms = forms_from_env_or(&[[-1.0, 0.0, 0.0, 0.0], [0.5, 0.5, 2.0, 3.0]]);
+        patch_study(n.parse().unwrap_or(20), &forms);
         return;
     }
     if let Ok(n) = std::env::var("T3_ANGLE_VARIABLE_STUDY") {
