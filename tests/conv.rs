@@ -55,27 +55,19 @@ fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f
             }
         }
     }
-    let a = t3::ANGLE;
     let bytes = encode(&TableSpec {
         table_id: TableId::Convolution,
         channels: (2 + angles) as u32,
         kernel: Kernel::Multilinear,
         value_type: twoscale::format::ValueType::U16,
         axes: &axes,
-        params: &[
-            angles as f64,
-            a.tau_max,
-            a.kernel_scale_floor,
-            a.ndf_weight,
-            a.ndf_exponent_cap,
-            t3::G_OFFSET,
-            t3::VALUE_FLOOR,
-            1e-6,
-            a.horizon_weight,
-            a.edge_weight,
-            a.edge_smoothing,
-            a.edge_fade_tan,
-        ],
+        params: &t3::header_params(
+            angles,
+            &twoscale::conv::AngleParams {
+                ndf_softening: 1e-6,
+                ..t3::ANGLE
+            },
+        ),
         grid: &grid,
         aux: &[],
         generator_version: "test",

@@ -20,7 +20,7 @@
 //! * `T3_AXIS_STUDY=n T3_AXIS=u|c|p`: one axis's mapping alone, candidates
 //!   compared on `n` random points (exact profiles at the candidate nodes);
 //! * `T3_ANGLE_STUDY=n`: the normalised angle's softening κ, ξ alone;
-//! * `T3_ANGLE_VARIABLE_STUDY=n`: forms of the angle ([`angle_g`]: kernel
+//! * `T3_ANGLE_VARIABLE_STUDY=n`: forms of the angle ([`Form`]: kernel
 //!   term in `sin θh`, horizon and edge terms), ξ alone, including θh
 //!   uniform; `T3_FULL_DOMAIN=1` draws verify's profiles instead of the BRDF
 //!   check's;
@@ -33,10 +33,12 @@
 //! * `T3_FORMS="w_h,w_e,smoothing,τ_f;…"`: the forms those three compare
 //!   (`w_h < 0`: format 1's angle).
 
-use generator::reference::conv::{Params, ProfileRule, convolution_profile};
+use generator::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
 use generator::tables::t3;
 use rayon::prelude::*;
-use twoscale::conv::{ConvTable, FIT_CHANNELS, normalised_angle};
+use twoscale::conv::{
+    AngleParams, ConvTable, FIT_CHANNELS, normalised_angle, tan_of_normalised_angle,
+};
 use twoscale::interp::{coordinate_f64, node_value};
 
 const AXES: [twoscale::format::AxisHeader; 4] = [t3::U_AXIS, t3::C_AXIS, t3::BETA_AXIS, t3::P_AXIS];
@@ -253,6 +255,20 @@ struct Exact {
     c0: f64,
 }
 
+/// SPEC's e_L2 (`generator::reference::conv::e_l2_on`) of values `approx`
+/// already computed at the rule's nodes (ascending), against `exact` there.
+fn e_l2_at_nodes(rule: &ProfileRule, approx: &[f64], exact: &[f64]) -> f64 {
+    e_l2_on(
+        rule,
+        |t| {
+            let k = rule.nodes.partition_point(|&x| x < t);
+            assert_eq!(rule.nodes[k], t, "rule nodes ascending");
+            approx[k]
+        },
+        exact,
+    )
+}
+
 /// The `qs` quantiles of `v` as percentages, space-separated.
 fn percentiles(v: &mut [f64], qs: &[f64]) -> String {
     let cells: Vec<String> = qs
@@ -462,12 +478,7 @@ fn angle_study(profiles: usize, kappas: &[f64]) {
                                 (0..4).map(|j| w[j] * ln_v[start + j]).sum::<f64>().exp()
                             })
                             .collect();
-                        let (mut num, mut den) = (0.0, 0.0);
-                        for ((a, e), w) in approx.iter().zip(&exact).zip(&rule.weights) {
-                            num += w * (a - e) * (a - e);
-                            den += w * e * e;
-                        }
-                        ((num / den).sqrt(), approx, exact.clone())
+                        (e_l2_at_nodes(&rule, &approx, &exact), approx, exact.clone())
                     })
                     .collect()
             })
@@ -523,60 +534,51 @@ fn forms_from_env() -> Vec<Form> {
     )
 }
 
-/// An angle form for [`angle_g`]: `[w_h, w_e, smooth, τ_cut]`.
+/// An angle form: `[w_h, w_e, smoothing, τ_f]`, the runtime's
+/// `AngleParams::{horizon_weight, edge_weight, edge_smoothing, edge_fade_tan}`
+/// with the other constants of `t3::ANGLE` (format 2 ships `[½, ½, 2, 3]`;
+/// `τ_f = 0`: no fade). `w_h < 0`: format 1's angle (`angle_f` with κ = 1).
 type Form = [f64; 4];
 
-/// A form of the normalised angle (format 2 ships `[½, ½, 2, 3]`): the kernel term in
-/// `sin θh` (the kernel's own variable: the far tail
-/// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in `asinh(2u sin θh)`)
-/// plus `w_h · ½ ln(1 + τ²) = −w_h ln cos θh` for the `cos²θh` fall at the
-/// horizon, `w_e · asinh(2 u_e sin(θh − θe)₊)` for the tail beyond the NDF's
-/// edge θe (where the NDF term saturates), and the shipped NDF term (κ = 1).
-/// `w_h < 0`: the previous angle (format 1; `angle_f` with κ = 1).
-fn angle_g(tau: f64, u: f64, beta: f64, p: f64, [horizon, edge, smooth, tau_cut]: Form) -> f64 {
-    if horizon < 0.0 {
-        return angle_f(tau, u, beta, p, t3::ANGLE.ndf_softening);
+/// The runtime's angle constants for `form`; `None` for format 1's angle.
+fn form_params([horizon, edge, smoothing, fade_tan]: Form) -> Option<AngleParams> {
+    (horizon >= 0.0).then_some(AngleParams {
+        horizon_weight: horizon,
+        edge_weight: edge,
+        edge_smoothing: smoothing,
+        edge_fade_tan: if fade_tan > 0.0 {
+            fade_tan
+        } else {
+            f64::INFINITY
+        },
+        ..t3::ANGLE
+    })
+}
+
+/// ξ of `τ = tan θh` under the angle `form` (the runtime's
+/// `normalised_angle`, or format 1's).
+fn xi_of(tau: f64, u: f64, beta: f64, p: f64, form: Form) -> f64 {
+    let tau = tau.min(t3::ANGLE.tau_max);
+    match form_params(form) {
+        Some(a) => normalised_angle(tau, u, beta, p, &a),
+        None => {
+            let kappa = t3::ANGLE.ndf_softening;
+            angle_f(tau, u, beta, p, kappa) / angle_f(t3::ANGLE.tau_max, u, beta, p, kappa)
+        }
     }
-    let a = t3::ANGLE;
-    let ue = (u * u + a.kernel_scale_floor * a.kernel_scale_floor).sqrt();
-    let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
-    let y = if tau > 0.0 {
-        (2.0 * p_eff * (tau / beta).ln()).exp()
-    } else {
-        0.0
-    };
-    let cap = a.ndf_exponent_cap;
-    let sin = tau / (1.0 + tau * tau).sqrt();
-    // Beyond the NDF's edge θe (where y = Y), C falls like the kernel's tail
-    // measured from the edge: ln C ≈ −(c+1) ln(2u sin(θh − θe)).
-    let theta_e = (beta * cap.powf(1.0 / (2.0 * p_eff))).atan();
-    let offset = tau.atan() - theta_e;
-    // `smooth > 0`: the onset x₊ softened over `smooth / (2 u_e)` (the
-    // kernel's width), x₊ ≈ (x + √(x² + δ²)) / 2.
-    let beyond = if smooth > 0.0 {
-        let delta = smooth / (2.0 * ue);
-        (0.5 * (offset + (offset * offset + delta * delta).sqrt()))
-            .min(std::f64::consts::FRAC_PI_2)
-            .sin()
-    } else {
-        offset.max(0.0).sin()
-    };
-    // `tau_cut > 0`: the edge term faded out for edges near the horizon,
-    // by 1 / (1 + (τe / τ_cut)²).
-    let tau_e = theta_e.tan();
-    let fade = if tau_cut > 0.0 {
-        1.0 / (1.0 + (tau_e / tau_cut).powi(2))
-    } else {
-        1.0
-    };
-    (2.0 * ue * sin).asinh()
-        + horizon * 0.5 * (tau * tau).ln_1p()
-        + edge * fade * (2.0 * ue * beyond).asinh()
-        + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
+}
+
+/// θh of `ξ` under the angle `form` (the inverse of [`xi_of`]).
+fn theta_of(xi: f64, u: f64, beta: f64, p: f64, form: Form) -> f64 {
+    match form_params(form) {
+        Some(a) => tan_of_normalised_angle(xi, u, beta, p, &a),
+        None => tau_of_xi(xi, u, beta, p, t3::ANGLE.ndf_softening),
+    }
+    .atan()
 }
 
 /// C at the angles `thetas` from the exact values at the 32 nodes of the
-/// angle `form` ([`angle_g`]; the node angles by bisection on `ln(1 + τ)`),
+/// angle `form` ([`Form`]; the node angles by the runtime's inverse),
 /// interpolated along ξ as the lookup does: the ξ-only part of T3b's error.
 fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec<f64> {
     let ln_v = node_ln_values(u, c, beta, p, form);
@@ -593,22 +595,9 @@ fn xi_only(u: f64, c: f64, beta: f64, p: f64, form: Form, thetas: &[f64]) -> Vec
 /// `form` for the parameters `(u, c, β, p)`: one node of a table built with
 /// that form.
 fn node_ln_values(u: f64, c: f64, beta: f64, p: f64, form: Form) -> Vec<f64> {
-    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
     let n = t3::ANGLES;
     let nodes: Vec<f64> = (0..n)
-        .map(|k| {
-            let target = k as f64 / (n - 1) as f64 * top;
-            let (mut lo, mut hi) = (0.0f64, t3::ANGLE.tau_max.ln_1p());
-            for _ in 0..100 {
-                let mid = 0.5 * (lo + hi);
-                if angle_g(mid.exp_m1(), u, beta, p, form) < target {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            (0.5 * (lo + hi)).exp_m1().atan()
-        })
+        .map(|k| theta_of(k as f64 / (n - 1) as f64, u, beta, p, form))
         .collect();
     let v = convolution_profile(u, c, beta, p, &nodes).unwrap();
     let peak = v.iter().cloned().fold(0.0f64, f64::max);
@@ -621,8 +610,7 @@ fn node_ln_values(u: f64, c: f64, beta: f64, p: f64, form: Form) -> Vec<f64> {
 /// `(u, β, p)` under the angle `form`.
 fn xi_weights(u: f64, beta: f64, p: f64, form: Form, theta: f64) -> (usize, [f64; 4]) {
     let n = t3::ANGLES;
-    let top = angle_g(t3::ANGLE.tau_max, u, beta, p, form);
-    let xi = angle_g(theta.tan().min(t3::ANGLE.tau_max), u, beta, p, form) / top;
+    let xi = xi_of(theta.tan(), u, beta, p, form);
     weights(
         Scheme::CatmullRomSecantEnds,
         n,
@@ -681,15 +669,10 @@ fn patch_study(profiles: usize, forms: &[Form]) {
                 .map(|&form| {
                     let xi = xi_only(u, c, beta, p, form, &rule.nodes);
                     let patch = beta_p_patch(u, c, beta, p, form, &rule.nodes);
-                    let e_l2 = |approx: &[f64]| {
-                        let (mut num, mut den) = (0.0, 0.0);
-                        for ((a, e), w) in approx.iter().zip(&exact).zip(&rule.weights) {
-                            num += w * (a - e) * (a - e);
-                            den += w * e * e;
-                        }
-                        (num / den).sqrt()
-                    };
-                    [(e_l2(&xi), xi), (e_l2(&patch), patch)]
+                    [
+                        (e_l2_at_nodes(&rule, &xi, &exact), xi),
+                        (e_l2_at_nodes(&rule, &patch, &exact), patch),
+                    ]
                 })
                 .collect();
             (per_form, exact, rule.weights.clone(), c0)
@@ -717,7 +700,7 @@ fn patch_study(profiles: usize, forms: &[Form]) {
 }
 
 /// ξ-only error (parameters exact, 32 angles) of the candidate angles
-/// ([`angle_g`]) on `brdf_scipy.py`'s parameter distribution, at the
+/// ([`Form`]) on `brdf_scipy.py`'s parameter distribution, at the
 /// profile rule's nodes and at θh uniform in [0, 1.3] (where the BRDF check
 /// reads C: both directions within 75°).
 fn angle_variable_study(profiles: usize, horizons: &[Form]) {
@@ -748,6 +731,7 @@ fn angle_variable_study(profiles: usize, horizons: &[Form]) {
                 .map(|&h| {
                     let at_rule = xi_only(u, c, beta, p, h, &rule.nodes);
                     let at_uniform = xi_only(u, c, beta, p, h, &uniform);
+                    let e_l2 = e_l2_at_nodes(&rule, &at_rule, &exact_rule);
                     let on_rule: Vec<(f64, f64)> = at_rule
                         .into_iter()
                         .zip(exact_rule.iter().copied())
@@ -756,12 +740,7 @@ fn angle_variable_study(profiles: usize, horizons: &[Form]) {
                         .into_iter()
                         .zip(exact_uniform.iter().copied())
                         .collect();
-                    let (mut num, mut den) = (0.0, 0.0);
-                    for ((a, e), w) in on_rule.iter().zip(&rule.weights) {
-                        num += w * (a - e) * (a - e);
-                        den += w * e * e;
-                    }
-                    ((num / den).sqrt(), on_rule, on_uniform, c0)
+                    (e_l2, on_rule, on_uniform, c0)
                 })
                 .collect()
         })
@@ -826,7 +805,7 @@ fn angle_variable_study(profiles: usize, horizons: &[Form]) {
 /// ξ-only C at given points (`u,c,beta,p,theta_h` lines of a CSV file,
 /// e.g. the BRDF check's points): exact C, and C from 32 exact node values
 /// interpolated along ξ with the previous angle (format 1) and with the
-/// form of [`angle_g`] shipped since format 2 (`[½, ½, 2, 3]`), or the
+/// form shipped since format 2 (`[½, ½, 2, 3]`), or the
 /// forms of `T3_FORMS`. Prints the exact value and one column per form.
 fn xi_only_at_points(path: &str) {
     let text = std::fs::read_to_string(path).expect("readable CSV");

@@ -221,6 +221,26 @@ pub fn node_values(index: usize) -> Result<Vec<f32>, BuildError> {
     Ok(out)
 }
 
+/// The header's generation parameters of a T3 file with `angles` angles and
+/// the angle constants `angle`, in the order of `TableId::param_names`
+/// (`ConvTable::from_table` reads them back).
+pub fn header_params(angles: usize, angle: &AngleParams) -> [f64; 12] {
+    [
+        angles as f64,
+        angle.tau_max,
+        angle.kernel_scale_floor,
+        angle.ndf_weight,
+        angle.ndf_exponent_cap,
+        G_OFFSET,
+        VALUE_FLOOR,
+        angle.ndf_softening,
+        angle.horizon_weight,
+        angle.edge_weight,
+        angle.edge_smoothing,
+        angle.edge_fade_tan,
+    ]
+}
+
 fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
     Ok(encode(&TableSpec {
         table_id: TableId::Convolution,
@@ -228,20 +248,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
         kernel: Kernel::Multilinear,
         value_type: twoscale::format::ValueType::U16,
         axes: &AXES,
-        params: &[
-            ANGLES as f64,
-            ANGLE.tau_max,
-            ANGLE.kernel_scale_floor,
-            ANGLE.ndf_weight,
-            ANGLE.ndf_exponent_cap,
-            G_OFFSET,
-            VALUE_FLOOR,
-            ANGLE.ndf_softening,
-            ANGLE.horizon_weight,
-            ANGLE.edge_weight,
-            ANGLE.edge_smoothing,
-            ANGLE.edge_fade_tan,
-        ],
+        params: &header_params(ANGLES, &ANGLE),
         grid,
         aux: &[],
         generator_version: GENERATOR_VERSION,
