@@ -45,10 +45,11 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
-use crate::conv::{ConvSlice, Convolution};
+use crate::bake::{ConvBake, DirectionBake, DirectionValues, MaskingBake};
+use crate::conv::Convolution;
 use crate::epd::Epd;
-use crate::fresnel::{Complex, DiffuseFresnelTable, fresnel, q_bar};
-use crate::kcorr::{SigmaRatioSlice, SigmaRatioTable};
+use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
+use crate::kcorr::SigmaRatioTable;
 use crate::math;
 use crate::smith::SmithG1Table;
 use core::f64::consts::PI;
@@ -281,33 +282,57 @@ fn one_minus_exp_over(x: f64, s: f64) -> f64 {
 }
 
 /// The two-scale BRDF at one wavelength (see the module documentation).
-#[derive(Clone, Copy)]
+///
+/// Construction bakes what depends only on the material and wavelength
+/// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, and C over
+/// `(u, θh)` when the source of C is T3b; module `bake`), so that `eval`
+/// reads small tables. About 15 KB; `Clone`, not `Copy`.
+#[derive(Clone)]
 pub struct TwoScale<'a> {
     ndf: Epd<'a>,
-    /// T2 restricted to this material's (B, c): a 4-tap 1-D spline per
-    /// lookup instead of 64 taps, same values.
-    sigma_ratio: SigmaRatioSlice<'a>,
+    /// G1 at the material's (β, p).
+    masking: MaskingBake,
+    /// F, Q̄'s factors and σrel/σs over `cos θ`.
+    direction: DirectionBake,
+    /// Q̄'s constants of η (`None` for η = 1: Q̄ = 0).
+    q: Option<QConstants>,
     conv: &'a (dyn Convolution + Sync),
-    /// `conv` restricted to this material's (c, β, p), when it offers one
-    /// (T3b does: 16 taps per lookup instead of 1024, same values).
-    conv_slice: Option<ConvSlice<'a>>,
+    /// `C` over `(u, θh)` for this material, when `conv` offers a slice
+    /// (T3b does); else `conv` is read directly.
+    conv_bake: Option<ConvBake>,
     /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
     surface: Surface,
     lambda: f64,
     /// `B = b / λ`.
     big_b: f64,
-    eta: Complex,
     base: BaseLayer,
     /// `F_dr,int(n)` from T5 (0 for a conductor).
     f_dr_int: f64,
+    /// `Re η` (the varnish index of the base layers).
+    eta_re: f64,
     lambertian: f64,
     options: Options,
 }
 
+/// What one pair of directions gives, independent of the wavelength: the
+/// geometry, D and G (shared by the channels of [`Rgb`]).
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    wi: [f64; 3],
+    wo: [f64; 3],
+    cos_d: f64,
+    cos_h: f64,
+    sin_h: f64,
+    /// D(h).
+    d: f64,
+    /// G(i, o).
+    g: f64,
+}
+
 impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
-    /// Construct once per material and wavelength: with σs > 0 and T3b this
-    /// pre-blends C over the material's (c, β, p) ([`ConvSlice`], ~80 µs).
+    /// Construct once per material and wavelength: it bakes the tables of
+    /// the type's documentation (cost: `cargo bench --bench brdf -- construct`).
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
     /// or ≤ 1 → no diffraction (σs = 0); λ NaN or ≤ 0 → 0.526 µm, λ clamped to
@@ -349,25 +374,35 @@ impl<'a> TwoScale<'a> {
             BaseLayer::Conductor => 0.0,
             _ => f64::from(tables.diffuse_fresnel.f_dr_int(eta.re)),
         };
+        let big_b = f64::from(surface.b) / lambda;
+        let q = QConstants::new(eta);
+        let conv_bake = if surface.sigma_s > 0.0 {
+            tables
+                .convolution
+                .material_slice(surface.c, surface.beta, surface.p)
+                .and_then(|slice| ConvBake::new(&slice, big_b as f32, surface.beta, surface.p))
+        } else {
+            None
+        };
         TwoScale {
+            masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
             ndf,
-            sigma_ratio: tables
-                .sigma_ratio
-                .slice((f64::from(surface.b) / lambda) as f32, surface.c),
+            direction: DirectionBake::new(
+                eta,
+                q.as_ref(),
+                &tables.sigma_ratio,
+                big_b as f32,
+                surface.c,
+            ),
+            q,
             conv: tables.convolution,
-            conv_slice: if surface.sigma_s > 0.0 {
-                tables
-                    .convolution
-                    .material_slice(surface.c, surface.beta, surface.p)
-            } else {
-                None
-            },
+            conv_bake,
             surface,
             lambda,
-            big_b: f64::from(surface.b) / lambda,
-            eta,
+            big_b,
             base,
             f_dr_int,
+            eta_re: f64::from(eta.re),
             lambertian: unit(layer.lambertian),
             options,
         }
@@ -402,38 +437,63 @@ impl<'a> TwoScale<'a> {
         self.options.colour == ColourTerms::White
     }
 
-    /// F(η, cos θ), or 1 for white colour terms.
-    fn fresnel_at(&self, cos: f64) -> f64 {
-        if self.white() {
-            1.0
-        } else {
-            f64::from(fresnel(self.eta, cos as f32))
-        }
+    /// F(η, cos θ) from the direction bake, or 1 for white colour terms.
+    fn fresnel_of(&self, values: &DirectionValues) -> f64 {
+        if self.white() { 1.0 } else { values.fresnel() }
     }
 
-    /// `σrel² (µm²)` for the incidence `cos θi` (and `cos θo` when symmetrised).
-    fn sigma_rel_sq(&self, cos_i: f64, cos_o: f64) -> f64 {
-        let s = &self.surface;
-        let ratio = |cos: f64| f64::from(self.sigma_ratio.sigma_ratio_cos(cos as f32));
-        let ratio_sq = match self.options.sigma_rel {
+    /// F(η, cos θ) (see [`TwoScale::fresnel_of`]).
+    fn fresnel_at(&self, cos: f64) -> f64 {
+        self.fresnel_of(&self.direction.at(cos as f32))
+    }
+
+    /// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
+    fn sigma_ratio_sq(&self, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
+        match self.options.sigma_rel {
             SigmaRelMode::Incident => {
-                let r = ratio(cos_i);
+                let r = at_i.sigma_ratio();
                 r * r
             }
             SigmaRelMode::Symmetrised => {
-                let (a, b) = (ratio(cos_i), ratio(cos_o));
+                let (a, b) = (at_i.sigma_ratio(), at_o.sigma_ratio());
                 0.5 * (a * a + b * b)
             }
-        };
-        let sigma_s = f64::from(s.sigma_s);
-        sigma_s * sigma_s * ratio_sq
+        }
     }
 
-    /// Shadowing–masking G (separable or height-correlated, per the options).
-    fn masking(&self, i: [f32; 3], o: [f32; 3]) -> f64 {
-        f64::from(match self.options.masking {
-            Masking::Separable => self.ndf.g(i, o),
-            Masking::HeightCorrelated => self.ndf.g_height_correlated(i, o),
+    /// The wavelength-independent part of `eval` at `(i, o)`: geometry, D
+    /// and G; `None` below the horizon.
+    fn pair(&self, i: [f32; 3], o: [f32; 3]) -> Option<Pair> {
+        let (wi, wo) = (upper(i)?, upper(o)?);
+        let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        // |i + o| ≥ z_i + z_o > 0.
+        let len = math::sqrt(dot(sum, sum));
+        let h = sum.map(|x| x / len);
+        let cos_d = dot(wi, h).max(0.0).min(1.0);
+        let cos_h = h[2].max(0.0).min(1.0);
+        // sin θh from the tangential components (f64): resolves θh ≪ 1e-3,
+        // which an f32 cos θh cannot.
+        let sin_h = math::sqrt(h[0] * h[0] + h[1] * h[1]).min(1.0);
+        let tangential = |w: [f64; 3]| math::sqrt(w[0] * w[0] + w[1] * w[1]) as f32;
+        let (g1_i, g1_o) = (
+            self.masking.g1(tangential(wi), wi[2] as f32),
+            self.masking.g1(tangential(wo), wo[2] as f32),
+        );
+        let g = match self.options.masking {
+            Masking::Separable => f64::from(g1_i) * f64::from(g1_o),
+            // Λ = 1/G1 − 1; G1 = 0 gives 1/∞ = 0.
+            Masking::HeightCorrelated => {
+                1.0 / (1.0 / f64::from(g1_i) + 1.0 / f64::from(g1_o) - 1.0)
+            }
+        };
+        Some(Pair {
+            wi,
+            wo,
+            cos_d,
+            cos_h,
+            sin_h,
+            d: f64::from(self.ndf.d(to_f32(h))),
+            g,
         })
     }
 
@@ -444,22 +504,30 @@ impl<'a> TwoScale<'a> {
 
     /// The three terms of ρ(i, o) separately.
     pub fn eval_lobes(&self, i: [f32; 3], o: [f32; 3]) -> Lobes {
-        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
-            return Lobes::default();
-        };
+        match self.pair(i, o) {
+            Some(pair) => self.lobes(&pair),
+            None => Lobes::default(),
+        }
+    }
+
+    /// The terms of ρ at a pair (HP17 24-33).
+    fn lobes(&self, pair: &Pair) -> Lobes {
+        let Pair {
+            wi,
+            wo,
+            cos_d,
+            cos_h,
+            sin_h,
+            d,
+            g,
+        } = *pair;
         let (cos_i, cos_o) = (wi[2], wo[2]);
-        let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-        // |i + o| ≥ z_i + z_o > 0.
-        let len = math::sqrt(dot(sum, sum));
-        let h = sum.map(|x| x / len);
-        let cos_d = dot(wi, h).max(0.0).min(1.0);
-        let cos_h = h[2].max(0.0).min(1.0);
-        // sin θh from the tangential components (f64): resolves θh ≪ 1e-3,
-        // which an f32 cos θh cannot.
-        let sin_h = math::sqrt(h[0] * h[0] + h[1] * h[1]).min(1.0);
-        let (i32_, o32, h32) = (to_f32(wi), to_f32(wo), to_f32(h));
-        let g = self.masking(i32_, o32);
+        let (at_i, at_o) = (
+            self.direction.at(cos_i as f32),
+            self.direction.at(cos_o as f32),
+        );
         let s = &self.surface;
+        let sigma_s = f64::from(s.sigma_s);
 
         // A_spec = exp(−x σrel²), x = (4π cos θd / λ)²            (HP17 25)
         let x = {
@@ -467,14 +535,13 @@ impl<'a> TwoScale<'a> {
             t * t
         };
         let sigma_rel_sq = if s.sigma_s > 0.0 {
-            self.sigma_rel_sq(cos_i, cos_o)
+            sigma_s * sigma_s * self.sigma_ratio_sq(&at_i, &at_o)
         } else {
             0.0
         };
         let a_spec = math::exp(-x * sigma_rel_sq);
 
         // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
-        let d = f64::from(self.ndf.d(h32));
         let rho_ct = self.fresnel_at(cos_d) * d * g / (4.0 * cos_i * cos_o);
         let specular = a_spec * rho_ct;
 
@@ -483,9 +550,19 @@ impl<'a> TwoScale<'a> {
             let q = if self.white() {
                 1.0
             } else {
-                f64::from(q_bar(self.eta, i32_, o32))
+                match &self.q {
+                    Some(q) => {
+                        // sin θi sin θo (cos φ, sin φ) with φ = φo − φi − π.
+                        let along = -(wi[0] * wo[0] + wi[1] * wo[1]);
+                        let across = -(wi[0] * wo[1] - wi[1] * wo[0]);
+                        let sin_sin =
+                            math::sqrt(((1.0 - cos_i * cos_i) * (1.0 - cos_o * cos_o)).max(0.0));
+                        q.combine(&at_i.q_factors(), &at_o.q_factors(), sin_sin, along, across)
+                            .max(0.0)
+                    }
+                    None => 0.0,
+                }
             };
-            let sigma_s = f64::from(s.sigma_s);
             let b = f64::from(s.b);
             let x_halo = match self.options.halo_weight {
                 HaloWeight::Printed => x,
@@ -497,13 +574,13 @@ impl<'a> TwoScale<'a> {
             let halo = (f64::from(s.c) - 1.0) * sigma_s * sigma_s * b * b
                 / (2.0 * PI * self.lambda * self.lambda)
                 * one_minus_exp_over(x_halo, sigma_rel_sq);
-            let u = self.big_b * cos_d;
-            let (sin_h, cos_h, u) = (sin_h as f32, cos_h as f32, u as f32);
-            let c_value = f64::from(match &self.conv_slice {
-                Some(slice) => slice.convolution_sin_cos(sin_h, cos_h, u),
-                None => self
-                    .conv
-                    .convolution_sin_cos(sin_h, cos_h, u, s.c, s.beta, s.p),
+            let u = (self.big_b * cos_d) as f32;
+            let c_value = f64::from(match &self.conv_bake {
+                Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
+                None => {
+                    self.conv
+                        .convolution_sin_cos(sin_h as f32, cos_h as f32, u, s.c, s.beta, s.p)
+                }
             });
             let c_value = if c_value > 0.0 { c_value } else { 0.0 };
             q * g * halo * c_value
@@ -514,28 +591,34 @@ impl<'a> TwoScale<'a> {
         Lobes {
             specular: finite_or_zero(specular),
             diffraction: finite_or_zero(diffraction),
-            base: finite_or_zero(self.base_value(cos_i, cos_o)),
+            base: finite_or_zero(self.base_value(&at_i, &at_o, cos_i, cos_o)),
         }
     }
 
     /// `ρ_base + k_d/π` (SPEC §2.6; HP17 42-47).
-    fn base_value(&self, cos_i: f64, cos_o: f64) -> f64 {
+    fn base_value(
+        &self,
+        at_i: &DirectionValues,
+        at_o: &DirectionValues,
+        cos_i: f64,
+        cos_o: f64,
+    ) -> f64 {
         let lambertian = self.lambertian / PI;
-        if self.white() {
+        if self.white() || self.base == BaseLayer::Conductor {
             return lambertian;
         }
-        let transmitted = || (1.0 - self.fresnel_at(cos_i)) * (1.0 - self.fresnel_at(cos_o)); // (HP17 42)
-        let n = f64::from(self.eta.re).abs().max(1e-3);
+        let transmitted = (1.0 - at_i.fresnel()) * (1.0 - at_o.fresnel()); // (HP17 42)
+        let n = self.eta_re.abs().max(1e-3);
         let base = match self.base {
             BaseLayer::Conductor => 0.0,
             BaseLayer::Plastic { albedo } => {
                 // (HP17 43) with SPEC §2.6's corrections (ρd in the bracket, 1/η²).
                 let rho_d = f64::from(albedo);
-                transmitted() * rho_d / (PI * n * n * (1.0 - rho_d * self.f_dr_int))
+                transmitted * rho_d / (PI * n * n * (1.0 - rho_d * self.f_dr_int))
             }
             BaseLayer::Subsurface { albedo } => {
                 let alpha = f64::from(albedo);
-                let t = transmitted();
+                let t = transmitted;
                 // cos θ' of the refracted ray: √(1 − sin²θ / n²).
                 let refracted = |cos: f64| math::sqrt((1.0 - (1.0 - cos * cos) / (n * n)).max(0.0));
                 let single =
@@ -803,7 +886,9 @@ fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
 }
 
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
-#[derive(Clone, Copy)]
+/// The channels share the geometry, D and G of each evaluation (they must
+/// share the surface, as [`Rgb::new`] makes them).
+#[derive(Clone)]
 pub struct Rgb<'a> {
     /// The red, green and blue channels.
     pub channels: [TwoScale<'a>; 3],
@@ -839,11 +924,10 @@ impl<'a> Rgb<'a> {
 
     /// ρ(i, o) per channel.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
-        [
-            self.channels[0].eval(i, o),
-            self.channels[1].eval(i, o),
-            self.channels[2].eval(i, o),
-        ]
+        match self.channels[0].pair(i, o) {
+            Some(pair) => self.channels.each_ref().map(|ch| ch.lobes(&pair).total()),
+            None => [0.0; 3],
+        }
     }
 
     /// The density of [`Rgb::sample`]: the mean of the channels' pdfs (one

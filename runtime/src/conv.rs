@@ -748,7 +748,7 @@ pub const DEFAULT_CUBIC_AXES: [bool; 4] = [true, true, true, true];
 
 /// Catmull–Rom weights of nodes `i−1, i, i+1, i+2` at fraction `t` of cell `i`.
 #[inline]
-fn catmull_rom_weights(t: f32) -> [f32; 4] {
+pub(crate) fn catmull_rom_weights(t: f32) -> [f32; 4] {
     let t2 = t * t;
     let t3 = t2 * t;
     [

@@ -306,31 +306,85 @@ impl Direction {
 /// 0). Finite for every input (at most ≈ 8·10³⁶ with the index cap), never
 /// panics; computed in f64.
 pub fn q_bar(eta: Complex, i: [f32; 3], o: [f32; 3]) -> f32 {
-    let Some(index) = Index::new(eta) else {
+    let Some(q) = QConstants::new(eta) else {
         return 0.0;
     };
     let (di, dout) = (Direction::new(i), Direction::new(o));
     // sin θi sin θo (cos φ, sin φ) with φ = φo − φi − π.
     let along = -(di.x * dout.x + di.y * dout.y);
     let across = -(di.x * dout.y - di.y * dout.x);
-    let r = math::hypot(along, across);
-    let (cos_phi, sin_phi) = if r > 0.0 {
-        (along / r, across / r)
-    } else {
-        (1.0, 0.0)
-    };
-    let (ci, co) = (index.c(di.cos), index.c(dout.cos));
-    let one = C64::real(1.0);
-    let q0 = index.e / (C64::real(di.cos) + ci);
-    let q1 = index.e / (index.eta_sq * di.cos + ci);
-    let q2 = one / (C64::real(dout.cos) + co);
-    let q3 = one / (index.eta_sq * dout.cos + co);
-    let qss = q0 * q2 * cos_phi;
-    let qsp = q0 * q3 * co * sin_phi;
-    let qps = q1 * q2 * ci * sin_phi;
-    let qpp = q1 * q3 * (ci * co * cos_phi - index.eta_sq * (di.sin * dout.sin));
-    let q = qss.norm_sqr() + qsp.norm_sqr() + qps.norm_sqr() + qpp.norm_sqr();
-    ((0.5 * q) as f32).max(0.0).min(f32::MAX)
+    let (fi, fo) = (q.factors(di.cos), q.factors(dout.cos));
+    (q.combine(&fi, &fo, di.sin * dout.sin, along, across) as f32)
+        .max(0.0)
+        .min(f32::MAX)
+}
+
+/// What Q̄ (HP17 10) needs of the index: `|η² − 1|²` and `η²`. With
+/// `c = √(η² − sin²θ)`, `W = 1/(η² cos θ + c)`, `U = c W` and
+/// `a = 1/|cos θ + c|²` per direction ([`QConstants::factors`]),
+///
+/// ```text
+/// Q̄ = |η² − 1|² / 2 · [ a_i a_o cos²φ + (a_i |U_o|² + |U_i|² a_o) sin²φ
+///                       + |U_i U_o cos φ − η² sin θi sin θo W_i W_o|² ]
+/// ```
+///
+/// the four terms of [`q_bar`] with `q0 = (η² − 1)/(cos θi + ci)`,
+/// `q1 = (η² − 1) W_i`, `q2 = 1/(cos θo + co)`, `q3 = W_o` factored out.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct QConstants {
+    index: Index,
+    e_norm_sqr: f64,
+}
+
+/// The per-direction factors of Q̄ at one `cos θ`: `[a, Re U, Im U, Re W, Im W]`.
+pub(crate) type QFactors = [f64; 5];
+
+impl QConstants {
+    /// `None` for `η² = 1` (Q̄ = 0).
+    pub(crate) fn new(eta: Complex) -> Option<QConstants> {
+        let index = Index::new(eta)?;
+        Some(QConstants {
+            index,
+            e_norm_sqr: index.e.norm_sqr(),
+        })
+    }
+
+    /// `[a, U, W]` at `cos θ ∈ [0, 1]` (see the type's documentation).
+    pub(crate) fn factors(&self, cos: f64) -> QFactors {
+        let c = self.index.c(cos);
+        let one = C64::real(1.0);
+        let sum = C64::real(cos) + c;
+        let w = one / (self.index.eta_sq * cos + c);
+        let u = c * w;
+        [1.0 / sum.norm_sqr(), u.re, u.im, w.re, w.im]
+    }
+
+    /// Q̄ from both directions' factors, `sin θi sin θo` and
+    /// `sin θi sin θo (cos φ, sin φ)` (φ is normalised out; φ = 0 when
+    /// either sine is 0).
+    pub(crate) fn combine(
+        &self,
+        fi: &QFactors,
+        fo: &QFactors,
+        sin_sin: f64,
+        along: f64,
+        across: f64,
+    ) -> f64 {
+        let r = math::hypot(along, across);
+        let (cos_phi, sin_phi) = if r > 0.0 {
+            (along / r, across / r)
+        } else {
+            (1.0, 0.0)
+        };
+        let (ui, uo) = (C64::new(fi[1], fi[2]), C64::new(fo[1], fo[2]));
+        let (wi, wo) = (C64::new(fi[3], fi[4]), C64::new(fo[3], fo[4]));
+        let (cos2, sin2) = (cos_phi * cos_phi, sin_phi * sin_phi);
+        let pp = ui * uo * cos_phi - self.index.eta_sq * (wi * wo) * sin_sin;
+        let q = fi[0] * fo[0] * cos2
+            + (fi[0] * uo.norm_sqr() + ui.norm_sqr() * fo[0]) * sin2
+            + pp.norm_sqr();
+        0.5 * self.e_norm_sqr * q
+    }
 }
 
 /// First η node of T5.

@@ -14,6 +14,7 @@
 // `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
 #![allow(clippy::manual_clamp)]
 
+mod bake;
 pub mod brdf;
 pub mod conv;
 pub mod epd;
@@ -29,6 +30,7 @@ pub mod math;
 pub mod mmap;
 pub mod sh;
 pub mod smith;
+pub mod table_set;
 
 pub use brdf::{Rgb, TwoScale};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
@@ -37,3 +39,4 @@ pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};
+pub use table_set::{TableBytes, TableSet, TableSetError, UnknownMaterial};

@@ -129,3 +129,8 @@ pub const PRESETS: [(&str, Material); 5] = [
     ("white-plastic", WHITE_PLASTIC),
     ("marble", MARBLE),
 ];
+
+/// The preset called `name`, if there is one.
+pub fn preset(name: &str) -> Option<Material> {
+    PRESETS.iter().find(|(n, _)| *n == name).map(|(_, m)| *m)
+}

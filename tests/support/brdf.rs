@@ -300,3 +300,21 @@ pub fn chi_square_sampler(
         success: successes as f64 / n as f64,
     }
 }
+
+/// A direction uniform over the upper hemisphere (`cos θ` uniform).
+pub fn random_direction(rng: &mut SplitMix64) -> [f32; 3] {
+    let z = rng.uniform();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * rng.uniform();
+    [(r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32]
+}
+
+/// The `q`-quantile (`q ∈ [0, 1]`, nearest rank) of `values` (sorted in place); 0 if empty.
+pub fn percentile(values: &mut [f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let k = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len()) - 1;
+    values[k]
+}

@@ -170,7 +170,7 @@ impl ModelTables<'_> {
 
 /// The runtime two-scale model as an [`IsotropicBrdf`]: `ρ(wi, wo)` =
 /// `TwoScale::eval` at the directions rounded to f32, widened to f64.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct TwoScaleBrdf<'a>(pub TwoScale<'a>);
 
 impl IsotropicBrdf for TwoScaleBrdf<'_> {

@@ -1,0 +1,323 @@
+//! Per-material bakes: what a [`crate::brdf::TwoScale`] precomputes once so
+//! that a lookup in the inner loop costs a few multiply-adds.
+//!
+//! * [`DirectionBake`]: the quantities of one direction's `cos θ` at one
+//!   wavelength — F(η, cos θ), the factors of Q̄ ([`QConstants::factors`]) and
+//!   σrel/σs (T2) — on 257 nodes even in `√cos θ` (dense at grazing, where σrel
+//!   and F move fastest), linear between nodes.
+//! * [`MaskingBake`]: Smith G1 (T1 at the material's p) on 1025 nodes even in
+//!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
+//!   horizon (G1 = 0).
+//! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 32 × 160
+//!   nodes, `u = B cos θd ∈ [0, B]` even in `ln(1 + u/u₀)` and θh even in
+//!   `x = ln((1 + sin θh / w) / cos θh)`, Catmull–Rom in both (edge cells
+//!   extrapolate linearly: a ghost node on each side). `w` is a quarter of the narrowest core the lobe
+//!   can have, so the core gets nodes and the power-law tail (linear in
+//!   `ln sin θh`) is interpolated almost exactly; the `1/cos θh` term spends
+//!   nodes on the horizon, where `C ∝ cos²θh` and `ln C` diverges. Beyond
+//!   `cos θh = 10⁻³` the last node is used.
+//!
+//! The errors against the direct lookups are measured by the tests beside
+//! each bake (`bake::tests`) and, for the whole BRDF, by `tests/bake.rs`.
+
+use crate::conv::{ConvSlice, catmull_rom_weights};
+use crate::fresnel::{Complex, QConstants, QFactors, fresnel};
+use crate::kcorr::SigmaRatioTable;
+use crate::math;
+use crate::smith::SmithShape;
+
+/// Nodes of [`DirectionBake`].
+const MU_NODES: usize = 257;
+/// Nodes of [`MaskingBake`].
+const MASKING_NODES: usize = 1025;
+/// `u` nodes of [`ConvBake`].
+pub const CONV_U_NODES: usize = 32;
+/// `sin θh` nodes of [`ConvBake`].
+pub const CONV_S_NODES: usize = 160;
+/// [`CONV_U_NODES`] and [`CONV_S_NODES`] with a ghost node at each end.
+const PADDED_U: usize = CONV_U_NODES + 2;
+const PADDED_S: usize = CONV_S_NODES + 2;
+/// `u₀` of the `u` mapping (as T3's `ln(u + 0.1)`).
+const U0: f32 = 0.1;
+/// Smallest `cos θh` of [`ConvBake`]'s angle axis.
+const COS_H_MIN: f64 = 1e-3;
+/// Floor of the stored `ln C` relative to its maximum (C below
+/// `e^−70 C_max` ≈ 4e-31 C_max is stored as that).
+const LN_C_RANGE: f32 = 70.0;
+
+/// Linear-interpolation position on `n` nodes of `x ∈ [0, 1]` (clamped; NaN
+/// gives 0): the cell and the fraction in it.
+#[inline]
+fn cell(x: f32, n: usize) -> (usize, f32) {
+    let last = (n - 1) as f32;
+    let t = (x * last).max(0.0).min(last);
+    let i = (t as usize).min(n - 2);
+    (i, t - i as f32)
+}
+
+/// One direction's quantities at one wavelength (module documentation).
+#[derive(Clone, Debug)]
+pub(crate) struct DirectionBake {
+    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0]` per node.
+    rows: [[f32; 8]; MU_NODES],
+}
+
+/// Interpolated [`DirectionBake`] row at one `cos θ`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DirectionValues {
+    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0]`.
+    pub v: [f32; 8],
+}
+
+impl DirectionValues {
+    /// F(η, cos θ).
+    #[inline]
+    pub fn fresnel(&self) -> f64 {
+        f64::from(self.v[0])
+    }
+
+    /// The factors of Q̄.
+    #[inline]
+    pub fn q_factors(&self) -> QFactors {
+        [1, 2, 3, 4, 5].map(|k| f64::from(self.v[k]))
+    }
+
+    /// σrel/σs.
+    #[inline]
+    pub fn sigma_ratio(&self) -> f64 {
+        f64::from(self.v[6])
+    }
+}
+
+impl DirectionBake {
+    /// Tabulates F and Q̄'s factors of `eta` (when `q` is given) and σrel/σs
+    /// of the spectrum `(B, c)` from T2.
+    pub fn new(
+        eta: Complex,
+        q: Option<&QConstants>,
+        sigma_ratio: &SigmaRatioTable<'_>,
+        big_b: f32,
+        c: f32,
+    ) -> Self {
+        let mut rows = [[0.0f32; 8]; MU_NODES];
+        for (k, row) in rows.iter_mut().enumerate() {
+            let x = k as f64 / (MU_NODES - 1) as f64;
+            let cos = x * x;
+            let factors = q.map(|q| q.factors(cos)).unwrap_or([0.0; 5]);
+            row[0] = fresnel(eta, cos as f32);
+            for (slot, value) in row[1..6].iter_mut().zip(factors) {
+                *slot = value as f32;
+            }
+            row[6] = sigma_ratio.sigma_ratio_cos(cos as f32, big_b, c);
+        }
+        DirectionBake { rows }
+    }
+
+    /// The values at `cos θ` (clamped to [0, 1]).
+    #[inline]
+    pub fn at(&self, cos: f32) -> DirectionValues {
+        let (i, t) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
+        let (a, b) = (&self.rows[i], &self.rows[i + 1]);
+        let mut v = [0.0f32; 8];
+        for k in 0..8 {
+            v[k] = a[k] + t * (b[k] - a[k]);
+        }
+        DirectionValues { v }
+    }
+}
+
+/// Smith G1 at the material's (β, p) (module documentation).
+#[derive(Clone, Debug)]
+pub(crate) struct MaskingBake {
+    beta: f32,
+    g1: [f32; MASKING_NODES],
+}
+
+impl MaskingBake {
+    /// Tabulates `shape` (T1 at p) for slopes `a = β tan θ`.
+    pub fn new(beta: f32, shape: &SmithShape<'_>) -> Self {
+        let mut g1 = [0.0f32; MASKING_NODES];
+        for (k, value) in g1.iter_mut().enumerate() {
+            let y = k as f64 / (MASKING_NODES - 1) as f64;
+            *value = if k + 1 == MASKING_NODES {
+                0.0
+            } else {
+                shape.g1((y / (1.0 - y)) as f32)
+            };
+        }
+        MaskingBake { beta, g1 }
+    }
+
+    /// G1 of a direction with `z = cos θ` and tangential length `r = sin θ`
+    /// (both ≥ 0; 0 at or below the horizon).
+    #[inline]
+    pub fn g1(&self, r: f32, z: f32) -> f32 {
+        if !(z > 0.0) {
+            return 0.0;
+        }
+        // y = a/(1 + a) with a = β r / z, without forming a (z may be tiny).
+        let a_num = self.beta * r;
+        let y = a_num / (a_num + z);
+        let (i, t) = cell(y, MASKING_NODES);
+        self.g1[i] + t * (self.g1[i + 1] - self.g1[i])
+    }
+}
+
+/// `ln C` for one material and wavelength over `(u, sin θh)` (module
+/// documentation).
+#[derive(Clone, Debug)]
+pub(crate) struct ConvBake {
+    /// `(CONV_U_NODES − 1) / ln(1 + B/u₀)`.
+    u_scale: f32,
+    /// `1/w`.
+    inv_w: f32,
+    /// `(CONV_S_NODES − 1) / x_max`, `x_max = ln((1 + 1/w) / cos θh,min)`.
+    s_scale: f32,
+    /// `ln C` row-major `[u][θh]` with one ghost node on each side of both
+    /// axes (linear extrapolation), so that every cell has four taps.
+    ln_c: [f32; PADDED_U * PADDED_S],
+}
+
+impl ConvBake {
+    /// Tabulates `slice` for `u ∈ [0, B]`; `beta`, `p` give the NDF's core
+    /// width. `None` when `B` is not positive and finite.
+    pub fn new(slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> Option<Self> {
+        if !(big_b > 0.0 && big_b.is_finite()) {
+            return None;
+        }
+        let u_span = math::lnf(1.0 + big_b / U0);
+        // The narrowest core: the kernel at u = B (width ~1/(2B) in sin θh),
+        // or the NDF's, where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
+        let kernel_width = 0.5 / big_b;
+        let ndf_width = beta * math::powff(0.1, 0.5 / p);
+        let w = (0.25 * kernel_width.max(ndf_width)).max(1e-6).min(0.25);
+        let angle_x =
+            |theta: f64| math::ln((1.0 + math::sin(theta) / f64::from(w)) / math::cos(theta));
+        let theta_max = math::acos(COS_H_MIN);
+        let s_span = angle_x(theta_max);
+        // θh of each node, by bisection of the increasing x(θh).
+        let mut tans = [0.0f64; CONV_S_NODES];
+        for (k, tan) in tans.iter_mut().enumerate() {
+            let target = k as f64 / (CONV_S_NODES - 1) as f64 * s_span;
+            let (mut lo, mut hi) = (0.0, theta_max);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if angle_x(mid) < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let theta = 0.5 * (lo + hi);
+            *tan = math::sin(theta) / math::cos(theta);
+        }
+        let s_span = s_span as f32;
+        let mut ln_c = [0.0f32; PADDED_U * PADDED_S];
+        let mut top = f32::MIN;
+        for j in 0..CONV_U_NODES {
+            let x_u = j as f32 / (CONV_U_NODES - 1) as f32 * u_span;
+            let u = U0 * math::expf(x_u) - U0;
+            let u = if j + 1 == CONV_U_NODES { big_b } else { u };
+            for (k, &tau) in tans.iter().enumerate() {
+                let c = slice.at_tan(tau, u);
+                let v = if c > 0.0 { math::lnf(c) } else { f32::MIN };
+                top = top.max(v);
+                ln_c[(j + 1) * PADDED_S + k + 1] = v;
+            }
+        }
+        let floor = if top > f32::MIN {
+            top - LN_C_RANGE
+        } else {
+            0.0
+        };
+        for v in ln_c.iter_mut() {
+            *v = v.max(floor);
+        }
+        // Ghost nodes: along θh in the real rows, then along u in every column.
+        for j in 1..=CONV_U_NODES {
+            let row = &mut ln_c[j * PADDED_S..(j + 1) * PADDED_S];
+            row[0] = 2.0 * row[1] - row[2];
+            row[PADDED_S - 1] = 2.0 * row[PADDED_S - 2] - row[PADDED_S - 3];
+        }
+        for k in 0..PADDED_S {
+            let at = |j: usize| j * PADDED_S + k;
+            ln_c[at(0)] = 2.0 * ln_c[at(1)] - ln_c[at(2)];
+            ln_c[at(PADDED_U - 1)] = 2.0 * ln_c[at(PADDED_U - 2)] - ln_c[at(PADDED_U - 3)];
+        }
+        Some(ConvBake {
+            u_scale: (CONV_U_NODES - 1) as f32 / u_span,
+            inv_w: 1.0 / w,
+            s_scale: (CONV_S_NODES - 1) as f32 / s_span,
+            ln_c,
+        })
+    }
+
+    /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
+    #[inline]
+    pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
+        let x_u = math::lnf(1.0 + u.max(0.0) / U0) * self.u_scale;
+        let x_h = (1.0 + sin_h.max(0.0).min(1.0) * self.inv_w) / cos_h.max(COS_H_MIN as f32);
+        let x_s = math::lnf(x_h) * self.s_scale;
+        let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
+        let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);
+        let mut ln_c = 0.0f32;
+        for (a, wa) in wu.iter().enumerate() {
+            let start = (ju + a) * PADDED_S + ks;
+            let taps = self.ln_c.get(start..start + 4).unwrap_or(&[0.0; 4]);
+            let along: f32 = taps.iter().zip(ws).map(|(v, w)| v * w).sum();
+            ln_c += wa * along;
+        }
+        let value = math::expf(ln_c);
+        if value.is_finite() { value } else { 0.0 }
+    }
+}
+
+/// The first of the four padded node indices (the cell's index, as the
+/// padding shifts nodes by one) and the Catmull–Rom weights at position `x`
+/// (in nodes, clamped to `[0, n − 1]`).
+#[inline]
+fn catmull_rom(x: f32, n: usize) -> (usize, [f32; 4]) {
+    let (i, t) = cell(x / (n - 1) as f32, n);
+    (i, catmull_rom_weights(t))
+}
+
+#[cfg(all(test, feature = "embedded"))]
+mod tests {
+    use super::*;
+    use crate::TableSet;
+
+    /// A small deterministic generator of uniforms in [0, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn conv_bake_reproduces_the_slice() {
+        let set = TableSet::embedded();
+        let mut rng = Lcg(7);
+        for &(c, beta, p, big_b) in &[(2.0f32, 0.0598f32, 1.0f32, 9.2f32), (2.5, 0.35, 1.5, 12.0)] {
+            let slice = set.convolution.slice(c, beta, p).unwrap();
+            let bake = ConvBake::new(&slice, big_b, beta, p).unwrap();
+            let mut worst = (0.0f64, 0.0, 0.0);
+            for _ in 0..2000 {
+                let theta = rng.next() * 1.5;
+                let u = (rng.next() as f32) * big_b;
+                let (s, co) = (math::sin(theta), math::cos(theta));
+                let direct = slice.at_tan(s / co, u);
+                let baked = bake.at(s as f32, co as f32, u);
+                let e = (f64::from(baked) / f64::from(direct) - 1.0).abs();
+                if e > worst.0 {
+                    worst = (e, theta, f64::from(u));
+                }
+            }
+            std::eprintln!("{c} {beta} {p} {big_b}: worst {worst:?}");
+        }
+    }
+}

@@ -1,0 +1,141 @@
+//! The per-material bake against the unbaked model: the same `TwoScale`
+//! with C read from T3b directly (a source that offers no material slice, so
+//! nothing of C is baked) on 10⁵ random direction pairs, for every preset
+//! and for random materials over the domain.
+//!
+//! The target is a relative error of ρ with p99 ≤ 0.5%. It is not met
+//! everywhere yet: `cargo test --release --test bake -- --include-ignored
+//! --nocapture` prints the figures (docs/design/per-material-bake.md). The
+//! tests that run by default hold the bake to what it achieves on the
+//! presets and to T3b's own pointwise budget on random materials, so that a
+//! change that makes it worse fails.
+
+use generator::rng::SplitMix64;
+use suite::brdf::{percentile, random_direction};
+use twoscale::brdf::{Material, Options, Rgb, Surface};
+use twoscale::conv::{ConvTable, Convolution};
+use twoscale::{Complex, TableSet};
+
+/// T3b without its material slice: C straight from the 4-D table.
+struct Unbaked<'a>(ConvTable<'a>);
+
+impl Convolution for Unbaked<'_> {
+    fn convolution_sin_cos(&self, s: f32, c: f32, u: f32, k: f32, b: f32, p: f32) -> f32 {
+        self.0.convolution_sin_cos(s, c, u, k, b, p)
+    }
+}
+
+/// Relative errors of the baked RGB model against the unbaked one, every
+/// channel, at `pairs` random direction pairs (uniform over the hemisphere).
+fn errors(set: &TableSet<'_>, material: &Material, pairs: usize, seed: u64) -> Vec<f64> {
+    let unbaked_source = Unbaked(set.convolution);
+    let mut unbaked_tables = set.brdf_tables();
+    unbaked_tables.convolution = &unbaked_source;
+    let baked = set.rgb(material, Options::default());
+    let unbaked = Rgb::new(&unbaked_tables, material, Options::default());
+    let mut rng = SplitMix64::new(seed);
+    let mut out = Vec::with_capacity(3 * pairs);
+    for _ in 0..pairs {
+        let (i, o) = (random_direction(&mut rng), random_direction(&mut rng));
+        let (x, y) = (baked.eval(i, o), unbaked.eval(i, o));
+        for k in 0..3 {
+            assert!(x[k].is_finite() && x[k] >= 0.0, "{x:?} at {i:?}, {o:?}");
+            if y[k] > 0.0 {
+                out.push((f64::from(x[k]) / f64::from(y[k]) - 1.0).abs());
+            }
+        }
+    }
+    out
+}
+
+fn report(name: &str, mut e: Vec<f64>) -> f64 {
+    let (p50, p99, max) = (
+        percentile(&mut e, 0.5),
+        percentile(&mut e, 0.99),
+        percentile(&mut e, 1.0),
+    );
+    eprintln!("{name:>28}: median {p50:.2e}, p99 {p99:.2e}, max {max:.2e}");
+    p99
+}
+
+/// Random conductors over the domain of T3 (β ∈ [0.002, 1] log-uniform,
+/// p ∈ [0.2, 5], c ∈ [1.01, 10]) and of the model's lengths (σs from 0.002 to
+/// 0.1 µm, b from 0.5 to 20 µm: B = b/λ up to 45).
+fn random_materials(count: u64) -> Vec<Material> {
+    let mut rng = SplitMix64::new(2026);
+    let log_uniform = |rng: &mut SplitMix64, lo: f64, hi: f64| {
+        (lo.ln() + rng.uniform() * (hi / lo).ln()).exp() as f32
+    };
+    (0..count)
+        .map(|_| Material {
+            layer: twoscale::brdf::Layer {
+                surface: Surface {
+                    beta: log_uniform(&mut rng, 0.002, 1.0),
+                    p: (0.2 + 4.8 * rng.uniform()) as f32,
+                    sigma_s: log_uniform(&mut rng, 0.002, 0.1),
+                    b: log_uniform(&mut rng, 0.5, 20.0),
+                    c: (1.01 + 8.99 * rng.uniform()) as f32,
+                },
+                base: twoscale::brdf::BaseLayer::Conductor,
+                lambertian: 0.0,
+            },
+            eta_rgb: [
+                Complex::new(0.2, 3.6),
+                Complex::new(0.6, 2.2),
+                Complex::new(1.4, 1.9),
+            ],
+        })
+        .collect()
+}
+
+/// p99 of every preset and of all random materials together.
+fn measure() -> (Vec<(&'static str, f64)>, f64) {
+    let set = TableSet::embedded();
+    let presets = twoscale::materials::PRESETS
+        .iter()
+        .enumerate()
+        .map(|(k, (name, material))| {
+            (
+                *name,
+                report(name, errors(&set, material, 100_000, 100 + k as u64)),
+            )
+        })
+        .collect();
+    let mut all = Vec::new();
+    for (m, material) in random_materials(20).iter().enumerate() {
+        let e = errors(&set, material, 5_000, 500 + m as u64);
+        let s = material.layer.surface;
+        let label = format!(
+            "β {:.4} p {:.2} c {:.2} B {:.1}",
+            s.beta,
+            s.p,
+            s.c,
+            s.b / 0.526
+        );
+        report(&label, e.clone());
+        all.extend(e);
+    }
+    (presets, report("all random materials", all))
+}
+
+#[test]
+#[ignore = "target not met yet: p99 0.70% (gold-hp17-geometry) and 4.3% (random materials)"]
+fn baked_model_is_within_half_a_percent_at_p99() {
+    let (presets, random) = measure();
+    for (name, p99) in presets {
+        assert!(p99 <= 5e-3, "{name}: p99 {p99:.2e} > 0.5%");
+    }
+    assert!(random <= 5e-3, "random materials: p99 {random:.2e} > 0.5%");
+}
+
+/// The bake as it is: presets within 1% at p99 (the worst measures 0.70%),
+/// random materials within 5% at p99 — T3b's own pointwise p95 target — so
+/// the bake never dominates the table's error budget.
+#[test]
+fn baked_model_stays_within_the_t3b_error_budget() {
+    let (presets, random) = measure();
+    for (name, p99) in presets {
+        assert!(p99 <= 1e-2, "{name}: p99 {p99:.2e} > 1%");
+    }
+    assert!(random <= 5e-2, "random materials: p99 {random:.2e} > 5%");
+}
