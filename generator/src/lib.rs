@@ -2,7 +2,7 @@
 //! reference implementation every table is measured against.
 //!
 //! - [`quad`]: adaptive quadrature that reports convergence;
-//! - [`reference`]: the f64 reference of SPEC §2 (EPD, Smith Λ, K-correlation, …);
+//! - [`reference`](mod@reference): the f64 reference of SPEC §2 (EPD, Smith Λ, K-correlation, …);
 //! - [`tables`]: one module per table: build (parallel, deterministic) and verify;
 //! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
 //!   forms of the convolution, table T3);

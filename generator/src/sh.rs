@@ -1,5 +1,5 @@
 //! Projection of an isotropic BRDF onto the spherical-harmonic matrix of T4
-//! ([WAT92] §2, SPEC §2.9), generic over the BRDF.
+//! (\[WAT92\] §2, SPEC §2.9), generic over the BRDF.
 //!
 //! The layout, the odd completion and the real-SH convention are documented
 //! in `twoscale::sh`. Block `m` of the matrix is
@@ -124,7 +124,7 @@ pub fn default_quadrature(band_limit: usize) -> Quadrature {
     }
 }
 
-/// The half-Gaussian band filter of [WAT92] §2.5: coefficient `M_jk` is
+/// The half-Gaussian band filter of \[WAT92\] §2.5: coefficient `M_jk` is
 /// multiplied by `h(l_j) h(l_k)`, `h(l) = exp(−(l − start)² / (2 width²))` for
 /// `l > start`, 1 otherwise.
 #[derive(Clone, Copy, Debug, PartialEq)]

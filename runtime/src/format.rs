@@ -70,7 +70,7 @@ pub enum TableId {
     /// the EPD NDF over (u, c, β, p): the paper's `s, g` (T3a) and `ln C` at
     /// 32 normalised angles (T3b) per node; see [`crate::conv`].
     Convolution = 4,
-    /// T4: spherical-harmonic BRDF matrix of one material ([WAT92] §2, SPEC
+    /// T4: spherical-harmonic BRDF matrix of one material (\[WAT92\] §2, SPEC
     /// §2.9), one channel per wavelength; see [`crate::sh`].
     ShBrdf = 6,
 }
@@ -119,7 +119,7 @@ impl TableId {
                 "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, SPEC 2.6); cubic B-spline coefficients"
             }
             TableId::Convolution => {
-                "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); multilinear in the parameters"
+                "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); u16 codes per node; Catmull-Rom in the parameters and in xi"
             }
             TableId::ShBrdf => {
                 "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, SPEC 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
@@ -258,7 +258,10 @@ impl Quantised<'_> {
 #[derive(TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
 pub enum Kernel {
-    /// n-linear interpolation of the samples at the nodes: `nodes` values per axis.
+    /// The payload holds values at the nodes (not spline coefficients),
+    /// `nodes` values per axis: `interp::Grid` blends them n-linearly (T1),
+    /// T3's reader with Catmull–Rom weights (`crate::conv`); T4's are the
+    /// packed SH matrix (`crate::sh`).
     Multilinear = 1,
     /// Uniform cubic B-spline in the mapped coordinates: the payload holds the
     /// spline's coefficients, `nodes + 2` per axis (one beyond each end node),

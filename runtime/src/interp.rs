@@ -1,5 +1,6 @@
-//! Axis mappings and the one n-linear interpolator every table uses
-//! (bilinear for T1, trilinear for T2, quadrilinear for T3).
+//! Axis mappings and the grid interpolator [`Grid`] of T1 (bilinear), T2
+//! (tricubic B-spline) and T5 (cubic B-spline). T3 uses [`Axis`] from here
+//! with its own Catmull–Rom blend (`crate::conv`); T4 is read by `crate::sh`.
 //!
 //! An [`Axis`] turns a physical value `x` into a position between two nodes:
 //! a cell index `i` and a fraction `t ∈ [0, 1]`, by mapping `x` to the coordinate

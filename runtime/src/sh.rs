@@ -1,11 +1,11 @@
-//! T4: spherical-harmonic BRDF matrices ([WAT92] §2, SPEC §2.9), and the real
+//! T4: spherical-harmonic BRDF matrices (\[WAT92\] §2, SPEC §2.9), and the real
 //! spherical harmonics they are built on.
 //!
 //! # The representation
 //!
 //! For one material and one wavelength, the function represented is
 //! `f(i, o) = ρ(i, o) cos θi cos θo` on the upper hemispheres, completed to the
-//! whole sphere by the odd reflection of [WAT92] §2.5:
+//! whole sphere by the odd reflection of \[WAT92\] §2.5:
 //! `f(θi, φi, π − θo, φo) = −f(θi, φi, θo, φo)`, and the same in `i`. Since
 //! `Y_lm(π − θ, φ) = (−1)^(l+m) Y_lm(θ, φ)`, every coefficient with `l + m`
 //! even vanishes, and
@@ -74,7 +74,7 @@
 //! A truncated SH series cannot follow a lobe narrower than about `1/L`
 //! radians; glossy materials need `L ~ 1/width` and the table grows like `L³`.
 //! Dividing by `cos θi cos θo` magnifies the truncation error near grazing
-//! ([WAT92] §5). Measured figures are in the README (T4 section).
+//! (\[WAT92\] §5). Measured figures are in the README (T4 section).
 
 // Index loops mirror the recurrences and the block formulas of the docs.
 #![allow(clippy::needless_range_loop)]
@@ -97,7 +97,7 @@ pub const MAX_CHANNELS: usize = 3;
 ///
 /// - `band_limit`: L, the largest degree stored;
 /// - `filter_start`, `filter_width`: the half-Gaussian band filter of
-///   [WAT92] §2.5: every coefficient `M_jk` is multiplied by `h(l_j) h(l_k)`,
+///   \[WAT92\] §2.5: every coefficient `M_jk` is multiplied by `h(l_j) h(l_k)`,
 ///   `h(l) = exp(−(l − l_f)² / (2 w²))` for `l > l_f`, 1 otherwise; `w = 0`
 ///   means no filter;
 /// - `lambda_0..2`: the wavelength of each channel, µm (0 for absent channels);

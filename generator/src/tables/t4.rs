@@ -1,5 +1,5 @@
 //! T4: the spherical-harmonic BRDF matrix of each material of the materials
-//! file ([WAT92] §2, SPEC §2.9), one file `t4-<material>.tbl` per material,
+//! file (\[WAT92\] §2, SPEC §2.9), one file `t4-<material>.tbl` per material,
 //! one channel per wavelength. Layout and conventions: `twoscale::sh`;
 //! projection: [`crate::sh`].
 //!
@@ -64,7 +64,7 @@ pub const INPUTS: [TableId; 4] = [
 
 /// Verification target: `max |f_SH − f| / max f` over the random pairs, with
 /// `f = ρ cos θi cos θo` (what the matrix represents; dividing by the cosines
-/// magnifies any error near grazing, [WAT92] §5). The maximum is always at
+/// magnifies any error near grazing, \[WAT92\] §5). The maximum is always at
 /// grazing incidence and exitance near the mirror azimuth, where the specular
 /// peak is narrower in `Δφ` than any band limit can follow. The target, 0.5,
 /// only catches a broken table; the p99 and median are the figures to read
