@@ -14,10 +14,10 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use suite::brdf::{BrdfTables, NarrowNdfConvolution};
-use twoscale::brdf::TwoScale;
-use twoscale::materials::HP17_NICKEL_SURFACE;
-use twoscale::{Complex, ConvTable, Convolution, TableId};
+use suite::brdf::NarrowNdfConvolution;
+use twoscale::brdf::{Options, Rgb, TwoScale};
+use twoscale::materials::{HP17_NICKEL_SURFACE, PRESETS};
+use twoscale::{Complex, Convolution, TableSet};
 
 const BATCH: usize = 1024;
 const LAMBDA: f32 = 0.526;
@@ -56,6 +56,68 @@ impl Ggx {
         let f = twoscale::fresnel::fresnel(self.eta, cos_d);
         f * d * self.g1(i) * self.g1(o) / (4.0 * i[2] * o[2])
     }
+
+    /// The RGB GGX conductor: D and G once, Fresnel per channel.
+    #[inline]
+    fn eval_rgb(&self, etas: &[Complex; 3], i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
+        if !(i[2] > 0.0 && o[2] > 0.0) {
+            return [0.0; 3];
+        }
+        let s = [i[0] + o[0], i[1] + o[1], i[2] + o[2]];
+        let inv = 1.0 / libm::sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        let h = s.map(|x| x * inv);
+        let cos_d = (i[0] * h[0] + i[1] * h[1] + i[2] * h[2]).clamp(0.0, 1.0);
+        let a2 = self.alpha * self.alpha;
+        let c2 = h[2] * h[2];
+        let t = a2 * c2 + (1.0 - c2);
+        let d = a2 / (core::f32::consts::PI * t * t);
+        let dg = d * self.g1(i) * self.g1(o) / (4.0 * i[2] * o[2]);
+        etas.map(|eta| twoscale::fresnel::fresnel(eta, cos_d) * dg)
+    }
+
+    /// Samples a visible normal (Heitz 2018, "Sampling the GGX Distribution
+    /// of Visible Normals", JCGT 7(4)), reflects `i` about it, and returns
+    /// the direction, its pdf `D_i(h) / (4 i·h)` and the eval there.
+    #[inline]
+    fn sample_eval(&self, i: [f32; 3], u: [f32; 2]) -> Option<([f32; 3], f32, f32)> {
+        let a = self.alpha;
+        let vh = [a * i[0], a * i[1], i[2]];
+        let l = libm::sqrtf(vh[0] * vh[0] + vh[1] * vh[1] + vh[2] * vh[2]);
+        let vh = vh.map(|x| x / l);
+        let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+        let t1 = if lensq > 0.0 {
+            let inv = 1.0 / libm::sqrtf(lensq);
+            [-vh[1] * inv, vh[0] * inv, 0.0]
+        } else {
+            [1.0, 0.0, 0.0]
+        };
+        let t2 = [
+            vh[1] * t1[2] - vh[2] * t1[1],
+            vh[2] * t1[0] - vh[0] * t1[2],
+            vh[0] * t1[1] - vh[1] * t1[0],
+        ];
+        let r = libm::sqrtf(u[0]);
+        let phi = 2.0 * core::f32::consts::PI * u[1];
+        let p1 = r * libm::cosf(phi);
+        let s = 0.5 * (1.0 + vh[2]);
+        let p2 = (1.0 - s) * libm::sqrtf((1.0 - p1 * p1).max(0.0)) + s * r * libm::sinf(phi);
+        let p3 = libm::sqrtf((1.0 - p1 * p1 - p2 * p2).max(0.0));
+        let nh = [0, 1, 2].map(|k| p1 * t1[k] + p2 * t2[k] + p3 * vh[k]);
+        let m = [a * nh[0], a * nh[1], nh[2].max(0.0)];
+        let lm = libm::sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        let m = m.map(|x| x / lm);
+        let k = 2.0 * (i[0] * m[0] + i[1] * m[1] + i[2] * m[2]);
+        let o = [k * m[0] - i[0], k * m[1] - i[1], k * m[2] - i[2]];
+        if !(o[2] > 0.0) {
+            return None;
+        }
+        let a2 = a * a;
+        let c2 = m[2] * m[2];
+        let t = a2 * c2 + (1.0 - c2);
+        let d = a2 / (core::f32::consts::PI * t * t);
+        let pdf = self.g1(i) * d / (4.0 * i[2]);
+        Some((o, pdf, self.eval(i, o)))
+    }
 }
 
 fn direction(rng: &mut generator::rng::SplitMix64) -> [f32; 3] {
@@ -67,19 +129,17 @@ fn direction(rng: &mut generator::rng::SplitMix64) -> [f32; 3] {
 }
 
 fn brdf(c: &mut Criterion) {
-    let owned = BrdfTables::load();
+    let set = TableSet::embedded();
     let standin = std::env::var_os("TWOSCALE_BENCH_STANDIN").is_some();
-    let t3 = (!standin).then(|| suite::read_table(TableId::Convolution));
-    let table = t3
-        .as_ref()
-        .map(|buf| ConvTable::from_bytes(buf.bytes()).expect("valid T3"));
+    let table = (!standin).then_some(set.convolution);
     let fit = table.as_ref().map(|t| t.fit());
     let narrow = NarrowNdfConvolution;
     let (conv, suffix): (&(dyn Convolution + Sync), &str) = match &table {
         Some(t) => (t, "t3b"),
         None => (&narrow, "standin_c"),
     };
-    let tables = owned.tables(conv);
+    let mut tables = set.brdf_tables();
+    tables.convolution = conv;
     let model = TwoScale::conductor(&tables, HP17_NICKEL_SURFACE, LAMBDA, NICKEL_LIKE);
     let ggx = Ggx {
         alpha: HP17_NICKEL_SURFACE.beta,
@@ -118,7 +178,8 @@ fn brdf(c: &mut Criterion) {
         })
     });
     if let Some(fit) = &fit {
-        let tables_fit = owned.tables(fit);
+        let mut tables_fit = set.brdf_tables();
+        tables_fit.convolution = fit;
         let model_fit = TwoScale::conductor(&tables_fit, HP17_NICKEL_SURFACE, LAMBDA, NICKEL_LIKE);
         group.bench_function("two_scale_eval_t3a", |b| {
             b.iter(|| {
@@ -152,7 +213,66 @@ fn brdf(c: &mut Criterion) {
             sum
         })
     });
+    // RGB: a preset from the table set against the RGB GGX conductor.
+    let gold = set.material("gold-hp17-geometry").expect("preset");
+    let gold_eta = PRESETS
+        .iter()
+        .find(|(n, _)| *n == "gold-hp17-geometry")
+        .map(|(_, m)| m.eta_rgb)
+        .expect("preset");
+    group.bench_function("ggx_cook_torrance_eval_rgb", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += ggx.eval_rgb(&gold_eta, black_box(i), black_box(o))[1];
+            }
+            sum
+        })
+    });
+    group.bench_function(format!("two_scale_eval_rgb_{suffix}"), |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += gold.eval(black_box(i), black_box(o))[1];
+            }
+            sum
+        })
+    });
+    group.bench_function("ggx_vndf_sample_and_eval", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, u) in &uniforms {
+                if let Some((_, pdf, value)) = ggx.sample_eval(black_box(i), [u[1], u[2]]) {
+                    sum += value / pdf;
+                }
+            }
+            sum
+        })
+    });
     group.finish();
+
+    // Construction: one wavelength, and the RGB model of a preset.
+    let mut setup = c.benchmark_group("construct");
+    setup.bench_function("two_scale_new", |b| {
+        b.iter(|| {
+            TwoScale::conductor(
+                &set.brdf_tables(),
+                black_box(HP17_NICKEL_SURFACE),
+                LAMBDA,
+                NICKEL_LIKE,
+            )
+        })
+    });
+    setup.bench_function("rgb_preset", |b| {
+        b.iter(|| {
+            Rgb::new(
+                &set.brdf_tables(),
+                black_box(&PRESETS[0].1),
+                Options::default(),
+            )
+        })
+    });
+    setup.finish();
 }
 
 criterion_group!(benches, brdf);
