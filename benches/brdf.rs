@@ -138,8 +138,7 @@ fn brdf(c: &mut Criterion) {
         Some(t) => (t, "t3b"),
         None => (&narrow, "standin_c"),
     };
-    let mut tables = set.brdf_tables();
-    tables.convolution = conv;
+    let tables = set.brdf_tables_with(conv);
     let model = TwoScale::conductor(&tables, HP17_NICKEL_SURFACE, LAMBDA, NICKEL_LIKE);
     let ggx = Ggx {
         alpha: HP17_NICKEL_SURFACE.beta,
@@ -178,8 +177,7 @@ fn brdf(c: &mut Criterion) {
         })
     });
     if let Some(fit) = &fit {
-        let mut tables_fit = set.brdf_tables();
-        tables_fit.convolution = fit;
+        let tables_fit = set.brdf_tables_with(fit);
         let model_fit = TwoScale::conductor(&tables_fit, HP17_NICKEL_SURFACE, LAMBDA, NICKEL_LIKE);
         group.bench_function("two_scale_eval_t3a", |b| {
             b.iter(|| {

@@ -356,7 +356,7 @@ fn sh_brdf(c: &mut Criterion) {
     group.throughput(Throughput::Elements(pairs.len() as u64));
     let inputs = generator::tables::t4::ModelInputs::load(&suite::tables_dir()).unwrap();
     let parsed = inputs.parse().unwrap();
-    let model_tables = parsed.tables();
+    let model_tables = parsed.brdf_tables();
     for material in &materials.materials {
         let Some(l) = material.band_limit else {
             continue;

@@ -29,8 +29,7 @@ impl Convolution for Unbaked<'_> {
 /// channel, at `pairs` random direction pairs (uniform over the hemisphere).
 fn errors(set: &TableSet<'_>, material: &Material, pairs: usize, seed: u64) -> Vec<f64> {
     let unbaked_source = Unbaked(set.convolution);
-    let mut unbaked_tables = set.brdf_tables();
-    unbaked_tables.convolution = &unbaked_source;
+    let unbaked_tables = set.brdf_tables_with(&unbaked_source);
     let baked = set.rgb(material, Options::default());
     let unbaked = Rgb::new(&unbaked_tables, material, Options::default());
     let mut rng = SplitMix64::new(seed);

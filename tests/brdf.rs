@@ -3,20 +3,20 @@
 //! reciprocity, the white furnace, χ² tests of the samplers against their
 //! pdfs, robustness over a dense sweep, and agreement with the f64 reference.
 //!
-//! C comes from stand-ins until T3 exists (see `suite::brdf`): the exact
+//! The tables are the embedded `TableSet`. C comes from stand-ins where the
+//! test is about something else than T3 (see `suite::brdf`): the exact
 //! reference through `ExactConvolution` where few evaluations are needed, a
 //! tabulated exact profile (`ProfileConvolution`) for the furnace, and the
 //! narrow-NDF limit where C's accuracy does not matter (sampling, sweeps).
-//! Swapping in T3b is a change of the `&dyn Convolution` passed to
-//! `BrdfTables::tables`.
+//! Those sources offer no material slice, so C is read directly; every other
+//! part of the model (F, Q̄, σrel, G1) is the baked one. The C bake is
+//! measured against T3b in `tests/bake.rs`.
 
 use generator::reference::brdf::{self as reference, ExactConvolution};
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
 use std::sync::Mutex;
-use suite::brdf::{
-    BrdfTables, NarrowNdfConvolution, ProfileConvolution, chi_square_sampler, random_direction,
-};
+use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_sampler, random_direction};
 use twoscale::Complex;
 use twoscale::brdf::{
     BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, Options, SigmaRelMode, Surface,
@@ -59,9 +59,9 @@ fn from_angles(theta: f64, phi: f64) -> [f32; 3] {
 /// here in closed form (F from the f64 reference).
 #[test]
 fn sigma_s_zero_p_one_is_beckmann_cook_torrance() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let conv = NarrowNdfConvolution;
-    let tables = owned.tables(&conv);
+    let tables = set.brdf_tables_with(&conv);
     let eta = generator::reference::fresnel::Complex64::new(1.98, 3.74);
     let lambda_b = |alpha: f64, w: [f64; 3]| {
         let tan = w[0].hypot(w[1]) / w[2];
@@ -140,9 +140,9 @@ fn sigma_s_zero_p_one_is_beckmann_cook_torrance() {
 /// (σrel(θi)) with the exact C.
 #[test]
 fn reciprocity() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let stub = NarrowNdfConvolution;
-    let tables = owned.tables(&stub);
+    let tables = set.brdf_tables_with(&stub);
     let mut rng = SplitMix64::new(11);
     let rel = |a: f32, b: f32| {
         let (a, b) = (f64::from(a), f64::from(b));
@@ -188,7 +188,7 @@ fn reciprocity() {
 
     // The paper's model with the exact C: report the asymmetry.
     let exact = ExactConvolution;
-    let tables = owned.tables(&exact);
+    let tables = set.brdf_tables_with(&exact);
     let model = TwoScale::conductor(
         &tables,
         surface(0.0598, 1.0, 0.0273, 4.8418, 2.0),
@@ -226,7 +226,7 @@ fn reciprocity() {
 /// C is the exact profile tabulated per material (`ProfileConvolution`).
 #[test]
 fn white_furnace() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let lambda = 0.526f32;
     let materials = [
         ("hp17-nickel", surface(0.0598, 1.0, 0.0273, 4.8418, 2.0)),
@@ -250,7 +250,7 @@ fn white_furnace() {
         )
     {
         let conv = ProfileConvolution::new(s.c, s.beta, s.p, f64::from(s.b / lambda) * 1.0001);
-        let tables = owned.tables(&conv);
+        let tables = set.brdf_tables_with(&conv);
         let options = Options {
             colour: ColourTerms::White,
             halo_weight,
@@ -323,7 +323,7 @@ fn white_furnace() {
 /// incidence the real Q̄ can push a strong halo above 1: gold-rough).
 #[test]
 fn preset_albedos() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let incidences = [0.0, 45.0, 70.0, 85.0];
     let n = 20_000;
     let mut table = String::from(
@@ -334,7 +334,7 @@ fn preset_albedos() {
         let s = material.layer.surface;
         let u_max = f64::from(s.b / twoscale::brdf::RGB_WAVELENGTHS[2]) * 1.0001;
         let conv = ProfileConvolution::new(s.c, s.beta, s.p, u_max);
-        let tables = owned.tables(&conv);
+        let tables = set.brdf_tables_with(&conv);
         let rgb = twoscale::Rgb::new(&tables, &material, Options::default());
         for deg in incidences {
             let i = from_angles(f64::to_radians(deg), 0.7);
@@ -378,9 +378,9 @@ fn preset_albedos() {
 /// success rate.
 #[test]
 fn sampling_matches_pdf() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let stub = NarrowNdfConvolution;
-    let tables = owned.tables(&stub);
+    let tables = set.brdf_tables_with(&stub);
     let lambda = 0.526f32;
     let materials: [(&str, Layer); 4] = [
         ("narrow", conductor(surface(0.004, 0.6, 0.008, 2.0, 1.8))),
@@ -518,9 +518,9 @@ fn sampling_matches_pdf() {
 /// The 2015 model: exact vs printed energy, and its sampler's χ².
 #[test]
 fn hp15_model() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let stub = NarrowNdfConvolution;
-    let tables = owned.tables(&stub);
+    let tables = set.brdf_tables_with(&stub);
     let lambda = 0.526f32;
     // Diffraction lobe alone, G ≈ 1 (β tiny): ∫ ρ cos θo dωo at normal
     // incidence is k_w/λ⁴ · E_exact/E (k_w chosen so that k_w/λ⁴ = 0.5).
@@ -602,9 +602,9 @@ fn hp15_model() {
 /// materials and every base layer and option.
 #[test]
 fn never_nan_over_dense_sweep() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let stub = NarrowNdfConvolution;
-    let tables = owned.tables(&stub);
+    let tables = set.brdf_tables_with(&stub);
     let thetas: Vec<f64> = (0..=40)
         .map(|k| PI / 2.0 * k as f64 / 40.0)
         .chain([
@@ -695,9 +695,9 @@ fn never_nan_over_dense_sweep() {
 /// (`ExactConvolution`), so this measures T1, T2 and f32 rounding.
 #[test]
 fn runtime_matches_reference() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let exact = ExactConvolution;
-    let tables = owned.tables(&exact);
+    let tables = set.brdf_tables_with(&exact);
     let mut rng = SplitMix64::new(2024);
     let mut errors = Vec::new();
     let mut worst = (0.0, String::new());
@@ -796,9 +796,9 @@ fn runtime_matches_reference() {
 /// parts; refined further, ∫ pdf moves by < 5e-7).
 #[test]
 fn narrow_grazing_specular_sampling() {
-    let owned = BrdfTables::load();
+    let set = twoscale::TableSet::embedded();
     let stub = NarrowNdfConvolution;
-    let tables = owned.tables(&stub);
+    let tables = set.brdf_tables_with(&stub);
     let model = TwoScale::conductor(
         &tables,
         surface(0.004, 0.6, 0.008, 2.0, 1.8),

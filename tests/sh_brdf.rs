@@ -246,7 +246,7 @@ fn committed_rough_file_matches_the_two_scale_model() {
     assert!(table.asymmetry() > 1e-4, "{:e}", table.asymmetry());
     let inputs = model_inputs();
     let parsed = inputs.parse().unwrap();
-    let tables = parsed.tables();
+    let tables = parsed.brdf_tables();
     let pairs = generator::tables::t4::verification_pairs(4000, 21);
     for (c, &lambda) in materials.wavelengths.iter().enumerate() {
         let brdf = generator::tables::t4::two_scale_brdf(gold, c, lambda, &tables);
@@ -268,7 +268,7 @@ fn committed_rough_file_matches_the_two_scale_model() {
 fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
     let inputs = model_inputs();
     let parsed = inputs.parse().unwrap();
-    let tables = parsed.tables();
+    let tables = parsed.brdf_tables();
     let text = ROUGH
         .replace("base = \"plastic\"", "base = \"conductor\"")
         .replace("albedo = [0.5, 0.2]\n", "")

@@ -116,21 +116,23 @@ struct RawFile {
     material: Vec<RawMaterial>,
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawMaterial {
-    name: String,
-    beta: f64,
-    p: f64,
-    sigma_s: f64,
-    b: f64,
-    c: f64,
-    n: Vec<f64>,
-    k: Vec<f64>,
-    base: String,
+    /// A shipped preset of the runtime (`twoscale::materials::PRESETS`):
+    /// its name and parameters, with no model field of its own.
+    preset: Option<String>,
+    name: Option<String>,
+    beta: Option<f64>,
+    p: Option<f64>,
+    sigma_s: Option<f64>,
+    b: Option<f64>,
+    c: Option<f64>,
+    n: Option<Vec<f64>>,
+    k: Option<Vec<f64>>,
+    base: Option<String>,
     albedo: Option<Vec<f64>>,
-    #[serde(default)]
-    lambertian: f64,
+    lambertian: Option<f64>,
     band_limit: Option<usize>,
     filter: Option<RawFilter>,
 }
@@ -169,6 +171,7 @@ impl Materials {
         }
         let mut materials: Vec<Material> = Vec::new();
         for m in raw.material {
+            let m = m.resolve_preset(&raw.wavelengths)?;
             let material = m.validate(channels)?;
             if materials.iter().any(|other| other.name == material.name) {
                 return Err(MaterialsError(format!(
@@ -205,8 +208,91 @@ fn in_range(
 }
 
 impl RawMaterial {
+    /// A `preset = "…"` entry with the runtime preset's parameters filled in
+    /// (the presets are defined once, in `twoscale::materials`); other
+    /// entries unchanged.
+    fn resolve_preset(self, wavelengths: &[f64]) -> Result<RawMaterial, MaterialsError> {
+        let Some(preset) = self.preset else {
+            return Ok(self);
+        };
+        let err = |m: String| Err(MaterialsError(format!("preset '{preset}': {m}")));
+        let Some(material) = twoscale::materials::preset(&preset) else {
+            let names: Vec<_> = twoscale::materials::PRESETS
+                .iter()
+                .map(|(n, _)| *n)
+                .collect();
+            return err(format!("not a shipped preset ({})", names.join(", ")));
+        };
+        let rgb = twoscale::brdf::RGB_WAVELENGTHS.map(f64::from);
+        if wavelengths.len() != 3
+            || wavelengths
+                .iter()
+                .zip(rgb)
+                .any(|(a, b)| (a - b).abs() > 1e-6)
+        {
+            return err(format!(
+                "presets are defined at the RGB wavelengths {rgb:?} µm"
+            ));
+        }
+        let own = [
+            self.name.is_some(),
+            self.beta.is_some(),
+            self.p.is_some(),
+            self.sigma_s.is_some(),
+            self.b.is_some(),
+            self.c.is_some(),
+            self.n.is_some(),
+            self.k.is_some(),
+            self.base.is_some(),
+            self.albedo.is_some(),
+            self.lambertian.is_some(),
+        ];
+        if own.into_iter().any(|given| given) {
+            return err("give only band_limit and filter with a preset".into());
+        }
+        let layer = material.layer;
+        let s = layer.surface;
+        let (base, albedo) = match layer.base {
+            twoscale::brdf::BaseLayer::Conductor => ("conductor", None),
+            twoscale::brdf::BaseLayer::Plastic { albedo } => ("plastic", Some(albedo)),
+            twoscale::brdf::BaseLayer::Subsurface { albedo } => ("subsurface", Some(albedo)),
+        };
+        Ok(RawMaterial {
+            name: Some(preset.clone()),
+            beta: Some(f64::from(s.beta)),
+            p: Some(f64::from(s.p)),
+            sigma_s: Some(f64::from(s.sigma_s)),
+            b: Some(f64::from(s.b)),
+            c: Some(f64::from(s.c)),
+            n: Some(material.eta_rgb.iter().map(|e| f64::from(e.re)).collect()),
+            k: Some(material.eta_rgb.iter().map(|e| f64::from(e.im)).collect()),
+            base: Some(base.into()),
+            albedo: albedo.map(|a| vec![f64::from(a); 3]),
+            lambertian: Some(f64::from(layer.lambertian)),
+            band_limit: self.band_limit,
+            filter: self.filter,
+            preset: None,
+        })
+    }
+
     fn validate(self, channels: usize) -> Result<Material, MaterialsError> {
-        let name = self.name;
+        let name = self.name.unwrap_or_default();
+        let need = |field: &str, value: Option<f64>| {
+            value.ok_or_else(|| MaterialsError(format!("material '{name}': missing field {field}")))
+        };
+        let (beta, p, sigma_s, b, c) = (
+            need("beta", self.beta)?,
+            need("p", self.p)?,
+            need("sigma_s", self.sigma_s)?,
+            need("b", self.b)?,
+            need("c", self.c)?,
+        );
+        let missing =
+            |field: &str| MaterialsError(format!("material '{name}': missing field {field}"));
+        let n = self.n.ok_or_else(|| missing("n"))?;
+        let k = self.k.ok_or_else(|| missing("k"))?;
+        let base_kind = self.base.ok_or_else(|| missing("base"))?;
+        let lambertian = self.lambertian.unwrap_or(0.0);
         if name.is_empty()
             || !name
                 .bytes()
@@ -216,12 +302,12 @@ impl RawMaterial {
                 "material name '{name}' must be non-empty and use only a-z, 0-9 and '-'"
             )));
         }
-        in_range(&name, "beta", self.beta, 0.0, 1.0, true)?;
-        in_range(&name, "p", self.p, 0.2, 5.0, false)?;
-        in_range(&name, "sigma_s", self.sigma_s, 0.0, 1.0, false)?;
-        in_range(&name, "b", self.b, 0.0, 1000.0, true)?;
-        in_range(&name, "c", self.c, 1.0, 100.0, true)?;
-        for (field, values) in [("n", &self.n), ("k", &self.k)] {
+        in_range(&name, "beta", beta, 0.0, 1.0, true)?;
+        in_range(&name, "p", p, 0.2, 5.0, false)?;
+        in_range(&name, "sigma_s", sigma_s, 0.0, 1.0, false)?;
+        in_range(&name, "b", b, 0.0, 1000.0, true)?;
+        in_range(&name, "c", c, 1.0, 100.0, true)?;
+        for (field, values) in [("n", &n), ("k", &k)] {
             if values.len() != channels {
                 return Err(MaterialsError(format!(
                     "material '{name}': {field} has {} values, one per wavelength ({channels}) needed",
@@ -229,13 +315,13 @@ impl RawMaterial {
                 )));
             }
         }
-        for &v in &self.n {
+        for &v in &n {
             in_range(&name, "n", v, 0.0, 10.0, true)?;
         }
-        for &v in &self.k {
+        for &v in &k {
             in_range(&name, "k", v, 0.0, 20.0, false)?;
         }
-        let base = match (self.base.as_str(), self.albedo) {
+        let base = match (base_kind.as_str(), self.albedo) {
             ("conductor", None) => Base::Conductor,
             ("conductor", Some(_)) => {
                 return Err(MaterialsError(format!(
@@ -252,7 +338,7 @@ impl RawMaterial {
                 for &a in &albedo {
                     in_range(&name, "albedo", a, 0.0, 0.999, false)?;
                 }
-                if self.k.iter().any(|&k| k != 0.0) || self.n.iter().any(|&n| n < 1.0) {
+                if k.iter().any(|&k| k != 0.0) || n.iter().any(|&n| n < 1.0) {
                     return Err(MaterialsError(format!(
                         "material '{name}': a {kind} base's varnish needs a real index n ≥ 1 (k = 0)"
                     )));
@@ -274,7 +360,7 @@ impl RawMaterial {
                 )));
             }
         };
-        in_range(&name, "lambertian", self.lambertian, 0.0, 1.0, false)?;
+        in_range(&name, "lambertian", lambertian, 0.0, 1.0, false)?;
         let max = twoscale::sh::MAX_BAND_LIMIT;
         if let Some(l) = self.band_limit
             && !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&l)
@@ -296,15 +382,15 @@ impl RawMaterial {
         };
         Ok(Material {
             name,
-            beta: self.beta,
-            p: self.p,
-            sigma_s: self.sigma_s,
-            b: self.b,
-            c: self.c,
-            n: self.n,
-            k: self.k,
+            beta,
+            p,
+            sigma_s,
+            b,
+            c,
+            n,
+            k,
             base,
-            lambertian: self.lambertian,
+            lambertian,
             band_limit: self.band_limit,
             filter,
         })
@@ -354,7 +440,7 @@ band_limit = 16
     /// (`twoscale::materials::PRESETS`): same names, and every value equal
     /// once rounded to the runtime's f32.
     #[test]
-    fn the_file_holds_the_runtime_presets() {
+    fn preset_entries_take_the_runtime_presets() {
         use twoscale::brdf::{BaseLayer, RGB_WAVELENGTHS};
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
         let file = Materials::load(Path::new(path)).unwrap();
@@ -387,6 +473,20 @@ band_limit = 16
                 assert_eq!(base, layer.base, "{name}: base at channel {c}");
             }
         }
+    }
+
+    #[test]
+    fn a_preset_entry_is_checked() {
+        let head = "wavelengths = [0.645, 0.526, 0.444]\n[[material]]\n";
+        let e = error_of(&format!("{head}preset = \"gold\"\n"));
+        assert!(
+            e.contains("not a shipped preset") && e.contains("gold-rough"),
+            "{e}"
+        );
+        let e = error_of(&format!("{head}preset = \"marble\"\nbeta = 0.1\n"));
+        assert!(e.contains("only band_limit and filter"), "{e}");
+        let e = error_of("wavelengths = [0.5]\n[[material]]\npreset = \"marble\"\n");
+        assert!(e.contains("RGB wavelengths"), "{e}");
     }
 
     #[test]

@@ -11,11 +11,9 @@
 use rayon::prelude::*;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use twoscale::mmap::MappedFile;
-use twoscale::{ConvTable, Convolution, SigmaRatioTable, SmithG1Table};
+use twoscale::{Convolution, TableSet};
 
 use crate::reference::{brdf, conv, epd, fresnel, kcorr};
-use crate::tables::file_name;
 
 /// Quantities that can be queried, with their input columns.
 pub const QUANTITIES: &[(&str, &[&str])] = &[
@@ -89,14 +87,13 @@ pub fn run(
         .collect::<Result<Vec<usize>, String>>()?;
 
     // Load the tables before reading rows, so a missing file fails fast.
-    let mapped;
-    let mapped_brdf;
-    let conv_table;
+    // (`TableSet::open` keeps its maps for the process: one set per run.)
+    let open_set = || {
+        TableSet::open(tables).map_err(|e| format!("{e} (build the tables with `generator build`)"))
+    };
     let (evaluate, outputs): (Evaluator<'_>, &[&str]) = match quantity {
         "g1" => {
-            mapped = open(tables, twoscale::TableId::SmithG1)?;
-            let table = SmithG1Table::from_bytes(mapped.bytes())
-                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::SmithG1)))?;
+            let table = open_set()?.smith;
             (
                 Box::new(move |x: &[f64]| {
                     let (p, a) = (x[0], x[1]);
@@ -110,9 +107,7 @@ pub fn run(
             )
         }
         "sigma-ratio" => {
-            mapped = open(tables, twoscale::TableId::SigmaRatio)?;
-            let table = SigmaRatioTable::from_bytes(mapped.bytes())
-                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::SigmaRatio)))?;
+            let table = open_set()?.sigma_ratio;
             (
                 Box::new(move |x: &[f64]| {
                     let (theta_i, big_b, c) = (x[0], x[1], x[2]);
@@ -144,9 +139,7 @@ pub fn run(
             &["table", "reference"],
         ),
         "conv" => {
-            mapped = open(tables, twoscale::TableId::Convolution)?;
-            let table = ConvTable::from_bytes(mapped.bytes())
-                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::Convolution)))?;
+            let table = open_set()?.convolution;
             (
                 // `fit` = T3a (the paper's s, g form), `table` = T3b, both
                 // from the runtime; `reference` = exact C by direct quadrature.
@@ -172,28 +165,10 @@ pub fn run(
         }
         "brdf" => {
             // SPEC §6: the conductor two-scale model. `table` is the runtime
-            // (`twoscale::brdf::TwoScale`, f32) reading T1, T2 and T5;
-            // `reference` is `reference::brdf::two_scale` (exact Λ, σrel, C).
-            mapped_brdf = (
-                open(tables, twoscale::TableId::SmithG1)?,
-                open(tables, twoscale::TableId::SigmaRatio)?,
-                open(tables, twoscale::TableId::DiffuseFresnel)?,
-                open(tables, twoscale::TableId::Convolution)?,
-            );
-            let (t1, t2, t5, t3) = &mapped_brdf;
-            conv_table = ConvTable::from_bytes(t3.bytes())
-                .map_err(|e| format!("{}: {e}", file_name(twoscale::TableId::Convolution)))?;
-            let table_err = |id: twoscale::TableId| move |e| format!("{}: {e}", file_name(id));
-            let runtime_tables = twoscale::brdf::Tables {
-                smith: SmithG1Table::from_bytes(t1.bytes())
-                    .map_err(table_err(twoscale::TableId::SmithG1))?,
-                sigma_ratio: SigmaRatioTable::from_bytes(t2.bytes())
-                    .map_err(table_err(twoscale::TableId::SigmaRatio))?,
-                diffuse_fresnel: twoscale::DiffuseFresnelTable::from_bytes(t5.bytes())
-                    .map_err(table_err(twoscale::TableId::DiffuseFresnel))?,
-                // C from T3b, the runtime's default form.
-                convolution: &conv_table,
-            };
+            // model (`twoscale::brdf::TwoScale`, f32, baked from the table
+            // set: the path a renderer calls); `reference` is
+            // `reference::brdf::two_scale` (exact Λ, σrel, C).
+            let set = open_set()?;
             (
                 Box::new(move |x: &[f64]| {
                     let params = brdf::Params {
@@ -223,7 +198,7 @@ pub fn run(
                         lambertian: 0.0,
                     };
                     let model = twoscale::TwoScale::new(
-                        &runtime_tables,
+                        &set.brdf_tables(),
                         layer,
                         f(params.lambda),
                         twoscale::Complex::new(f(params.n), f(params.k)),
@@ -286,15 +261,4 @@ pub fn run(
         }
     }
     Ok(summary)
-}
-
-fn open(dir: &Path, id: twoscale::TableId) -> Result<MappedFile, String> {
-    let path = dir.join(file_name(id));
-    MappedFile::open(&path).map_err(|e| {
-        format!(
-            "cannot open {}: {e} (build it with `generator build {}`)",
-            path.display(),
-            id.name()
-        )
-    })
 }

@@ -200,7 +200,8 @@ impl ConvBake {
         for (k, tan) in tans.iter_mut().enumerate() {
             let target = k as f64 / (CONV_S_NODES - 1) as f64 * s_span;
             let (mut lo, mut hi) = (0.0, theta_max);
-            for _ in 0..60 {
+            // 34 halvings of [0, π/2]: 1e-10 rad, far below what f32 resolves.
+            for _ in 0..34 {
                 let mid = 0.5 * (lo + hi);
                 if angle_x(mid) < target {
                     lo = mid;
@@ -218,8 +219,9 @@ impl ConvBake {
             let x_u = j as f32 / (CONV_U_NODES - 1) as f32 * u_span;
             let u = U0 * math::expf(x_u) - U0;
             let u = if j + 1 == CONV_U_NODES { big_b } else { u };
-            for (k, &tau) in tans.iter().enumerate() {
-                let c = slice.at_tan(tau, u);
+            let mut profile = [0.0f32; CONV_S_NODES];
+            slice.profile_at_tans(u, &tans, &mut profile);
+            for (k, &c) in profile.iter().enumerate() {
                 let v = if c > 0.0 { math::lnf(c) } else { f32::MIN };
                 top = top.max(v);
                 ln_c[(j + 1) * PADDED_S + k + 1] = v;
@@ -266,6 +268,10 @@ impl ConvBake {
             let taps = self.ln_c.get(start..start + 4).unwrap_or(&[0.0; 4]);
             let along: f32 = taps.iter().zip(ws).map(|(v, w)| v * w).sum();
             ln_c += wa * along;
+        }
+        // e^x is 0 in f32 below x ≈ −103.3 (and expf is slow near there).
+        if !(ln_c > -104.0) {
+            return 0.0;
         }
         let value = math::expf(ln_c);
         if value.is_finite() { value } else { 0.0 }

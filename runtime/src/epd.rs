@@ -84,7 +84,12 @@ impl<'a> Epd<'a> {
         }
         let cos_sq = cos_theta * cos_theta;
         let tan_sq = tan_sq(m);
-        let falloff = math::expf(-math::powff(tan_sq * self.inv_beta_sq, self.p));
+        let y = math::powff(tan_sq * self.inv_beta_sq, self.p);
+        // e^−y is 0 in f32 beyond y ≈ 104 (and expf slow near there).
+        if !(y < 104.0) {
+            return 0.0;
+        }
+        let falloff = math::expf(-y);
         if !(falloff > 0.0) {
             // Also covers z so small that cos⁴θ underflows (tan² = ∞).
             return 0.0;

@@ -145,6 +145,18 @@ impl<'a> TableSet<'a> {
         }
     }
 
+    /// The view the BRDF constructors take, with another source of C (T3a is
+    /// `&set.convolution.fit()`; tests pass adapters).
+    pub fn brdf_tables_with<'s>(
+        &'s self,
+        convolution: &'s (dyn crate::conv::Convolution + Sync),
+    ) -> Tables<'s> {
+        Tables {
+            convolution,
+            ..self.brdf_tables()
+        }
+    }
+
     /// The RGB model of `material` (at [`crate::brdf::RGB_WAVELENGTHS`]).
     /// Construction bakes what depends only on the material (see
     /// [`crate::brdf::TwoScale::new`]); build it once per material.

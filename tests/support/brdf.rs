@@ -1,51 +1,12 @@
-//! Helpers of the BRDF tests and benchmarks: loading the tables the model
-//! reads, stand-ins for the T3 convolution tables, and a χ² test of a
+//! Helpers of the BRDF tests and benchmarks: stand-ins for the T3
+//! convolution tables, random directions and percentiles, and a χ² test of a
 //! direction sampler against its pdf.
 
 use generator::quad::gauss_legendre;
 use generator::reference::conv;
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
-use twoscale::brdf::Tables;
 use twoscale::conv::{Convolution, kernel};
-use twoscale::format::AlignedBuf;
-use twoscale::{DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId};
-
-/// The committed T1, T2 and T5, owned.
-pub struct BrdfTables {
-    t1: AlignedBuf,
-    t2: AlignedBuf,
-    t5: AlignedBuf,
-}
-
-impl Default for BrdfTables {
-    fn default() -> Self {
-        Self::load()
-    }
-}
-
-impl BrdfTables {
-    /// Reads the committed tables.
-    pub fn load() -> Self {
-        BrdfTables {
-            t1: crate::read_table(TableId::SmithG1),
-            t2: crate::read_table(TableId::SigmaRatio),
-            t5: crate::read_table(TableId::DiffuseFresnel),
-        }
-    }
-
-    /// The runtime's table set with `convolution` as the source of C.
-    ///
-    /// When T3 lands, tests pass the T3b table here instead of an adapter.
-    pub fn tables<'a>(&'a self, convolution: &'a (dyn Convolution + Sync)) -> Tables<'a> {
-        Tables {
-            smith: SmithG1Table::from_bytes(self.t1.bytes()).expect("valid T1"),
-            sigma_ratio: SigmaRatioTable::from_bytes(self.t2.bytes()).expect("valid T2"),
-            diffuse_fresnel: DiffuseFresnelTable::from_bytes(self.t5.bytes()).expect("valid T5"),
-            convolution,
-        }
-    }
-}
 
 /// A cheap stand-in for C where its accuracy does not matter (sampling
 /// tests, robustness sweeps, benchmarks until T3 exists): the narrow-NDF

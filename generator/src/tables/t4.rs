@@ -39,10 +39,7 @@ use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
 use twoscale::format::write::{TableSpec, encode};
 use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
-use twoscale::{
-    Complex, ConvTable, DiffuseFresnelTable, ShBrdfTable, SigmaRatioTable, SmithG1Table, TableId,
-    TwoScale,
-};
+use twoscale::{Complex, ShBrdfTable, TableBytes, TableId, TableSet, TwoScale};
 
 use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind, file_name};
 use crate::analytic::{BeckmannCt, StandIn};
@@ -113,14 +110,6 @@ pub struct ModelInputs {
     buffers: [AlignedBuf; 4],
 }
 
-/// [`ModelInputs`] validated: the runtime's views of the four tables.
-pub struct ModelTables<'a> {
-    smith: SmithG1Table<'a>,
-    sigma_ratio: SigmaRatioTable<'a>,
-    diffuse_fresnel: DiffuseFresnelTable<'a>,
-    conv: ConvTable<'a>,
-}
-
 impl ModelInputs {
     /// Reads [`INPUTS`] from `dir` (no fallback: see [`input_dir`]).
     pub fn load(dir: &Path) -> Result<ModelInputs, BuildError> {
@@ -144,27 +133,19 @@ impl ModelInputs {
         })
     }
 
-    /// Validates the four files.
-    pub fn parse(&self) -> Result<ModelTables<'_>, BuildError> {
+    /// Validates the four files as the runtime's table set.
+    pub fn parse(&self) -> Result<TableSet<'_>, BuildError> {
         let [t1, t2, t5, t3] = &self.buffers;
-        Ok(ModelTables {
-            smith: SmithG1Table::from_bytes(t1.bytes())?,
-            sigma_ratio: SigmaRatioTable::from_bytes(t2.bytes())?,
-            diffuse_fresnel: DiffuseFresnelTable::from_bytes(t5.bytes())?,
-            conv: ConvTable::from_bytes(t3.bytes())?,
+        TableSet::from_bytes(TableBytes {
+            smith: t1.bytes(),
+            sigma_ratio: t2.bytes(),
+            convolution: t3.bytes(),
+            diffuse_fresnel: t5.bytes(),
         })
-    }
-}
-
-impl ModelTables<'_> {
-    /// The runtime's table set, C from T3b.
-    pub fn tables(&self) -> Tables<'_> {
-        Tables {
-            smith: self.smith,
-            sigma_ratio: self.sigma_ratio,
-            diffuse_fresnel: self.diffuse_fresnel,
-            convolution: &self.conv,
-        }
+        .map_err(|e| BuildError::Input {
+            path: self.dir.display().to_string(),
+            message: e.to_string(),
+        })
     }
 }
 
@@ -289,7 +270,7 @@ fn with_source<T>(
         Projected::TwoScale { dir } => {
             let inputs = ModelInputs::load(&input_dir(dir))?;
             let parsed = inputs.parse()?;
-            f(Some(&parsed.tables()))
+            f(Some(&parsed.brdf_tables()))
         }
         Projected::BeckmannStandIn => f(None),
     }
