@@ -108,7 +108,7 @@ impl Ggx {
         let m = m.map(|x| x / lm);
         let k = 2.0 * (i[0] * m[0] + i[1] * m[1] + i[2] * m[2]);
         let o = [k * m[0] - i[0], k * m[1] - i[1], k * m[2] - i[2]];
-        if !(o[2] > 0.0) {
+        if o[2] <= 0.0 || o[2].is_nan() {
             return None;
         }
         let a2 = a * a;
