@@ -83,7 +83,7 @@ fn main() {
     let materials = Materials::load(Path::new(path)).expect("materials.toml");
     let inputs = ModelInputs::load(Path::new(WORKSPACE_TABLES)).expect("T1, T2, T3, T5");
     let parsed = inputs.parse().expect("valid tables");
-    let tables = parsed.tables();
+    let tables = parsed.brdf_tables();
     let channel = 1;
     let lambda = materials.wavelengths[channel];
     for (name, bands) in [
