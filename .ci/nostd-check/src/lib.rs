@@ -56,3 +56,13 @@ pub extern "C" fn twoscale_q_bar(n: f32, k: f32, cos_i: f32, ox: f32, oy: f32, o
     let sin_i = twoscale::math::sqrtf((1.0 - cos_i * cos_i).max(0.0));
     twoscale::fresnel::q_bar(Complex::new(n, k), [sin_i, 0.0, cos_i], [ox, oy, oz])
 }
+
+/// ρ of the `gold-rough` preset from the embedded table set (feature
+/// `embedded`, no std) at the green wavelength, or −1 for an unknown preset.
+#[unsafe(no_mangle)]
+pub extern "C" fn twoscale_gold_rough_green(ix: f32, iy: f32, iz: f32, ox: f32, oy: f32, oz: f32) -> f32 {
+    match twoscale::TableSet::embedded().material("gold-rough") {
+        Ok(model) => model.eval([ix, iy, iz], [ox, oy, oz])[1],
+        Err(_) => -1.0,
+    }
+}
