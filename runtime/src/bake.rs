@@ -3,7 +3,7 @@
 //!
 //! * [`DirectionBake`]: the quantities of one direction's `cos θ` at one
 //!   wavelength — F(η, cos θ), the factors of Q̄ ([`QConstants::factors`]) and
-//!   σrel/σs (T2) — on 257 nodes even in `√cos θ` (dense at grazing, where σrel
+//!   σrel/σs (T2), and the sampler's lobe weights — on 257 nodes even in `√cos θ` (dense at grazing, where σrel
 //!   and F move fastest), linear between nodes.
 //! * [`MaskingBake`]: Smith G1 (T1 at the material's p) on 1025 nodes even in
 //!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
@@ -58,15 +58,19 @@ fn cell(x: f32, n: usize) -> (usize, f32) {
 /// One direction's quantities at one wavelength (module documentation).
 #[derive(Clone, Debug)]
 pub(crate) struct DirectionBake {
-    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0]` per node.
-    rows: [[f32; 8]; MU_NODES],
+    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0, w_spec, w_diff, w_base, 0]`
+    /// per node.
+    rows: [[f32; ROW]; MU_NODES],
 }
+
+/// Values per [`DirectionBake`] node.
+const ROW: usize = 12;
 
 /// Interpolated [`DirectionBake`] row at one `cos θ`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirectionValues {
-    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0]`.
-    pub v: [f32; 8],
+    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0, w_spec, w_diff, w_base, 0]`.
+    pub v: [f32; ROW],
 }
 
 impl DirectionValues {
@@ -87,6 +91,18 @@ impl DirectionValues {
     pub fn sigma_ratio(&self) -> f64 {
         f64::from(self.v[6])
     }
+
+    /// The sampler's lobe weights `[specular, diffraction, base]` (sum 1).
+    #[inline]
+    pub fn lobe_weights(&self) -> [f64; 3] {
+        let w = [8, 9, 10].map(|k| f64::from(self.v[k]).max(0.0));
+        let total = w[0] + w[1] + w[2];
+        if total > 0.0 {
+            w.map(|x| x / total)
+        } else {
+            [1.0, 0.0, 0.0]
+        }
+    }
 }
 
 impl DirectionBake {
@@ -99,7 +115,7 @@ impl DirectionBake {
         big_b: f32,
         c: f32,
     ) -> Self {
-        let mut rows = [[0.0f32; 8]; MU_NODES];
+        let mut rows = [[0.0f32; ROW]; MU_NODES];
         for (k, row) in rows.iter_mut().enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;
             let cos = x * x;
@@ -113,13 +129,25 @@ impl DirectionBake {
         DirectionBake { rows }
     }
 
+    /// Tabulates the lobe weights `weights(cos θ)` (which may read `self`).
+    pub fn with_lobe_weights(mut self, weights: impl Fn(&Self, f64) -> [f64; 3]) -> Self {
+        for k in 0..MU_NODES {
+            let x = k as f64 / (MU_NODES - 1) as f64;
+            let w = weights(&self, x * x);
+            for (slot, value) in self.rows[k][8..11].iter_mut().zip(w) {
+                *slot = value as f32;
+            }
+        }
+        self
+    }
+
     /// The values at `cos θ` (clamped to [0, 1]).
     #[inline]
     pub fn at(&self, cos: f32) -> DirectionValues {
         let (i, t) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
         let (a, b) = (&self.rows[i], &self.rows[i + 1]);
-        let mut v = [0.0f32; 8];
-        for k in 0..8 {
+        let mut v = [0.0f32; ROW];
+        for k in 0..ROW {
             v[k] = a[k] + t * (b[k] - a[k]);
         }
         DirectionValues { v }

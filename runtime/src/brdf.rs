@@ -384,7 +384,7 @@ impl<'a> TwoScale<'a> {
         } else {
             None
         };
-        TwoScale {
+        let model = TwoScale {
             masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
             ndf,
             direction: DirectionBake::new(
@@ -405,7 +405,12 @@ impl<'a> TwoScale<'a> {
             eta_re: f64::from(eta.re),
             lambertian: unit(layer.lambertian),
             options,
-        }
+        };
+        let direction = model
+            .direction
+            .clone()
+            .with_lobe_weights(|bake, cos| model.weights_at(&bake.at(cos as f32), cos));
+        TwoScale { direction, ..model }
     }
 
     /// A conductor (no base layer, no Lambertian term) with the default options.
@@ -647,7 +652,10 @@ impl<'a> TwoScale<'a> {
     ///
     /// The surface lobes share F(θi) as the estimate of their energy and split
     /// it by (HP17 48) as printed. When every estimate is 0 (η = 1 and no
-    /// base) the split `[A_imp, 1 − A_imp, 0]` is used.
+    /// base) the split `[A_imp, 1 − A_imp, 0]` is used. The weights are
+    /// tabulated with the material (linear in `√cos θi` between 257 nodes):
+    /// `sample` and `pdf` read the same table, so the pdf stays the sampler's
+    /// exact density.
     pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
         let Some(wi) = upper(i) else {
             return [0.0; 3];
@@ -656,13 +664,20 @@ impl<'a> TwoScale<'a> {
         [w[0] as f32, w[1] as f32, w[2] as f32]
     }
 
+    /// The lobe weights at `cos θi`, from the direction bake's table of
+    /// [`TwoScale::weights_at`].
     fn weights(&self, cos_i: f64) -> [f64; 3] {
+        self.direction.at(cos_i as f32).lobe_weights()
+    }
+
+    /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`.
+    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64) -> [f64; 3] {
         let t = 2.0 * PI * f64::from(self.surface.sigma_s) * cos_i / self.lambda;
         let a_imp = math::exp(-t * t);
-        let e_s = self.fresnel_at(cos_i);
+        let e_s = self.fresnel_of(at_i);
         let mut e_b = self.lambertian;
         if !self.white() {
-            let into = 1.0 - self.fresnel_at(cos_i);
+            let into = 1.0 - at_i.fresnel();
             e_b += match self.base {
                 BaseLayer::Conductor => 0.0,
                 BaseLayer::Plastic { albedo } => {
@@ -743,7 +758,7 @@ impl<'a> TwoScale<'a> {
         if !(s.sigma_s > 0.0 && self.big_b > 0.0) {
             return None;
         }
-        let sin_i = math::hypot(wi[0], wi[1]).min(1.0);
+        let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
         let b = self.big_b;
         let half_cm1 = 0.5 * (f64::from(s.c) - 1.0);
         let reach = b * (1.0 + sin_i);
@@ -769,7 +784,7 @@ impl<'a> TwoScale<'a> {
             return 0.0;
         };
         let (dx, dy) = (wo[0] + wi[0], wo[1] + wi[1]);
-        let r = math::hypot(dx, dy);
+        let r = math::sqrt(dx * dx + dy * dy);
         if r > 1.0 + sin_i {
             return 0.0;
         }
