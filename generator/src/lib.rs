@@ -7,6 +7,7 @@
 //! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
 //!   forms of the convolution, table T3);
 //! - [`query`]: the batch CSV queries of SPEC §6;
+//! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod analytic;
@@ -16,6 +17,7 @@ pub mod materials;
 pub mod quad;
 pub mod query;
 pub mod reference;
+pub mod report;
 pub mod rng;
 pub mod sh;
 pub mod tables;

@@ -17,8 +17,9 @@ use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
 use generator::materials::Materials;
+use generator::report::{self, TableReport};
 use generator::tables::t4::{Projected, ShBrdf};
-use generator::tables::{self, Accuracy, TableKind};
+use generator::tables::{self, TableKind};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
@@ -71,9 +72,14 @@ enum Command {
         /// Seed of the random points.
         #[arg(long, default_value_t = 2017)]
         seed: u64,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores). The figures do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Also write the figures as markdown to this file (what
+        /// `docs/accuracy.md` holds; no timestamps, so the same tables, points
+        /// and seed give the same bytes).
+        #[arg(long, value_name = "FILE")]
+        markdown: Option<PathBuf>,
     },
     /// Recompute a spread of grid nodes of tables too expensive to rebuild
     /// in CI (T3) and compare their bits with the files in a directory.
@@ -136,7 +142,9 @@ fn main() -> ExitCode {
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, &materials, &tables, points, seed)),
+            markdown,
+        } => set_threads(threads)
+            .and_then(|()| verify(&dir, &materials, &tables, points, seed, markdown.as_deref())),
         Command::SpotCheck {
             tables,
             dir,
@@ -352,9 +360,10 @@ fn verify(
     names: &[String],
     points: usize,
     seed: u64,
+    markdown: Option<&Path>,
 ) -> Result<ExitCode, String> {
     let t4 = material_tables(materials, dir)?;
-    let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
+    let mut reports = Vec::new();
     for kind in selected(names, &t4)? {
         let id = kind.id();
         let stem = kind.file_stem();
@@ -376,59 +385,32 @@ fn verify(
                 );
                 Ok((size, accuracy))
             });
-        match outcome {
-            Ok((size, accuracy)) => rows.push((stem, size, Ok(accuracy))),
-            Err(e) => rows.push((stem, 0, Err(e))),
-        }
+        reports.push(match outcome {
+            Ok((bytes, accuracy)) => TableReport {
+                stem,
+                bytes,
+                outcome: Ok(accuracy),
+            },
+            Err(e) => TableReport {
+                stem,
+                bytes: 0,
+                outcome: Err(e),
+            },
+        });
     }
-    println!(
-        "{:<22} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>20}  result  worst at",
-        "table", "bytes", "metric", "points", "max", "median", "p90", "p99", "target"
-    );
-    let mut failed = false;
-    for (stem, size, outcome) in &rows {
-        match outcome {
-            Ok(accuracy) => {
-                for a in accuracy {
-                    failed |= !a.passed();
-                    let target = if !a.target.is_finite() {
-                        "-".to_string()
-                    } else if a.gate_quantile < 1.0 {
-                        format!(
-                            "p{:.0} {:.1e}<={:.0e}",
-                            100.0 * a.gate_quantile,
-                            a.gated,
-                            a.target
-                        )
-                    } else {
-                        format!("max <= {:.0e}", a.target)
-                    };
-                    println!(
-                        "{:<22} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>20}  {:<6}  {}",
-                        stem,
-                        size,
-                        a.metric,
-                        a.points,
-                        a.max,
-                        a.median,
-                        a.p90,
-                        a.p99,
-                        target,
-                        a.verdict(),
-                        a.worst_at
-                    );
-                }
-            }
-            Err(e) => {
-                failed = true;
-                println!("{:<22} {:>9}  FAIL: {e}", stem, "-");
-            }
+    print!("{}", report::text(&reports));
+    if let Some(file) = markdown {
+        let mut command = format!("generator verify --points {points} --seed {seed}");
+        for n in names {
+            command.push_str(&format!(" --table {n}"));
         }
+        write_atomic(file, report::markdown(&command, &reports).as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
     }
-    Ok(if failed {
-        ExitCode::FAILURE
-    } else {
+    Ok(if reports.iter().all(TableReport::passed) {
         ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
     })
 }
 
