@@ -23,6 +23,8 @@ use generator::tables::{self, TableKind};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
+/// Where `plot` writes (the pictures of the docs).
+const DEFAULT_IMAGES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/img");
 /// The workspace's materials file (T4 builds one table per material).
 const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
 
@@ -99,6 +101,38 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Draw the pictures of docs/img/: the BRDF lobes of each material in the
+    /// plane of incidence (lobes-<name>.png) and the error maps of T1, T2 and
+    /// T3 at verify's points (error-t1.png, error-t2.png, error-t3.png).
+    Plot {
+        /// Output directory.
+        #[arg(long, default_value = DEFAULT_IMAGES)]
+        out: PathBuf,
+        /// Table directory.
+        #[arg(long, default_value = DEFAULT_TABLES)]
+        tables: PathBuf,
+        /// Materials file.
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
+        /// Only these materials' lobes (all if none).
+        #[arg(long = "material")]
+        only: Vec<String>,
+        /// No error maps (they repeat verify's measurement of T1, T2, T3).
+        #[arg(long)]
+        no_errors: bool,
+        /// Random points of the error maps, as for verify.
+        #[arg(long, default_value_t = 20_000)]
+        points: usize,
+        /// Seed of the random points, as for verify.
+        #[arg(long, default_value_t = 2017)]
+        seed: u64,
+        /// TrueType font for the text.
+        #[arg(long, default_value = generator::plot::DEFAULT_FONT)]
+        font: PathBuf,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Print the header of table files readably.
     Inspect {
         /// Table files.
@@ -152,6 +186,28 @@ fn main() -> ExitCode {
             nodes,
             threads,
         } => set_threads(threads).and_then(|()| spot_check(&tables, &dir, &materials, nodes)),
+        Command::Plot {
+            out,
+            tables,
+            materials,
+            only,
+            no_errors,
+            points,
+            seed,
+            font,
+            threads,
+        } => set_threads(threads).and_then(|()| {
+            plot(&PlotArgs {
+                out,
+                tables,
+                materials,
+                only,
+                errors: !no_errors,
+                points,
+                seed,
+                font,
+            })
+        }),
         Command::Inspect { files } => inspect(&files),
         Command::Query { quantity, tables } => query(&quantity, &tables),
     };
@@ -412,6 +468,89 @@ fn verify(
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// The arguments of `plot`.
+struct PlotArgs {
+    out: PathBuf,
+    tables: PathBuf,
+    materials: PathBuf,
+    only: Vec<String>,
+    errors: bool,
+    points: usize,
+    seed: u64,
+    font: PathBuf,
+}
+
+fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
+    use generator::plot;
+    plot::load_font(&args.font)?;
+    let materials = Materials::load(&args.materials).map_err(|e| e.to_string())?;
+    for name in &args.only {
+        if !materials.materials.iter().any(|m| &m.name == name) {
+            return Err(format!(
+                "no material {name} in {}",
+                args.materials.display()
+            ));
+        }
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    // The green channel (as T4's band-limit study).
+    let channel = 1;
+    let lambda = materials.wavelengths[channel];
+    for material in &materials.materials {
+        if !args.only.is_empty() && !args.only.contains(&material.name) {
+            continue;
+        }
+        let path = args.out.join(format!("lobes-{}.png", material.name));
+        plot::lobes(material, channel, lambda, &args.tables, &path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if args.errors {
+        let (dir, points, seed) = (&args.tables, args.points, args.seed);
+        let suffix = format!("{points} verify points, seed {seed}; largest error per bin");
+        let t1 = plot::View {
+            title: format!("T1 (Smith G1): |G1 − G1_ref|, {suffix}"),
+            x: (0.2, 5.0, "p"),
+            y: (-4.0, 4.0, "log10 a"),
+        };
+        let path = args.out.join("error-t1.png");
+        plot::heat_map(
+            &path,
+            &t1,
+            &plot::t1_errors(dir, points, seed)?,
+            (48, 32),
+            "|G1 − G1_ref|",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let t2 = plot::View {
+            title: format!("T2 (σ ratio): relative error, {suffix} (over c)"),
+            x: (0.0, 90.0, "θi (°)"),
+            y: (-1.0, 3000f64.log10(), "log10 B"),
+        };
+        let path = args.out.join("error-t2.png");
+        plot::heat_map(
+            &path,
+            &t2,
+            &plot::t2_errors(dir, points, seed)?,
+            (45, 30),
+            "relative error",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let profiles = plot::t3_errors(dir, points, seed)?;
+        let path = args.out.join("error-t3.png");
+        plot::t3_map(
+            &path,
+            &profiles,
+            &format!(
+                "T3b: e_L2 of each of verify's {} profiles (seed {seed})",
+                profiles.len()
+            ),
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
