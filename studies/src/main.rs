@@ -52,7 +52,8 @@ enum Study {
     },
     /// T3's normalised angle: the NDF term's softening κ, ξ alone, on
     /// verify's and the BRDF check's points
-    /// (docs/design/t3-normalised-angle.md).
+    /// (docs/design/t3-normalised-angle.md). κ = 1 was chosen on format 1's
+    /// angle (`--angle format1`); the default measures it in the shipped one.
     T3AngleSoftening {
         /// Profiles per distribution.
         #[arg(long, default_value_t = 60)]

@@ -386,3 +386,40 @@ pub fn at_points(path: &std::path::Path, angles: &[Angle], patch: bool) -> Resul
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_last_default_angle_is_the_shipped_one() {
+        let shipped = Angle::parse(DEFAULT_ANGLES[DEFAULT_ANGLES.len() - 1]).unwrap();
+        assert_eq!(shipped, Angle::Runtime(t3::ANGLE));
+        assert_eq!(Angle::parse("format1").unwrap(), Angle::Format1(t3::ANGLE));
+        assert!(Angle::parse("0.5,0.5").is_err());
+        assert!(Angle::parse("a,b,c,d").is_err());
+    }
+
+    #[test]
+    fn angles_invert_and_increase() {
+        for angle in DEFAULT_ANGLES.map(|s| Angle::parse(s).unwrap()) {
+            for [u, beta, p] in [[0.0, 0.002, 0.2], [20.0, 0.1, 1.0], [3000.0, 1.0, 5.0]] {
+                let mut previous = -1.0;
+                for k in 0..=16 {
+                    let xi = f64::from(k) / 16.0;
+                    let theta = angle.theta(xi, u, beta, p);
+                    assert!((0.0..=std::f64::consts::FRAC_PI_2).contains(&theta));
+                    assert!(theta >= previous, "{angle}: θ({xi}) decreases");
+                    previous = theta;
+                    if (0.05..0.95).contains(&xi) {
+                        let back = angle.xi(theta.tan(), u, beta, p);
+                        assert!(
+                            (back - xi).abs() < 1e-9,
+                            "{angle} at {u} {beta} {p}: {xi} -> {back}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
