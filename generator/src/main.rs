@@ -496,6 +496,7 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
     }
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let out = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
     // The green channel (as T4's band-limit study).
     let channel = 1;
     let lambda = materials.wavelengths[channel];
@@ -503,7 +504,7 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
         if !args.only.is_empty() && !args.only.contains(&material.name) {
             continue;
         }
-        let path = args.out.join(format!("lobes-{}.png", material.name));
+        let path = out.join(format!("lobes-{}.png", material.name));
         plot::lobes(material, channel, lambda, &args.tables, &path)?;
         eprintln!("wrote {}", path.display());
     }
@@ -515,7 +516,7 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
             x: (0.2, 5.0, "p"),
             y: (-4.0, 4.0, "log10 a"),
         };
-        let path = args.out.join("error-t1.png");
+        let path = out.join("error-t1.png");
         plot::heat_map(
             &path,
             &t1,
@@ -529,7 +530,7 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
             x: (0.0, 90.0, "θi (°)"),
             y: (-1.0, 3000f64.log10(), "log10 B"),
         };
-        let path = args.out.join("error-t2.png");
+        let path = out.join("error-t2.png");
         plot::heat_map(
             &path,
             &t2,
@@ -539,7 +540,7 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
         )?;
         eprintln!("wrote {}", path.display());
         let profiles = plot::t3_errors(dir, points, seed)?;
-        let path = args.out.join("error-t3.png");
+        let path = out.join("error-t3.png");
         plot::t3_map(
             &path,
             &profiles,
