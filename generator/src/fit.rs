@@ -4,8 +4,8 @@
 //! # The problem
 //!
 //! Given a profile `C(θ_i)` on the nodes of a quadrature rule with weights
-//! `w_i` (for T3: the node's angle rule,
-//! whose weights contain the `sin θh` of SPEC §2.5's error metric), and a
+//! `w_i` (for T3: the node's angle rule, whose weights contain the `sin θh`
+//! of the error metric `e_L2`, `reference::conv::e_l2`), and a
 //! family of shapes `φ_g(θ)` with one width parameter `g > 0`, find
 //!
 //! ```text
@@ -13,7 +13,7 @@
 //! ```
 //!
 //! With these weights the objective is exactly `e_L2² · Σ w C²`, so the fit
-//! minimises the SPEC error metric `e_L2` of the form `s φ_g` itself.
+//! minimises the error metric `e_L2` of the form `s φ_g` itself.
 //!
 //! # The algorithm (variable projection)
 //!
