@@ -4,8 +4,8 @@
 //! # The problem
 //!
 //! Given a profile `C(θ_i)` on the nodes of a quadrature rule with weights
-//! `w_i` (for the T3 study: [`ProfileRule`](crate::reference::conv::ProfileRule),
-//! whose weights contain the `sin θh` of SPEC §2.5's error metric), and a
+//! `w_i` (for T3: the node's angle rule, whose weights contain the `sin θh`
+//! of the error metric `e_L2`, `reference::conv::e_l2`), and a
 //! family of shapes `φ_g(θ)` with one width parameter `g > 0`, find
 //!
 //! ```text
@@ -13,7 +13,7 @@
 //! ```
 //!
 //! With these weights the objective is exactly `e_L2² · Σ w C²`, so the fit
-//! minimises the SPEC error metric `e_L2` of the form `s φ_g` itself.
+//! minimises the error metric `e_L2` of the form `s φ_g` itself.
 //!
 //! # The algorithm (variable projection)
 //!
@@ -31,19 +31,9 @@
 //! local minima the scan saw is reported ([`Minimum::scan_minima`]) so that a
 //! study can tell where the fitted parameters might jump between branches.
 //!
-//! # The moment fit
-//!
-//! [`fit_k_lobe_moments`] is the alternative for the paper's form: it keeps
-//! the peak `C(0)` and the energy `∫ C sin θ cos θ dθ` exactly (closed-form
-//! lobe energy [`k_lobe_energy`], bisection for `g`). Its `e_L2` is larger
-//! than the least-squares optimum, but `s` and `g` are smooth in the
-//! parameters, whereas the least-squares `g` drops to 0 (a constant lobe)
-//! with a square-root onset wherever `C` is flat or rises towards grazing.
-//!
-//! Measured on the T3 study (`generator/examples/t3_study.rs`, 360 points
-//! over the T3 domain): least squares `e_L2` median 0.22, p90 0.39, max 0.99;
-//! cost ≈ 1 ms per point on a 250–600-node profile (≈ 150 objective
-//! evaluations).
+//! The shipped table fits the paper's form at every node with
+//! [`fit_k_lobe`] (`tables::t3`); the error of the form itself is what
+//! `generator verify` reports for T3a.
 
 /// The result of [`best_scale`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,84 +291,6 @@ pub fn fit_k_lobe(
     })
 }
 
-/// The energy of the paper's lobe, in closed form:
-///
-/// ```text
-///   ∫₀^{π/2} k(2g sin θ) sin θ cos θ dθ = ∫₀¹ (1 + a x²)^(−q) x dx
-///                                       = (1 − (1 + a)^(1−q)) / (2a (q − 1)),
-///   a = 4g²,  q = (c + 1)/2 > 1
-/// ```
-///
-/// evaluated with `expm1`/`ln_1p` so that it stays accurate for `a → 0`
-/// (limit `1/2`) and for `c → 1` (limit `ln(1 + a)/(2a)`).
-pub fn k_lobe_energy(c: f64, g: f64) -> f64 {
-    let a = 4.0 * g * g;
-    if a < 1e-12 {
-        // 1/2 − q a/4 + O(a²).
-        return 0.5 - 0.125 * (c + 1.0) * a;
-    }
-    let qm1 = 0.5 * (c - 1.0);
-    -(-qm1 * a.ln_1p()).exp_m1() / (2.0 * a * qm1)
-}
-
-/// The result of [`fit_k_lobe_moments`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MomentFit {
-    /// The scale `s`.
-    pub s: f64,
-    /// The width parameter `g` (0 when clamped).
-    pub g: f64,
-    /// `true` when the profile is too flat for any lobe of peak `C(0)`
-    /// (`E ≥ C(0)/2`, e.g. when `C` rises towards grazing): then `g = 0`
-    /// and `s = 2E` (a constant with the right energy).
-    pub clamped: bool,
-}
-
-/// The **moment fit** of the paper's form `s · k(2g sin θh)`: the peak and
-/// the energy of the profile are kept exactly,
-///
-/// ```text
-///   s = C(0),     s · ∫₀^{π/2} k(2g sin θ) sin θ cos θ dθ = E = ∫₀^{π/2} C sin θ cos θ dθ,
-/// ```
-///
-/// with `g` found by bisection on `ln g ∈ [ln 1e-8, ln 1e8]` (the lobe's
-/// energy, [`k_lobe_energy`], decreases monotonically from `1/2` at `g = 0`)
-/// to a relative `1e-13`. Unlike the least-squares fit, `s` and `g` are then
-/// smooth functions of the parameters wherever `C(0)` and `E` are (except at
-/// the clamp, where `g` goes to 0 like a square root). Returns a zero fit for
-/// non-positive or non-finite input.
-pub fn fit_k_lobe_moments(c0: f64, energy: f64, c: f64) -> MomentFit {
-    if !(c0 > 0.0 && energy > 0.0 && c0.is_finite() && energy.is_finite() && c > 1.0) {
-        return MomentFit {
-            s: 0.0,
-            g: 0.0,
-            clamped: true,
-        };
-    }
-    let target = energy / c0;
-    if target >= 0.5 {
-        return MomentFit {
-            s: 2.0 * energy,
-            g: 0.0,
-            clamped: true,
-        };
-    }
-    let (mut lo, mut hi) = (1e-8f64.ln(), 1e8f64.ln());
-    while hi - lo > 1e-13 {
-        let mid = 0.5 * (lo + hi);
-        if k_lobe_energy(c, mid.exp()) > target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    MomentFit {
-        s: c0,
-        g: (0.5 * (lo + hi)).exp(),
-        clamped: false,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -442,44 +354,6 @@ mod tests {
             assert!((fit.s / s - 1.0).abs() < 1e-7, "{fit:?}");
             assert!(fit.e_l2 < 1e-8, "{fit:?}");
         }
-    }
-
-    #[test]
-    fn lobe_energy_matches_quadrature_and_limits() {
-        let (x, w) = crate::quad::gauss_legendre(200);
-        for c in [1.01, 2.0, 10.0] {
-            for g in [0.0, 1e-7, 0.01, 0.5, 3.0, 40.0] {
-                // ∫₀¹ (1 + 4g²t²)^(−q) t dt on t = (x+1)/2, split at 1/(2g).
-                let q = 0.5 * (c + 1.0);
-                let f = |t: f64| (1.0 + 4.0 * g * g * t * t).powf(-q) * t;
-                let knee: f64 = if g > 0.5 { 0.5 / g } else { 1.0 };
-                let mut sum = 0.0;
-                for (a, b) in [(0.0, knee), (knee, 1.0)] {
-                    for (xi, wi) in x.iter().zip(&w) {
-                        sum += 0.5 * (b - a) * wi * f(a + 0.5 * (b - a) * (xi + 1.0));
-                    }
-                }
-                let e = k_lobe_energy(c, g);
-                assert!((e / sum - 1.0).abs() < 1e-10, "c={c} g={g}: {e} vs {sum}");
-            }
-        }
-    }
-
-    #[test]
-    fn moment_fit_inverts_the_energy() {
-        for (c, g) in [(1.01, 0.3), (2.0, 5.0), (10.0, 2000.0)] {
-            let e = 3.0 * k_lobe_energy(c, g);
-            let fit = fit_k_lobe_moments(3.0, e, c);
-            assert!(!fit.clamped);
-            assert_eq!(fit.s, 3.0);
-            assert!((fit.g / g - 1.0).abs() < 1e-9, "{fit:?}");
-        }
-        // Too flat: a constant of the same energy.
-        let fit = fit_k_lobe_moments(1.0, 0.7, 2.0);
-        assert!(fit.clamped && fit.g == 0.0 && (fit.s - 1.4).abs() < 1e-15);
-        // Bad input does not panic.
-        let fit = fit_k_lobe_moments(f64::NAN, 1.0, 2.0);
-        assert_eq!(fit.s, 0.0);
     }
 
     #[test]

@@ -7,15 +7,19 @@
 //! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
 //!   forms of the convolution, table T3);
 //! - [`query`]: the batch CSV queries of SPEC §6;
+//! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
+//! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod analytic;
 pub mod bspline;
 pub mod fit;
 pub mod materials;
+pub mod plot;
 pub mod quad;
 pub mod query;
 pub mod reference;
+pub mod report;
 pub mod rng;
 pub mod sh;
 pub mod tables;

@@ -17,11 +17,14 @@ use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
 use generator::materials::Materials;
+use generator::report::{self, TableReport};
 use generator::tables::t4::{Projected, ShBrdf};
-use generator::tables::{self, Accuracy, TableKind};
+use generator::tables::{self, TableKind};
 
 /// The workspace's table directory (the default for every subcommand).
 const DEFAULT_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
+/// Where `plot` writes (the pictures of the docs).
+const DEFAULT_IMAGES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/img");
 /// The workspace's materials file (T4 builds one table per material).
 const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
 
@@ -71,9 +74,14 @@ enum Command {
         /// Seed of the random points.
         #[arg(long, default_value_t = 2017)]
         seed: u64,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores). The figures do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Also write the figures as markdown to this file (what
+        /// `docs/accuracy.md` holds; no timestamps, so the same tables, points
+        /// and seed give the same bytes).
+        #[arg(long, value_name = "FILE")]
+        markdown: Option<PathBuf>,
     },
     /// Recompute a spread of grid nodes of tables too expensive to rebuild
     /// in CI (T3) and compare their bits with the files in a directory.
@@ -89,6 +97,38 @@ enum Command {
         /// Nodes to recompute per table (spread evenly, first and last included).
         #[arg(long, default_value_t = 24)]
         nodes: usize,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Draw the pictures of docs/img/: the BRDF lobes of each material in the
+    /// plane of incidence (lobes-<name>.png) and the error maps of T1, T2 and
+    /// T3 at verify's points (error-t1.png, error-t2.png, error-t3.png).
+    Plot {
+        /// Output directory.
+        #[arg(long, default_value = DEFAULT_IMAGES)]
+        out: PathBuf,
+        /// Table directory.
+        #[arg(long, default_value = DEFAULT_TABLES)]
+        tables: PathBuf,
+        /// Materials file.
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
+        /// Only these materials' lobes (all if none).
+        #[arg(long = "material")]
+        only: Vec<String>,
+        /// No error maps (they repeat verify's measurement of T1, T2, T3).
+        #[arg(long)]
+        no_errors: bool,
+        /// Random points of the error maps, as for verify.
+        #[arg(long, default_value_t = 20_000)]
+        points: usize,
+        /// Seed of the random points, as for verify.
+        #[arg(long, default_value_t = 2017)]
+        seed: u64,
+        /// TrueType font for the text.
+        #[arg(long, default_value = generator::plot::DEFAULT_FONT)]
+        font: PathBuf,
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
@@ -136,7 +176,9 @@ fn main() -> ExitCode {
             points,
             seed,
             threads,
-        } => set_threads(threads).and_then(|()| verify(&dir, &materials, &tables, points, seed)),
+            markdown,
+        } => set_threads(threads)
+            .and_then(|()| verify(&dir, &materials, &tables, points, seed, markdown.as_deref())),
         Command::SpotCheck {
             tables,
             dir,
@@ -144,6 +186,28 @@ fn main() -> ExitCode {
             nodes,
             threads,
         } => set_threads(threads).and_then(|()| spot_check(&tables, &dir, &materials, nodes)),
+        Command::Plot {
+            out,
+            tables,
+            materials,
+            only,
+            no_errors,
+            points,
+            seed,
+            font,
+            threads,
+        } => set_threads(threads).and_then(|()| {
+            plot(&PlotArgs {
+                out,
+                tables,
+                materials,
+                only,
+                errors: !no_errors,
+                points,
+                seed,
+                font,
+            })
+        }),
         Command::Inspect { files } => inspect(&files),
         Command::Query { quantity, tables } => query(&quantity, &tables),
     };
@@ -352,9 +416,10 @@ fn verify(
     names: &[String],
     points: usize,
     seed: u64,
+    markdown: Option<&Path>,
 ) -> Result<ExitCode, String> {
     let t4 = material_tables(materials, dir)?;
-    let mut rows: Vec<(String, u64, Result<Vec<Accuracy>, String>)> = Vec::new();
+    let mut reports = Vec::new();
     for kind in selected(names, &t4)? {
         let id = kind.id();
         let stem = kind.file_stem();
@@ -376,60 +441,117 @@ fn verify(
                 );
                 Ok((size, accuracy))
             });
-        match outcome {
-            Ok((size, accuracy)) => rows.push((stem, size, Ok(accuracy))),
-            Err(e) => rows.push((stem, 0, Err(e))),
-        }
+        reports.push(match outcome {
+            Ok((bytes, accuracy)) => TableReport {
+                stem,
+                bytes,
+                outcome: Ok(accuracy),
+            },
+            Err(e) => TableReport {
+                stem,
+                bytes: 0,
+                outcome: Err(e),
+            },
+        });
     }
-    println!(
-        "{:<22} {:>9}  {:<30} {:>7} {:>10} {:>10} {:>10} {:>10} {:>20}  result  worst at",
-        "table", "bytes", "metric", "points", "max", "median", "p90", "p99", "target"
-    );
-    let mut failed = false;
-    for (stem, size, outcome) in &rows {
-        match outcome {
-            Ok(accuracy) => {
-                for a in accuracy {
-                    failed |= !a.passed();
-                    let target = if !a.target.is_finite() {
-                        "-".to_string()
-                    } else if a.gate_quantile < 1.0 {
-                        format!(
-                            "p{:.0} {:.1e}<={:.0e}",
-                            100.0 * a.gate_quantile,
-                            a.gated,
-                            a.target
-                        )
-                    } else {
-                        format!("max <= {:.0e}", a.target)
-                    };
-                    println!(
-                        "{:<22} {:>9}  {:<30} {:>7} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e} {:>20}  {:<6}  {}",
-                        stem,
-                        size,
-                        a.metric,
-                        a.points,
-                        a.max,
-                        a.median,
-                        a.p90,
-                        a.p99,
-                        target,
-                        a.verdict(),
-                        a.worst_at
-                    );
-                }
-            }
-            Err(e) => {
-                failed = true;
-                println!("{:<22} {:>9}  FAIL: {e}", stem, "-");
-            }
+    print!("{}", report::text(&reports));
+    if let Some(file) = markdown {
+        let mut command = format!("generator verify --points {points} --seed {seed}");
+        for n in names {
+            command.push_str(&format!(" --table {n}"));
         }
+        write_atomic(file, report::markdown(&command, &reports).as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
     }
-    Ok(if failed {
-        ExitCode::FAILURE
-    } else {
+    Ok(if reports.iter().all(TableReport::passed) {
         ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
     })
+}
+
+/// The arguments of `plot`.
+struct PlotArgs {
+    out: PathBuf,
+    tables: PathBuf,
+    materials: PathBuf,
+    only: Vec<String>,
+    errors: bool,
+    points: usize,
+    seed: u64,
+    font: PathBuf,
+}
+
+fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
+    use generator::plot;
+    plot::load_font(&args.font)?;
+    let materials = Materials::load(&args.materials).map_err(|e| e.to_string())?;
+    for name in &args.only {
+        if !materials.materials.iter().any(|m| &m.name == name) {
+            return Err(format!(
+                "no material {name} in {}",
+                args.materials.display()
+            ));
+        }
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let out = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
+    // The green channel (as T4's band-limit study).
+    let channel = 1;
+    let lambda = materials.wavelengths[channel];
+    for material in &materials.materials {
+        if !args.only.is_empty() && !args.only.contains(&material.name) {
+            continue;
+        }
+        let path = out.join(format!("lobes-{}.png", material.name));
+        plot::lobes(material, channel, lambda, &args.tables, &path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if args.errors {
+        let (dir, points, seed) = (&args.tables, args.points, args.seed);
+        let suffix = format!("{points} verify points, seed {seed}; largest error per bin");
+        let t1 = plot::View {
+            title: format!("T1 (Smith G1): |G1 − G1_ref|, {suffix}"),
+            x: (0.2, 5.0, "p"),
+            y: (-4.0, 4.0, "log10 a"),
+        };
+        let path = out.join("error-t1.png");
+        plot::heat_map(
+            &path,
+            &t1,
+            &plot::t1_errors(dir, points, seed)?,
+            (48, 32),
+            "|G1 − G1_ref|",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let t2 = plot::View {
+            title: format!("T2 (σ ratio): relative error, {suffix} (over c)"),
+            x: (0.0, 90.0, "θi (°)"),
+            y: (-1.0, 3000f64.log10(), "log10 B"),
+        };
+        let path = out.join("error-t2.png");
+        plot::heat_map(
+            &path,
+            &t2,
+            &plot::t2_errors(dir, points, seed)?,
+            (45, 30),
+            "relative error",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let profiles = plot::t3_errors(dir, points, seed)?;
+        let path = out.join("error-t3.png");
+        plot::t3_map(
+            &path,
+            &profiles,
+            &format!(
+                "T3b: e_L2 of each of verify's {} profiles (seed {seed})",
+                profiles.len()
+            ),
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {

@@ -429,37 +429,11 @@ impl<'a> ConvTable<'a> {
         self
     }
 
-    /// The interpolation weights of parameter axis `d` in `cell`:
-    /// `(first node, node count, weights)`. Linear weights on nodes `i, i+1`,
-    /// or Catmull–Rom weights on `i−1 … i+2` (quadratic in the first and last
-    /// cell, where a node is missing).
+    /// The interpolation weights of parameter axis `d` in `cell`
+    /// ([`axis_weights`] with this table's node count and kernel for `d`).
     #[inline]
     fn axis_weights(&self, d: usize, cell: (usize, f32)) -> (usize, usize, [f32; 4]) {
-        let (i, t) = cell;
-        let n = self.axes[d].nodes();
-        if self.cubic[d] && i >= 1 && i + 2 < n {
-            (i - 1, 4, catmull_rom_weights(t))
-        } else if self.cubic[d] && n >= 3 && i == 0 {
-            // First cell: the quadratic through nodes 0, 1, 2.
-            let w = [
-                0.5 * (t - 1.0) * (t - 2.0),
-                -t * (t - 2.0),
-                0.5 * t * (t - 1.0),
-                0.0,
-            ];
-            (0, 3, w)
-        } else if self.cubic[d] && n >= 3 && i + 2 == n {
-            // Last cell: the quadratic through nodes n−3, n−2, n−1.
-            let w = [
-                0.5 * t * (t - 1.0),
-                (1.0 - t) * (1.0 + t),
-                0.5 * t * (t + 1.0),
-                0.0,
-            ];
-            (i - 1, 3, w)
-        } else {
-            (i, 2, [1.0 - t, t, 0.0, 0.0])
-        }
+        axis_weights(self.axes[d].nodes(), cell, self.cubic[d])
     }
 
     /// T3b restricted to the material `(c, β, p)` (see [`ConvSlice`]);
@@ -657,7 +631,7 @@ impl<'a> ConvTable<'a> {
 /// (already blended) values of the four channels `first … first + 3` around
 /// `ξ`; one-sided slopes in the first and last interval.
 #[inline]
-fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) -> f32 {
+pub fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) -> f32 {
     let n = angles;
     let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
     let k = (math::floorf(position) as usize).min(n - 2);
@@ -779,6 +753,40 @@ pub(crate) fn catmull_rom_weights(t: f32) -> [f32; 4] {
         0.5 * (-3.0 * t3 + 4.0 * t2 + t),
         0.5 * (t3 - t2),
     ]
+}
+
+/// The interpolation weights of a parameter axis with `nodes` nodes in
+/// `cell` (from [`Axis::locate`](crate::interp::Axis::locate)):
+/// `(first node, node count, weights)`. Linear weights on nodes `i, i+1`, or
+/// with `cubic` Catmull–Rom weights on `i−1 … i+2` (quadratic in the first
+/// and last cell, where a node is missing).
+#[inline]
+pub fn axis_weights(nodes: usize, cell: (usize, f32), cubic: bool) -> (usize, usize, [f32; 4]) {
+    let (i, t) = cell;
+    let n = nodes;
+    if cubic && i >= 1 && i + 2 < n {
+        (i - 1, 4, catmull_rom_weights(t))
+    } else if cubic && n >= 3 && i == 0 {
+        // First cell: the quadratic through nodes 0, 1, 2.
+        let w = [
+            0.5 * (t - 1.0) * (t - 2.0),
+            -t * (t - 2.0),
+            0.5 * t * (t - 1.0),
+            0.0,
+        ];
+        (0, 3, w)
+    } else if cubic && n >= 3 && i + 2 == n {
+        // Last cell: the quadratic through nodes n−3, n−2, n−1.
+        let w = [
+            0.5 * t * (t - 1.0),
+            (1.0 - t) * (1.0 + t),
+            0.5 * t * (t + 1.0),
+            0.0,
+        ];
+        (i - 1, 3, w)
+    } else {
+        (i, 2, [1.0 - t, t, 0.0, 0.0])
+    }
 }
 
 /// `tan θh = sin θh / cos θh`, with non-positive cosines at the horizon (∞)

@@ -156,6 +156,23 @@ impl Accuracy {
         self
     }
 
+    /// The target as `verify` prints it: `-` for none, `max <= T`, or
+    /// `pQ value<=T` for a gated quantile.
+    pub fn target_text(&self) -> String {
+        if !self.target.is_finite() {
+            "-".to_string()
+        } else if self.gate_quantile < 1.0 {
+            format!(
+                "p{:.0} {:.1e}<={:.0e}",
+                100.0 * self.gate_quantile,
+                self.gated,
+                self.target
+            )
+        } else {
+            format!("max <= {:.0e}", self.target)
+        }
+    }
+
     /// Whether the target is met (a NaN fails); always true when reported only.
     pub fn passed(&self) -> bool {
         self.report_only || self.gated <= self.target

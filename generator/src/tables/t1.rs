@@ -99,14 +99,7 @@ impl TableKind for SmithG1 {
         let samples = verification_points(points, seed);
         let errors = samples
             .par_iter()
-            .map(|&(p, a)| {
-                let reference = epd::g1(p, a).map_err(|source| BuildError::Quadrature {
-                    at: format!("T1 verify p = {p}, a = {a}"),
-                    source,
-                })?;
-                let got = f64::from(table.g1(p as f32, a as f32));
-                Ok(((got - reference).abs(), format!("p = {p:.4}, a = {a:.4e}")))
-            })
+            .map(|&(p, a)| Ok((error_at(&table, p, a)?, format!("p = {p:.4}, a = {a:.4e}"))))
             .collect::<Result<Vec<_>, BuildError>>()?;
         Ok(vec![Accuracy::from_errors(
             "max |G1 - G1_ref|",
@@ -114,6 +107,16 @@ impl TableKind for SmithG1 {
             errors,
         )])
     }
+}
+
+/// The error `verify` measures at one point: `|G1 − G1_ref|` of the table at
+/// `(p, a)` against the reference.
+pub fn error_at(table: &SmithG1Table<'_>, p: f64, a: f64) -> Result<f64, BuildError> {
+    let reference = epd::g1(p, a).map_err(|source| BuildError::Quadrature {
+        at: format!("T1 verify p = {p}, a = {a}"),
+        source,
+    })?;
+    Ok((f64::from(table.g1(p as f32, a as f32)) - reference).abs())
 }
 
 /// Random verification points (p, a), off-grid with probability 1: p uniform

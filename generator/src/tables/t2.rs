@@ -115,20 +115,11 @@ impl TableKind for SigmaRatio {
         let errors = verification_points(points, seed)
             .par_iter()
             .map(|&(cos_theta_i, big_b, c)| {
-                let theta_i = cos_theta_i.acos();
-                let reference = kcorr::sigma_ratio(theta_i, big_b, c).map_err(|source| {
-                    BuildError::Quadrature {
-                        at: format!("T2 verify θi = {theta_i}, B = {big_b}, c = {c}"),
-                        source,
-                    }
-                })?;
-                let got =
-                    f64::from(table.sigma_ratio_cos(cos_theta_i as f32, big_b as f32, c as f32));
                 Ok((
-                    ((got - reference) / reference).abs(),
+                    error_at(&table, cos_theta_i, big_b, c)?,
                     format!(
                         "θi = {:.4}°, B = {big_b:.4}, c = {c:.4}",
-                        theta_i.to_degrees()
+                        cos_theta_i.acos().to_degrees()
                     ),
                 ))
             })
@@ -139,6 +130,24 @@ impl TableKind for SigmaRatio {
             errors,
         )])
     }
+}
+
+/// The error `verify` measures at one point: the relative error of the
+/// table's σ ratio at `(cos θi, B, c)` against the reference.
+pub fn error_at(
+    table: &SigmaRatioTable<'_>,
+    cos_theta_i: f64,
+    big_b: f64,
+    c: f64,
+) -> Result<f64, BuildError> {
+    let theta_i = cos_theta_i.acos();
+    let reference =
+        kcorr::sigma_ratio(theta_i, big_b, c).map_err(|source| BuildError::Quadrature {
+            at: format!("T2 verify θi = {theta_i}, B = {big_b}, c = {c}"),
+            source,
+        })?;
+    let got = f64::from(table.sigma_ratio_cos(cos_theta_i as f32, big_b as f32, c as f32));
+    Ok(((got - reference) / reference).abs())
 }
 
 /// Random points over the SPEC domain θi ∈ [0, π/2], B ∈ [0.1, 3000],

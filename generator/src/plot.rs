@@ -1,0 +1,476 @@
+//! `generator plot`: the pictures of `docs/img/`.
+//!
+//! * **Lobes** (one PNG per material, as HP17 Figs. 12–15): the two-scale
+//!   BRDF in the plane of incidence at four incidences, on a log scale, with
+//!   its three terms apart (`TwoScale::eval_lobes`: specular `A_spec ρ_CT`,
+//!   diffraction `ρ_CTD`, base `ρ_base + k_d/π`).
+//! * **Error maps** of T1, T2 and T3: the errors `verify` measures, at
+//!   `verify`'s random points (the same functions: `t1::error_at`,
+//!   `t2::error_at`, `t3::verify_point`), binned over two axes of the
+//!   table's domain (the largest error per bin; T3's profiles, being few,
+//!   are drawn one marker each).
+//!
+//! Text needs a TrueType font, read from a file at run time (plotters'
+//! `ab_glyph` feature: no system font lookup); [`DEFAULT_FONT`] is where
+//! Debian's `fonts-dejavu-core` puts DejaVu Sans.
+
+use crate::materials::Material;
+use crate::tables::t4::{ModelInputs, two_scale_brdf};
+use crate::tables::{BuildError, file_name, t1, t2, t3};
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+use rayon::prelude::*;
+use std::path::Path;
+use twoscale::format::aligned_copy;
+use twoscale::{ConvTable, SigmaRatioTable, SmithG1Table, TableId};
+
+/// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
+pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+/// The incidences of the lobe plots, degrees.
+pub const INCIDENCES: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
+
+/// Size of every picture, pixels.
+const SIZE: (u32, u32) = (800, 540);
+
+/// The font family name the pictures use.
+const FONT: &str = "sans-serif";
+
+/// Reads the TrueType file at `path` and registers it as the pictures' font.
+pub fn load_font(path: &Path) -> Result<(), String> {
+    let bytes = std::fs::read(path).map_err(|e| {
+        format!(
+            "cannot read the font {} ({e}); install fonts-dejavu-core or pass --font",
+            path.display()
+        )
+    })?;
+    // plotters keeps fonts for the life of the process.
+    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+    plotters::style::register_font(FONT, FontStyle::Normal, bytes)
+        .map_err(|_| format!("{} is not a TrueType font", path.display()))
+}
+
+fn draw_error(e: impl std::fmt::Debug) -> String {
+    format!("drawing failed: {e:?}")
+}
+
+/// One term of the BRDF, as drawn.
+struct Term {
+    name: &'static str,
+    color: RGBColor,
+    pick: fn(&twoscale::brdf::Lobes) -> f32,
+}
+
+const TERMS: [Term; 4] = [
+    Term {
+        name: "total ρ",
+        color: BLACK,
+        pick: |l| l.total(),
+    },
+    Term {
+        name: "specular",
+        color: RGBColor(31, 119, 180),
+        pick: |l| l.specular,
+    },
+    Term {
+        name: "diffraction",
+        color: RGBColor(214, 39, 40),
+        pick: |l| l.diffraction,
+    },
+    Term {
+        name: "base",
+        color: RGBColor(44, 160, 44),
+        pick: |l| l.base,
+    },
+];
+
+/// Outgoing angles in the plane of incidence, degrees (positive: the
+/// mirror side), with a fine run around the mirror direction so that narrow
+/// specular peaks are resolved.
+fn outgoing_angles(theta_i: f64) -> Vec<f64> {
+    let mut v: Vec<f64> = (0..=716).map(|k| -89.5 + 0.25 * f64::from(k)).collect();
+    v.extend((0..=600).map(|k| theta_i - 3.0 + 0.01 * f64::from(k)));
+    v.retain(|t| t.abs() <= 89.5);
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
+/// with the tables of `tables_dir` to `path`.
+pub fn lobes(
+    material: &Material,
+    channel: usize,
+    lambda: f64,
+    tables_dir: &Path,
+    path: &Path,
+) -> Result<(), String> {
+    let inputs = ModelInputs::load(tables_dir).map_err(|e| e.to_string())?;
+    let parsed = inputs.parse().map_err(|e| e.to_string())?;
+    let tables = parsed.brdf_tables();
+    let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
+    // Per incidence: θo and the terms at each.
+    let curves: Vec<(f64, Vec<f64>, Vec<[f64; 4]>)> = INCIDENCES
+        .iter()
+        .map(|&theta_i| {
+            let ti = theta_i.to_radians();
+            let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
+            let thetas = outgoing_angles(theta_i);
+            let values = thetas
+                .iter()
+                .map(|&t| {
+                    let to = t.to_radians();
+                    let lobes = brdf.eval_lobes(i, [to.sin() as f32, 0.0, to.cos() as f32]);
+                    TERMS.map(|term| f64::from((term.pick)(&lobes)))
+                })
+                .collect();
+            (theta_i, thetas, values)
+        })
+        .collect();
+    let peak = curves
+        .iter()
+        .flat_map(|(_, _, v)| v.iter().map(|t| t[0]))
+        .fold(0.0f64, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return Err(format!("{}: the BRDF is zero everywhere", material.name));
+    }
+    let hi = 10f64.powf(peak.log10().ceil() + 0.3);
+    let lo = hi * 1e-6;
+
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let root = root
+        .titled(
+            &format!(
+                "{}: ρ in the plane of incidence, λ = {lambda} µm (log scale)",
+                material.name
+            ),
+            (FONT, 20),
+        )
+        .map_err(draw_error)?;
+    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(&curves) {
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("θi = {theta_i}°"), (FONT, 15))
+            .margin(6)
+            .x_label_area_size(32)
+            .y_label_area_size(58)
+            .build_cartesian_2d(-90f64..90f64, (lo..hi).log_scale())
+            .map_err(draw_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("θo (°), + on the mirror side")
+            .y_desc("ρ (sr⁻¹)")
+            .x_labels(7)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style((FONT, 11))
+            .axis_desc_style((FONT, 12))
+            .draw()
+            .map_err(draw_error)?;
+        for (k, term) in TERMS.iter().enumerate() {
+            // Runs above the plot's floor (a log axis has no 0).
+            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+            for (&t, v) in thetas.iter().zip(values) {
+                if v[k] > lo {
+                    runs.last_mut().expect("one run").push((t, v[k]));
+                } else if !runs.last().expect("one run").is_empty() {
+                    runs.push(Vec::new());
+                }
+            }
+            let style = ShapeStyle::from(&term.color).stroke_width(if k == 0 { 2 } else { 1 });
+            if runs.iter().all(Vec::is_empty) {
+                // Listed all the same: absent (a conductor has no base), or
+                // below the plot.
+                let largest = values.iter().map(|v| v[k]).fold(0.0f64, f64::max);
+                let label = if largest > 0.0 {
+                    format!("{}: all < {lo:.0e}", term.name)
+                } else {
+                    format!("{}: none", term.name)
+                };
+                chart
+                    .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                    .map_err(draw_error)?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+                continue;
+            }
+            for (r, run) in runs.into_iter().filter(|r| !r.is_empty()).enumerate() {
+                let series = chart
+                    .draw_series(LineSeries::new(run, style))
+                    .map_err(draw_error)?;
+                if r == 0 {
+                    series
+                        .label(term.name)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 11))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(draw_error)?;
+    }
+    root.present().map_err(draw_error)
+}
+
+/// Errors at points of a 2-D view of a table's domain: `(x, y, error)` in
+/// plot coordinates.
+pub type Samples = Vec<(f64, f64, f64)>;
+
+/// The file of table `id` in `dir`, aligned.
+fn table_bytes(dir: &Path, id: TableId) -> Result<twoscale::format::AlignedBuf, String> {
+    let path = dir.join(file_name(id));
+    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    Ok(aligned_copy(&bytes))
+}
+
+/// T1's errors at `verify`'s points: `(p, log10 a, |G1 − G1_ref|)`.
+pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, String> {
+    let buf = table_bytes(dir, TableId::SmithG1)?;
+    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    t1::verification_points(points, seed)
+        .par_iter()
+        .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), t1::error_at(&table, p, a)?)))
+        .collect::<Result<_, BuildError>>()
+        .map_err(|e| e.to_string())
+}
+
+/// T2's errors at `verify`'s points: `(θi in degrees, log10 B, relative error)`.
+pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, String> {
+    let buf = table_bytes(dir, TableId::SigmaRatio)?;
+    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    t2::verification_points(points, seed)
+        .par_iter()
+        .map(|&(cos_i, big_b, c)| {
+            Ok((
+                cos_i.acos().to_degrees(),
+                big_b.log10(),
+                t2::error_at(&table, cos_i, big_b, c)?,
+            ))
+        })
+        .collect::<Result<_, BuildError>>()
+        .map_err(|e| e.to_string())
+}
+
+/// T3b's e_L2 at `verify`'s profiles (`t3::profiles_for(points)` of them):
+/// `([u, c, β, p], e_L2)`.
+pub fn t3_errors(dir: &Path, points: usize, seed: u64) -> Result<Vec<([f64; 4], f64)>, String> {
+    let buf = table_bytes(dir, TableId::Convolution)?;
+    let table = ConvTable::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    t3::verification_points(t3::profiles_for(points), seed)
+        .par_iter()
+        .map(|&pt| Ok((pt, t3::verify_point(&table, pt)?.accurate_e_l2)))
+        .collect::<Result<_, BuildError>>()
+        .map_err(|e| e.to_string())
+}
+
+/// A 2-D view of a domain: ranges and axis descriptions.
+pub struct View {
+    /// Picture title.
+    pub title: String,
+    /// x range and description.
+    pub x: (f64, f64, &'static str),
+    /// y range and description.
+    pub y: (f64, f64, &'static str),
+}
+
+/// The colour scale of the error maps: `log10` of the error from `lo` to
+/// `hi` (decades).
+struct Scale {
+    lo: f64,
+    hi: f64,
+}
+
+impl Scale {
+    fn of(errors: impl Iterator<Item = f64>) -> Scale {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for e in errors.filter(|e| *e > 0.0 && e.is_finite()) {
+            lo = lo.min(e.log10());
+            hi = hi.max(e.log10());
+        }
+        if lo >= hi {
+            // No positive error (or one value): any decade range will do.
+            (lo, hi) = (lo.min(0.0) - 8.0, lo.min(0.0));
+        }
+        Scale {
+            lo: lo.floor().max(hi.ceil() - 8.0),
+            hi: hi.ceil(),
+        }
+    }
+
+    fn color(&self, error: f64) -> RGBColor {
+        let v = if error > 0.0 { error.log10() } else { self.lo };
+        ViridisRGB::get_color_normalized(v.clamp(self.lo, self.hi), self.lo, self.hi)
+    }
+}
+
+/// Draws the colour bar of `scale` into `area`.
+fn color_bar(
+    area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    scale: &Scale,
+    what: &str,
+) -> Result<(), String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(40)
+        .margin_bottom(40)
+        .margin_right(8)
+        .y_label_area_size(52)
+        .build_cartesian_2d(0f64..1f64, scale.lo..scale.hi)
+        .map_err(draw_error)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .y_desc(what)
+        .y_label_formatter(&|v| format!("{:.0e}", 10f64.powf(*v)))
+        .label_style((FONT, 11))
+        .axis_desc_style((FONT, 12))
+        .draw()
+        .map_err(draw_error)?;
+    let steps = 100;
+    let step = (scale.hi - scale.lo) / f64::from(steps);
+    chart
+        .draw_series((0..steps).map(|k| {
+            let v0 = scale.lo + step * f64::from(k);
+            let c = ViridisRGB::get_color_normalized(v0 + 0.5 * step, scale.lo, scale.hi);
+            Rectangle::new([(0.0, v0), (1.0, v0 + step)], c.filled())
+        }))
+        .map_err(draw_error)?;
+    Ok(())
+}
+
+/// A bitmap drawing area.
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// A picture at `path` with `title`: the whole canvas, the plot area and the
+/// colour bar's area.
+fn canvas<'a>(path: &'a Path, title: &str) -> Result<(Area<'a>, Area<'a>, Area<'a>), String> {
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let titled = root.titled(title, (FONT, 18)).map_err(draw_error)?;
+    let (main, bar) = titled.split_horizontally(SIZE.0 - 130);
+    Ok((root, main, bar))
+}
+
+/// Axes over `x` and `y` (range and description) in `area`, drawn, with or
+/// without the mesh.
+fn axes<'a, 'b>(
+    area: &'a Area<'b>,
+    x: (f64, f64, &str),
+    y: (f64, f64, &str),
+    mesh: bool,
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(draw_error)?;
+    let mut style = chart.configure_mesh();
+    if !mesh {
+        style.disable_mesh();
+    }
+    style
+        .x_desc(x.2)
+        .y_desc(y.2)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .draw()
+        .map_err(draw_error)?;
+    Ok(chart)
+}
+
+/// The error map of `samples` over `view`: the largest error in each of
+/// `bins.0 × bins.1` bins (samples outside the view go to the edge bins),
+/// empty bins left white; `what` names the error.
+pub fn heat_map(
+    path: &Path,
+    view: &View,
+    samples: &Samples,
+    bins: (usize, usize),
+    what: &str,
+) -> Result<(), String> {
+    let (nx, ny) = bins;
+    let (x0, x1, y0, y1) = (view.x.0, view.x.1, view.y.0, view.y.1);
+    let index = |v: f64, lo: f64, hi: f64, n: usize| {
+        (((v - lo) / (hi - lo) * n as f64).floor().max(0.0) as usize).min(n - 1)
+    };
+    let mut worst = vec![None::<f64>; nx * ny];
+    for &(x, y, e) in samples {
+        let k = index(y, y0, y1, ny) * nx + index(x, x0, x1, nx);
+        worst[k] = Some(worst[k].map_or(e, |w: f64| w.max(e)));
+    }
+    let scale = Scale::of(worst.iter().flatten().copied());
+    let (root, main, bar) = canvas(path, &view.title)?;
+    let mut chart = axes(&main, view.x, view.y, false)?;
+    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+    chart
+        .draw_series(worst.iter().enumerate().filter_map(|(k, w)| {
+            let (i, j) = ((k % nx) as f64, (k / nx) as f64);
+            w.map(|e| {
+                Rectangle::new(
+                    [
+                        (x0 + i * dx, y0 + j * dy),
+                        (x0 + (i + 1.0) * dx, y0 + (j + 1.0) * dy),
+                    ],
+                    scale.color(e).filled(),
+                )
+            })
+        }))
+        .map_err(draw_error)?;
+    color_bar(&bar, &scale, what)?;
+    root.present().map_err(draw_error)
+}
+
+/// The T3 map: one marker per profile in two views, `(ln u, ln β)` and
+/// `(c, p)`, coloured by T3b's e_L2.
+pub fn t3_map(path: &Path, profiles: &[([f64; 4], f64)], title: &str) -> Result<(), String> {
+    let scale = Scale::of(profiles.iter().map(|p| p.1));
+    let (root, main, bar) = canvas(path, title)?;
+    let panels = main.split_evenly((1, 2));
+    /// One panel: the plot coordinates of a point `(u, c, β, p)` and the
+    /// axes (range, description).
+    struct Panel {
+        coords: fn(&[f64; 4]) -> (f64, f64),
+        x: (f64, f64, &'static str),
+        y: (f64, f64, &'static str),
+    }
+    let views = [
+        Panel {
+            coords: |p| ((p[0] + 0.1).log10(), p[2].log10()),
+            x: (-1.0, 3.5, "log10(u + 0.1)"),
+            y: (0.002f64.log10(), 0.0, "log10 β"),
+        },
+        Panel {
+            coords: |p| (p[1], p[3]),
+            x: (1.0, 10.0, "c"),
+            y: (0.2, 5.0, "p"),
+        },
+    ];
+    for (panel, view) in panels.iter().zip(views) {
+        let coords = view.coords;
+        let mut chart = axes(panel, view.x, view.y, true)?;
+        chart
+            .draw_series(
+                profiles
+                    .iter()
+                    .map(|(p, e)| Circle::new(coords(p), 6, scale.color(*e).filled())),
+            )
+            .map_err(draw_error)?;
+        chart
+            .draw_series(
+                profiles
+                    .iter()
+                    .map(|(p, _)| Circle::new(coords(p), 6, BLACK.stroke_width(1))),
+            )
+            .map_err(draw_error)?;
+    }
+    color_bar(&bar, &scale, "T3b e_L2 against exact C")?;
+    root.present().map_err(draw_error)
+}

@@ -1,0 +1,50 @@
+//! `generator plot` runs: one material's lobes into a temporary directory
+//! give a PNG of the documented size.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+#[test]
+fn plot_writes_the_lobes_of_one_material() {
+    let out = std::env::temp_dir().join(format!("generator-plot-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = Command::new(env!("CARGO_BIN_EXE_generator"))
+        .args(["plot", "--no-errors", "--material", "gold-rough", "--out"])
+        .arg(&out)
+        .status()
+        .expect("generator runs");
+    assert!(status.success(), "generator plot failed: {status}");
+    let written: Vec<PathBuf> = std::fs::read_dir(&out)
+        .expect("output directory")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    assert_eq!(written, vec![out.join("lobes-gold-rough.png")]);
+    let png = std::fs::read(&written[0]).expect("readable PNG");
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "not a PNG");
+    // IHDR: width and height, big-endian, at bytes 16..24.
+    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert_eq!((width, height), (800, 540));
+    // Curves and text, not a blank canvas: a blank 800×540 PNG compresses
+    // to a few kB.
+    assert!(png.len() > 20_000, "{} bytes", png.len());
+    std::fs::remove_dir_all(&out).expect("clean up");
+}
+
+#[test]
+fn plot_refuses_an_unknown_material() {
+    let output = Command::new(env!("CARGO_BIN_EXE_generator"))
+        .args([
+            "plot",
+            "--no-errors",
+            "--material",
+            "no-such-material",
+            "--out",
+        ])
+        .arg(std::env::temp_dir().join("generator-plot-test-unknown"))
+        .output()
+        .expect("generator runs");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no material no-such-material"), "{stderr}");
+}

@@ -1,0 +1,148 @@
+//! What the T3 studies share: exact profiles, the committed table, the two
+//! parameter distributions, and error summaries.
+
+use generator::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
+use generator::rng::SplitMix64;
+use generator::tables::t3;
+use generator::tables::t4::WORKSPACE_TABLES;
+use std::path::Path;
+use twoscale::format::{AlignedBuf, AxisHeader, TableId};
+use twoscale::interp::Axis;
+
+/// T3's parameter axes `(u, c, β, p)`, as the generator builds them.
+pub const AXES: [AxisHeader; 4] = [t3::U_AXIS, t3::C_AXIS, t3::BETA_AXIS, t3::P_AXIS];
+
+/// Gauss nodes per interval of the studies' profile rule (half the metric's
+/// 16: the metric does not change, and the reference costs half).
+pub const ORDER: usize = 8;
+
+/// The committed T3 file, copied to aligned memory.
+pub fn committed_t3() -> AlignedBuf {
+    let path = Path::new(WORKSPACE_TABLES).join(generator::tables::file_name(TableId::Convolution));
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    twoscale::format::aligned_copy(&bytes)
+}
+
+/// The runtime's cell of `x` on axis `d` of [`AXES`] (clamped to the axis).
+pub fn cell(d: usize, x: f64) -> (usize, f32) {
+    Axis::new(&AXES[d]).expect("valid T3 axis").locate(x as f32)
+}
+
+/// An exact profile: `C` on the nodes of the studies' profile rule, and `C(0)`.
+pub struct Exact {
+    /// `(u, c, β, p)`.
+    pub point: [f64; 4],
+    /// The rule (the metric's intervals, [`ORDER`] nodes each).
+    pub rule: ProfileRule,
+    /// `C` at the rule's nodes.
+    pub values: Vec<f64>,
+    /// `C(0)`.
+    pub c0: f64,
+}
+
+impl Exact {
+    /// Computes the profile at `point` with the reference.
+    pub fn new(point: [f64; 4]) -> Exact {
+        let [u, c, beta, p] = point;
+        let params = Params::new(u, c, beta, p).expect("point inside T3's domain");
+        let rule = ProfileRule::with_order(ProfileRule::width_for(&params), ORDER);
+        let values = exact_c(point, &rule.nodes);
+        let c0 = exact_c(point, &[0.0])[0];
+        Exact {
+            point,
+            rule,
+            values,
+            c0,
+        }
+    }
+
+    /// e_L2 (`reference::conv::e_l2_on`) of values `approx` given at the
+    /// rule's nodes.
+    pub fn e_l2(&self, approx: &[f64]) -> f64 {
+        let nodes = &self.rule.nodes;
+        e_l2_on(
+            &self.rule,
+            |t| approx[nodes.partition_point(|&x| x < t).min(approx.len() - 1)],
+            &self.values,
+        )
+    }
+
+    /// Relative errors of `approx` (at the rule's nodes) split into the core
+    /// (`C > 1e-3 C(0)`) and the tail (`1e-9 C(0) < C ≤ 1e-3 C(0)`), appended.
+    pub fn pointwise(&self, approx: &[f64], core: &mut Vec<f64>, tail: &mut Vec<f64>) {
+        for (a, &x) in approx.iter().zip(&self.values) {
+            let rel = ((a - x) / x).abs();
+            if x > 1e-3 * self.c0 {
+                core.push(rel);
+            } else if x > 1e-9 * self.c0 {
+                tail.push(rel);
+            }
+        }
+    }
+}
+
+/// Exact `C` at the angles `thetas` (the reference).
+pub fn exact_c([u, c, beta, p]: [f64; 4], thetas: &[f64]) -> Vec<f64> {
+    convolution_profile(u, c, beta, p, thetas).expect("reference converges in T3's domain")
+}
+
+/// `ln C` floored as the table stores it (`VALUE_FLOOR` times the peak).
+pub fn floored_ln(values: &[f64]) -> Vec<f64> {
+    let peak = values.iter().copied().fold(0.0f64, f64::max);
+    values
+        .iter()
+        .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
+        .collect()
+}
+
+/// Which parameter points a study draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Distribution {
+    /// `generator verify`'s: uniform in the mapped coordinates of the whole
+    /// T3 domain (`t3::verification_points`).
+    Verify,
+    /// The BRDF check's (`tests/independent/brdf_scipy.py`): u log-uniform in
+    /// [0.5, 50], c uniform in [1.2, 6], β log-uniform in [0.05, 1], p
+    /// uniform in [0.5, 5].
+    Brdf,
+}
+
+impl Distribution {
+    /// `count` points of the distribution from `seed`.
+    pub fn points(self, count: usize, seed: u64) -> Vec<[f64; 4]> {
+        match self {
+            Distribution::Verify => t3::verification_points(count, seed),
+            Distribution::Brdf => {
+                let mut rng = SplitMix64::new(seed);
+                (0..count)
+                    .map(|_| {
+                        let u = rng.log_uniform_in(0.5, 50.0);
+                        let c = rng.uniform_in(1.2, 6.0);
+                        let beta = rng.log_uniform_in(0.05, 1.0);
+                        let p = rng.uniform_in(0.5, 5.0);
+                        [u, c, beta, p]
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// The `q` quantile of `v` (sorted in place; NaN when empty), with the
+/// rounding of `tables::Accuracy`.
+pub fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// The `qs` quantiles of `v` as percentages, space-separated.
+pub fn percentiles(v: &mut [f64], qs: &[f64]) -> String {
+    let cells: Vec<String> = qs
+        .iter()
+        .map(|&q| format!("{:.2}%", 100.0 * quantile(v, q)))
+        .collect();
+    cells.join(" ")
+}

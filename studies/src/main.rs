@@ -1,0 +1,201 @@
+//! `studies`: the design studies behind the shipped tables. Each subcommand
+//! reproduces the measurements of one record in `docs/design/`; it calls the
+//! runtime and the generator (the reference, the tables' constants, the
+//! lookup's weights) instead of copies of them.
+//!
+//! ```text
+//! cargo run --release -p studies -- <subcommand> [options]
+//! ```
+//!
+//! Deterministic (fixed seeds); the reference profiles run on rayon's
+//! threads (`RAYON_NUM_THREADS` limits them).
+
+mod common;
+mod t3_angle;
+mod t3_axes;
+mod t3_interp;
+mod t3_thresholds;
+mod t4_band_limits;
+
+use clap::{Parser, Subcommand};
+use common::Distribution;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use t3_angle::Angle;
+
+/// The workspace's materials file.
+const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
+
+#[derive(Parser)]
+#[command(about = "Design studies behind the shipped tables (see docs/design/)")]
+struct Cli {
+    #[command(subcommand)]
+    study: Study,
+}
+
+#[derive(Subcommand)]
+enum Study {
+    /// T3's normalised angle, ξ alone: each form's error on exact profiles
+    /// with the parameters exact (docs/design/t3-normalised-angle.md).
+    T3AngleForms {
+        /// Profiles.
+        #[arg(long, default_value_t = 80)]
+        profiles: usize,
+        /// Whose parameter points.
+        #[arg(long, value_enum, default_value_t = Distribution::Brdf)]
+        distribution: Distribution,
+        /// Angles compared: `format1`, or `w_h,w_e,s_e,tau_f` (the runtime's
+        /// angle with those weights); repeatable.
+        #[arg(long = "angle", value_parser = Angle::parse,
+              default_values = t3_angle::DEFAULT_ANGLES)]
+        angles: Vec<Angle>,
+    },
+    /// T3's normalised angle: the NDF term's softening κ, ξ alone, on
+    /// verify's and the BRDF check's points
+    /// (docs/design/t3-normalised-angle.md). κ = 1 was chosen on format 1's
+    /// angle (`--angle format1`); the default measures it in the shipped one.
+    T3AngleSoftening {
+        /// Profiles per distribution.
+        #[arg(long, default_value_t = 60)]
+        profiles: usize,
+        /// The angle whose κ varies (`format1` or `w_h,w_e,s_e,tau_f`).
+        #[arg(long, value_parser = Angle::parse, default_value = "0.5,0.5,2,3")]
+        angle: Angle,
+        /// The κ compared.
+        #[arg(long, value_delimiter = ',', default_value = "0,0.5,1,2,4")]
+        kappas: Vec<f64>,
+    },
+    /// T3's normalised angle with β and p interpolated as the lookup does
+    /// (u, c exact), against ξ alone: predicts a table's error without
+    /// building it (docs/design/t3-normalised-angle.md).
+    T3AnglePatch {
+        /// Verify profiles.
+        #[arg(long, default_value_t = 80)]
+        profiles: usize,
+        /// Angles compared (as for t3-angle-forms).
+        #[arg(long = "angle", value_parser = Angle::parse,
+              default_values = t3_angle::DEFAULT_ANGLES)]
+        angles: Vec<Angle>,
+    },
+    /// T3's normalised angle at given points (CSV `u,c,beta,p,theta_h`, e.g.
+    /// the BRDF check's): exact C and each angle's, as CSV on stdout
+    /// (docs/design/t3-normalised-angle.md).
+    T3AngleAtPoints {
+        /// The points.
+        file: PathBuf,
+        /// β and p interpolated too (as t3-angle-patch), not ξ alone.
+        #[arg(long)]
+        patch: bool,
+        /// Angles compared (as for t3-angle-forms).
+        #[arg(long = "angle", value_parser = Angle::parse,
+              default_values = t3_angle::DEFAULT_ANGLES)]
+        angles: Vec<Angle>,
+    },
+    /// T3's parameter axes: node count and mapping of one axis, the others
+    /// exact (docs/design/t3-grid-and-quantisation.md).
+    T3Axis {
+        /// The axis.
+        #[arg(value_enum)]
+        axis: t3_axes::Param,
+        /// Random triples (one fixes the other parameters, two test).
+        #[arg(long, default_value_t = 40)]
+        triples: usize,
+    },
+    /// T3's interpolation across the parameters: Catmull–Rom or linear per
+    /// axis, on the committed table (docs/design/t3-interpolation.md).
+    T3CubicAxes {
+        /// Verify profiles.
+        #[arg(long, default_value_t = 60)]
+        profiles: usize,
+    },
+    /// T3's interpolation: Catmull–Rom (shipped) against a not-a-knot
+    /// B-spline on prefiltered coefficients, on the committed table's values
+    /// (docs/design/t3-interpolation.md).
+    T3Spline {
+        /// Profiles.
+        #[arg(long, default_value_t = 120)]
+        profiles: usize,
+        /// Seed of the points.
+        #[arg(long, default_value_t = 99)]
+        seed: u64,
+        /// Whose parameter points.
+        #[arg(long, value_enum, default_value_t = Distribution::Verify)]
+        distribution: Distribution,
+        /// Parameters snapped to their nearest nodes: any of `u`, `c`, `b`
+        /// (β), `p`.
+        #[arg(long, default_value = "")]
+        snap: String,
+    },
+    /// The paper's thresholds for T3a's g (HP17 §4.4) read from the
+    /// committed table (docs/design/t3-paper-form.md).
+    T3Thresholds,
+    /// T4's error against the band limit L
+    /// (docs/design/t4-band-limits.md).
+    T4BandLimits {
+        /// Which BRDFs.
+        #[arg(value_enum, default_value_t = t4_band_limits::Subject::TwoScale)]
+        subject: t4_band_limits::Subject,
+        /// Materials file (for the two-scale presets).
+        #[arg(long, default_value = DEFAULT_MATERIALS)]
+        materials: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let result = match Cli::parse().study {
+        Study::T3AngleForms {
+            profiles,
+            distribution,
+            angles,
+        } => {
+            t3_angle::forms(profiles, distribution, &angles);
+            Ok(())
+        }
+        Study::T3AngleSoftening {
+            profiles,
+            angle,
+            kappas,
+        } => {
+            t3_angle::softening(profiles, angle, &kappas);
+            Ok(())
+        }
+        Study::T3AnglePatch { profiles, angles } => {
+            t3_angle::patch(profiles, &angles);
+            Ok(())
+        }
+        Study::T3AngleAtPoints {
+            file,
+            patch,
+            angles,
+        } => t3_angle::at_points(&file, &angles, patch),
+        Study::T3Axis { axis, triples } => {
+            t3_axes::run(axis, triples);
+            Ok(())
+        }
+        Study::T3CubicAxes { profiles } => {
+            t3_interp::cubic_axes(profiles);
+            Ok(())
+        }
+        Study::T3Spline {
+            profiles,
+            seed,
+            distribution,
+            snap,
+        } => {
+            t3_interp::spline(profiles, seed, distribution, &snap);
+            Ok(())
+        }
+        Study::T3Thresholds => {
+            t3_thresholds::run();
+            Ok(())
+        }
+        Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

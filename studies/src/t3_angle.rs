@@ -1,0 +1,425 @@
+//! T3b's normalised angle ξ (`docs/design/t3-normalised-angle.md`): which
+//! form of the angle, with which constants, lets 32 angles follow `ln C`.
+//!
+//! Every measurement builds what one table node would hold — `ln C` at the
+//! 32 node angles of the angle under test, from exact profiles — and
+//! interpolates it as the lookup does (`twoscale::conv::along_xi`; across β
+//! and p with `twoscale::conv::axis_weights`), against exact `C`.
+
+use crate::common::{AXES, Distribution, Exact, exact_c, floored_ln, percentiles, quantile};
+use generator::tables::t3;
+use rayon::prelude::*;
+use twoscale::conv::{
+    AngleParams, along_xi, axis_weights, normalised_angle, tan_of_normalised_angle,
+};
+use twoscale::interp::node_value;
+
+/// An angle under test: the runtime's (any constants), or format 1's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Angle {
+    /// The runtime's `normalised_angle` with these constants.
+    Runtime(AngleParams),
+    /// Format 1's angle, no longer in the runtime:
+    /// `F(τ) = asinh(2 u_e τ) + λ ln(1 + Y (1 − e^(−y/Y)))` with the softened
+    /// `y = (τ/β)^(2p')` (constants `τ_max, u_floor, λ, Y, κ` of the params).
+    Format1(AngleParams),
+}
+
+impl Angle {
+    /// Parses `format1` (format 1 with the shipped constants) or
+    /// `w_h,w_e,s_e,τ_f` (the runtime's angle with those weights and the
+    /// shipped constants otherwise; `τ_f = 0`: no fade).
+    pub fn parse(s: &str) -> Result<Angle, String> {
+        if s == "format1" {
+            return Ok(Angle::Format1(t3::ANGLE));
+        }
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{s}: {e}")))
+            .collect::<Result<_, _>>()?;
+        let [horizon, edge, smoothing, fade] = v[..] else {
+            return Err(format!("{s}: expected format1 or w_h,w_e,s_e,tau_f"));
+        };
+        Ok(Angle::Runtime(AngleParams {
+            horizon_weight: horizon,
+            edge_weight: edge,
+            edge_smoothing: smoothing,
+            edge_fade_tan: if fade > 0.0 { fade } else { f64::INFINITY },
+            ..t3::ANGLE
+        }))
+    }
+
+    /// The same angle with the NDF softening `κ`.
+    fn with_softening(self, kappa: f64) -> Angle {
+        match self {
+            Angle::Runtime(a) => Angle::Runtime(AngleParams {
+                ndf_softening: kappa,
+                ..a
+            }),
+            Angle::Format1(a) => Angle::Format1(AngleParams {
+                ndf_softening: kappa,
+                ..a
+            }),
+        }
+    }
+
+    /// `ξ` of `τ = tan θh` at `(u, β, p)`.
+    fn xi(&self, tau: f64, u: f64, beta: f64, p: f64) -> f64 {
+        match self {
+            Angle::Runtime(a) => normalised_angle(tau, u, beta, p, a),
+            Angle::Format1(a) => {
+                let tau = tau.max(0.0).min(a.tau_max);
+                format1_f(tau, u, beta, p, a) / format1_f(a.tau_max, u, beta, p, a)
+            }
+        }
+    }
+
+    /// `θh` at `ξ` (the inverse of [`Angle::xi`]).
+    fn theta(&self, xi: f64, u: f64, beta: f64, p: f64) -> f64 {
+        match self {
+            Angle::Runtime(a) => tan_of_normalised_angle(xi, u, beta, p, a),
+            Angle::Format1(a) => {
+                let target = xi * format1_f(a.tau_max, u, beta, p, a);
+                let (mut lo, mut hi) = (0.0f64, a.tau_max.ln_1p());
+                for _ in 0..100 {
+                    let mid = 0.5 * (lo + hi);
+                    if format1_f(mid.exp_m1(), u, beta, p, a) < target {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                (0.5 * (lo + hi)).exp_m1()
+            }
+        }
+        .atan()
+    }
+}
+
+impl std::fmt::Display for Angle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Angle::Format1(a) => write!(f, "format 1 (κ {})", a.ndf_softening),
+            Angle::Runtime(a) => write!(
+                f,
+                "w_h {}, w_e {}, s_e {}, τ_f {}, κ {}",
+                a.horizon_weight, a.edge_weight, a.edge_smoothing, a.edge_fade_tan, a.ndf_softening
+            ),
+        }
+    }
+}
+
+/// Format 1's `F(τ)` (see [`Angle::Format1`]).
+fn format1_f(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
+    let ue = (u * u + a.kernel_scale_floor * a.kernel_scale_floor).sqrt();
+    let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
+    let y = if tau > 0.0 {
+        (2.0 * p_eff * (tau / beta).ln()).exp()
+    } else {
+        0.0
+    };
+    let cap = a.ndf_exponent_cap;
+    (2.0 * ue * tau).asinh() + a.ndf_weight * (cap * -(-(y / cap)).exp_m1()).ln_1p()
+}
+
+/// The angles compared by default: format 1, the horizon term alone, the
+/// edge term unsmoothed, smoothed and faded, and the shipped form
+/// (`½, ½, 2, 3`).
+pub const DEFAULT_ANGLES: [&str; 5] = [
+    "format1",
+    "0.5,0,0,0",
+    "0.5,1,0,0",
+    "0.5,1,2,3",
+    "0.5,0.5,2,3",
+];
+
+/// `ln C` (floored as stored) at the node angles of `angle` for `point`:
+/// one node of a table built with that angle.
+fn node_ln_values(point: [f64; 4], angle: Angle) -> Vec<f64> {
+    let [u, _, beta, p] = point;
+    let n = t3::ANGLES;
+    let thetas: Vec<f64> = (0..n)
+        .map(|k| angle.theta(k as f64 / (n - 1) as f64, u, beta, p))
+        .collect();
+    floored_ln(&exact_c(point, &thetas))
+}
+
+/// The lookup's cubic along ξ at `θh`, on `ln C` values `window(first)`.
+fn along_angle(
+    angle: Angle,
+    [u, _, beta, p]: [f64; 4],
+    theta: f64,
+    window: impl FnOnce(usize) -> [f32; 4],
+) -> f64 {
+    let xi = angle.xi(theta.tan(), u, beta, p);
+    f64::from(along_xi(t3::ANGLES, xi, window)).exp()
+}
+
+/// The four values of `ln_v` from `first` (as the lookup reads a node).
+fn window(ln_v: &[f64], first: usize) -> [f32; 4] {
+    std::array::from_fn(|j| ln_v[first + j] as f32)
+}
+
+/// `C` at `thetas` from the exact node values of `angle` at `point`,
+/// interpolated along ξ only (parameters exact).
+fn xi_only(point: [f64; 4], angle: Angle, thetas: &[f64]) -> Vec<f64> {
+    let ln_v = node_ln_values(point, angle);
+    thetas
+        .iter()
+        .map(|&t| along_angle(angle, point, t, |first| window(&ln_v, first)))
+        .collect()
+}
+
+/// `C` at `thetas` as a table built with `angle` gives it with u and c exact
+/// and β, p interpolated: the lookup's weights over the β, p nodes around
+/// the point (exact profiles at their own node angles), blended at equal ξ,
+/// then the cubic along ξ at the point's own ξ(θh).
+fn beta_p_patch(point: [f64; 4], angle: Angle, thetas: &[f64]) -> Vec<f64> {
+    let [u, c, beta, p] = point;
+    let (b0, nb, wb) = axis_weights(AXES[2].nodes as usize, crate::common::cell(2, beta), true);
+    let (p0, np, wp) = axis_weights(AXES[3].nodes as usize, crate::common::cell(3, p), true);
+    let mut corners = Vec::new();
+    for (i, &w_beta) in wb[..nb].iter().enumerate() {
+        for (j, &w_p) in wp[..np].iter().enumerate() {
+            let node = [
+                u,
+                c,
+                node_value(&AXES[2], b0 + i),
+                node_value(&AXES[3], p0 + j),
+            ];
+            corners.push((f64::from(w_beta * w_p), node_ln_values(node, angle)));
+        }
+    }
+    thetas
+        .iter()
+        .map(|&t| {
+            along_angle(angle, point, t, |first| {
+                std::array::from_fn(|k| {
+                    corners
+                        .iter()
+                        .map(|(w, ln_v)| w * ln_v[first + k])
+                        .sum::<f64>() as f32
+                })
+            })
+        })
+        .collect()
+}
+
+/// ξ-only errors (e_L2, core and tail pointwise on the profile rule) of
+/// each angle on `profiles` points of a distribution.
+fn xi_only_table(points: &[[f64; 4]], angles: &[Angle], label: &str) {
+    let rows: Vec<(Exact, Vec<Vec<f64>>)> = points
+        .par_iter()
+        .map(|&pt| {
+            let exact = Exact::new(pt);
+            let approx = angles
+                .iter()
+                .map(|&a| xi_only(pt, a, &exact.rule.nodes))
+                .collect();
+            (exact, approx)
+        })
+        .collect();
+    for (k, angle) in angles.iter().enumerate() {
+        let (mut el2, mut core, mut tail) = (vec![], vec![], vec![]);
+        for (exact, approx) in &rows {
+            el2.push(exact.e_l2(&approx[k]));
+            exact.pointwise(&approx[k], &mut core, &mut tail);
+        }
+        println!(
+            "{label} {angle}: e_L2 median/p90/max {} | core median/p95/max {} | tail {}",
+            percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+            percentiles(&mut core, &[0.5, 0.95, 1.0]),
+            percentiles(&mut tail, &[0.5, 0.95, 1.0]),
+        );
+    }
+}
+
+/// The NDF term's softening κ: ξ-only error of `angle` with each κ, on
+/// verify's profiles (seed 31) and the BRDF check's (seed 32).
+pub fn softening(profiles: usize, angle: Angle, kappas: &[f64]) {
+    let angles: Vec<Angle> = kappas.iter().map(|&k| angle.with_softening(k)).collect();
+    for (distribution, seed) in [(Distribution::Verify, 31), (Distribution::Brdf, 32)] {
+        let points = distribution.points(profiles, seed);
+        xi_only_table(&points, &angles, &format!("{distribution:?}"));
+    }
+}
+
+/// The forms of the angle, ξ alone (parameters exact), on `profiles` points
+/// of `distribution` (seed 57): e_L2 and pointwise on the profile rule, and
+/// pointwise at 64 θh evenly spaced up to 1.3 (BRDF check: both directions
+/// within 75°) or 1.55 (verify's), where `C > 1e-9 C(0)`.
+pub fn forms(profiles: usize, distribution: Distribution, angles: &[Angle]) {
+    let points = distribution.points(profiles, 57);
+    let horizon = match distribution {
+        Distribution::Verify => 1.55,
+        Distribution::Brdf => 1.3,
+    };
+    let uniform: Vec<f64> = (0..64).map(|k| horizon * (k as f64 + 0.5) / 64.0).collect();
+    type Row = (Exact, Vec<f64>, Vec<(Vec<f64>, Vec<f64>)>);
+    let rows: Vec<Row> = points
+        .par_iter()
+        .map(|&pt| {
+            let exact = Exact::new(pt);
+            let exact_uniform = exact_c(pt, &uniform);
+            let per_angle = angles
+                .iter()
+                .map(|&a| (xi_only(pt, a, &exact.rule.nodes), xi_only(pt, a, &uniform)))
+                .collect();
+            (exact, exact_uniform, per_angle)
+        })
+        .collect();
+    for (k, angle) in angles.iter().enumerate() {
+        let (mut el2, mut core, mut tail, mut far) = (vec![], vec![], vec![], vec![]);
+        let mut worst = (0.0f64, [0.0; 4], 0.0);
+        for (exact, exact_uniform, per_angle) in &rows {
+            let (on_rule, on_uniform) = &per_angle[k];
+            el2.push(exact.e_l2(on_rule));
+            exact.pointwise(on_rule, &mut core, &mut tail);
+            for ((a, x), &theta) in on_uniform.iter().zip(exact_uniform).zip(&uniform) {
+                if *x > 1e-9 * exact.c0 {
+                    let rel = ((a - x) / x).abs();
+                    far.push(rel);
+                    if rel > worst.0 {
+                        worst = (rel, exact.point, theta);
+                    }
+                }
+            }
+        }
+        println!(
+            "{angle}: e_L2 median/p90/max {} | rule core p95/max {} | rule tail p95/max {} | \
+             θh uniform ≤ {horizon} median/p95/max {} (worst at u,c,β,p {:?}, θh {:.3})",
+            percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+            percentiles(&mut core, &[0.95, 1.0]),
+            percentiles(&mut tail, &[0.95, 1.0]),
+            percentiles(&mut far, &[0.5, 0.95, 1.0]),
+            worst.1,
+            worst.2,
+        );
+    }
+}
+
+/// ξ alone against β and p interpolated too ([`beta_p_patch`]), for each
+/// angle on `profiles` of verify's profiles (seed 61): e_L2 and core
+/// pointwise. Predicts a table's β, p error without building it.
+pub fn patch(profiles: usize, angles: &[Angle]) {
+    let points = Distribution::Verify.points(profiles, 61);
+    type Row = (Exact, Vec<[Vec<f64>; 2]>);
+    let rows: Vec<Row> = points
+        .par_iter()
+        .map(|&pt| {
+            let exact = Exact::new(pt);
+            let per_angle = angles
+                .iter()
+                .map(|&a| {
+                    [
+                        xi_only(pt, a, &exact.rule.nodes),
+                        beta_p_patch(pt, a, &exact.rule.nodes),
+                    ]
+                })
+                .collect();
+            (exact, per_angle)
+        })
+        .collect();
+    for (k, angle) in angles.iter().enumerate() {
+        for (which, name) in ["ξ only", "β, p patch"].iter().enumerate() {
+            let (mut el2, mut core, mut tail) = (vec![], vec![], vec![]);
+            for (exact, per_angle) in &rows {
+                let approx = &per_angle[k][which];
+                el2.push(exact.e_l2(approx));
+                exact.pointwise(approx, &mut core, &mut tail);
+            }
+            println!(
+                "{angle} {name:10}: e_L2 median/p90/max {} | core median/p95/max {}",
+                percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+                percentiles(&mut core, &[0.5, 0.95, 1.0]),
+            );
+        }
+    }
+}
+
+/// At given points (`u,c,beta,p,theta_h` CSV with a header line, e.g. the
+/// BRDF check's): exact `C`, and per angle `C` from ξ alone (or with β and p
+/// interpolated, `patch`). Writes CSV to stdout and the relative error's
+/// p95 / max per angle to stderr.
+pub fn at_points(path: &std::path::Path, angles: &[Angle], patch: bool) -> Result<(), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let points: Vec<[f64; 5]> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<f64> = l.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            (v.len() == 5).then(|| [v[0], v[1], v[2], v[3], v[4]])
+        })
+        .collect();
+    let rows: Vec<Vec<f64>> = points
+        .par_iter()
+        .map(|&[u, c, beta, p, theta]| {
+            let pt = [u, c, beta, p];
+            let mut out = vec![exact_c(pt, &[theta])[0]];
+            for &a in angles {
+                out.push(if patch {
+                    beta_p_patch(pt, a, &[theta])[0]
+                } else {
+                    xi_only(pt, a, &[theta])[0]
+                });
+            }
+            out
+        })
+        .collect();
+    let names: Vec<String> = angles.iter().map(|a| format!("\"{a}\"")).collect();
+    println!("exact,{}", names.join(","));
+    for r in &rows {
+        let cells: Vec<String> = r.iter().map(|x| x.to_string()).collect();
+        println!("{}", cells.join(","));
+    }
+    for (k, angle) in angles.iter().enumerate() {
+        let mut rel: Vec<f64> = rows
+            .iter()
+            .map(|r| ((r[k + 1] - r[0]) / r[0]).abs())
+            .collect();
+        eprintln!(
+            "{angle}: {} points, relative error p95 {:.2}%, max {:.2}%",
+            rel.len(),
+            100.0 * quantile(&mut rel, 0.95),
+            100.0 * quantile(&mut rel, 1.0)
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_last_default_angle_is_the_shipped_one() {
+        let shipped = Angle::parse(DEFAULT_ANGLES[DEFAULT_ANGLES.len() - 1]).unwrap();
+        assert_eq!(shipped, Angle::Runtime(t3::ANGLE));
+        assert_eq!(Angle::parse("format1").unwrap(), Angle::Format1(t3::ANGLE));
+        assert!(Angle::parse("0.5,0.5").is_err());
+        assert!(Angle::parse("a,b,c,d").is_err());
+    }
+
+    #[test]
+    fn angles_invert_and_increase() {
+        for angle in DEFAULT_ANGLES.map(|s| Angle::parse(s).unwrap()) {
+            for [u, beta, p] in [[0.0, 0.002, 0.2], [20.0, 0.1, 1.0], [3000.0, 1.0, 5.0]] {
+                let mut previous = -1.0;
+                for k in 0..=16 {
+                    let xi = f64::from(k) / 16.0;
+                    let theta = angle.theta(xi, u, beta, p);
+                    assert!((0.0..=std::f64::consts::FRAC_PI_2).contains(&theta));
+                    assert!(theta >= previous, "{angle}: θ({xi}) decreases");
+                    previous = theta;
+                    if (0.05..0.95).contains(&xi) {
+                        let back = angle.xi(theta.tan(), u, beta, p);
+                        assert!(
+                            (back - xi).abs() < 1e-9,
+                            "{angle} at {u} {beta} {p}: {xi} -> {back}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
