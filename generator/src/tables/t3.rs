@@ -8,10 +8,15 @@
 //!
 //! Each node needs the exact profile at its 32 angles (the reference
 //! `convolution_profile`: zonal harmonics when affordable, otherwise direct
-//! 2-D quadrature per angle; 1 ms to ~1 s per node). 40 320 nodes take
-//! 57 min on the 2-core machine (16 u nodes took 33–37 min), so CI does not
-//! rebuild T3: it recomputes a spread of nodes and compares their bits with
-//! the committed file (`generator spot-check`).
+//! 2-D quadrature per angle; 1 ms to ~1 s per node). The build shares the
+//! zonal-harmonic moments between nodes ([`MomentCache`]: the kernel's
+//! depend on `(u, c)` only, the NDF's on `(β, p)` only), which leaves the
+//! direct quadrature of the narrow kernels (`u ≳ 150` on cusped `D`, a
+//! quarter of the nodes) as most of the cost. The progress bar counts
+//! estimated CPU time ([`node_cost`]), not nodes. The nodes can be computed
+//! in shards on several machines and merged bit-identically ([`Shard`],
+//! `generator build t3 --shard K/N`, `generator merge`). Measured times, the
+//! profile and a cluster example: docs/design/t3-build-speed.md.
 //!
 //! # The fit of T3a
 //!

@@ -182,9 +182,15 @@ pub fn merge_grid(files: &[(String, Vec<u8>)]) -> Result<Vec<f32>, BuildError> {
         .map(|(k, _)| format!("{}/{n}", k + 1))
         .collect();
     if !missing.is_empty() {
+        let shown = missing.len().min(10);
+        let more = if missing.len() > shown {
+            format!(" and {} more", missing.len() - shown)
+        } else {
+            String::new()
+        };
         return Err(shard_error(format!(
-            "missing shards: {}",
-            missing.join(", ")
+            "missing shards: {}{more}",
+            missing[..shown].join(", ")
         )));
     }
     let mut grid = vec![0.0f32; node_count() * CHANNELS];
@@ -241,7 +247,10 @@ mod tests {
     #[test]
     fn missing_repeated_mismatched_and_corrupt_shards_are_errors() {
         let s = |k, n| Shard { k, n };
-        assert!(err(&files(&[s(1, 3), s(3, 3)])).contains("missing shards: 2/3"));
+        assert!(err(&files(&[s(1, 3), s(3, 3)])).ends_with("missing shards: 2/3"));
+        let many = err(&files(&[s(2, 40)]));
+        let want = "missing shards: 1/40, 3/40, 4/40, 5/40, 6/40, 7/40, 8/40, 9/40, 10/40, 11/40 and 29 more";
+        assert!(many.ends_with(want), "{many}");
         assert!(err(&files(&[s(1, 2), s(1, 2), s(2, 2)])).contains("shard 1/2 given twice"));
         assert!(err(&files(&[s(1, 2), s(2, 3)])).contains("of 2 shards"));
         assert!(err(&[]).contains("no shard files"));
