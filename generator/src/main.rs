@@ -54,6 +54,22 @@ enum Command {
         /// Worker threads (default: all cores). The output does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// T3 only: compute shard K of N (the nodes i with i mod N = K − 1)
+        /// into `<out>/t3-convolution.shard-K-of-N`; `merge` assembles the N
+        /// shards into the table.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+    },
+    /// Assemble T3 shard files (`build t3 --shard K/N`, all N of them, in
+    /// any order) into `<out>/t3-convolution.tbl`, bit-identical to a
+    /// single build.
+    Merge {
+        /// The shard files.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = DEFAULT_TABLES)]
+        out: PathBuf,
     },
     /// Check headers and checksums of a table directory, then measure every
     /// table against the reference at random off-grid points.
@@ -161,6 +177,7 @@ fn main() -> ExitCode {
         out: PathBuf::from(DEFAULT_TABLES),
         materials: PathBuf::from(DEFAULT_MATERIALS),
         threads: None,
+        shard: None,
     });
     let result = match command {
         Command::Build {
@@ -168,7 +185,16 @@ fn main() -> ExitCode {
             out,
             materials,
             threads,
+            shard: None,
         } => set_threads(threads).and_then(|()| build(&tables, &out, &materials)),
+        Command::Build {
+            tables,
+            out,
+            materials,
+            threads,
+            shard: Some(shard),
+        } => set_threads(threads).and_then(|()| build_shard(&tables, &out, &materials, &shard)),
+        Command::Merge { shards, out } => merge(&shards, &out),
         Command::Verify {
             dir,
             materials,
@@ -295,36 +321,20 @@ fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, Str
                 tables::t4::input_dir(out).display()
             );
         }
-        let progress = ProgressBar::new(kind.work_items()).with_style(
-            ProgressStyle::with_template(
-                "{prefix:>14} [{bar:40}] {pos}/{len} nodes, {elapsed}, eta {eta}",
-            )
-            .expect("static template")
-            .progress_chars("=> "),
-        );
         let stem = kind.file_stem();
-        progress.set_prefix(stem.clone());
         let start = Instant::now();
-        // indicatif draws only on a terminal; elsewhere (CI logs, redirected
-        // output) print a plain progress line every 30 s instead.
-        let done = std::sync::atomic::AtomicBool::new(false);
-        let bytes = std::thread::scope(|scope| {
-            if !std::io::stderr().is_terminal() {
-                scope.spawn(|| plain_progress(&stem, &progress, &done, start));
-            }
-            let result = kind.build(&progress);
-            done.store(true, std::sync::atomic::Ordering::Relaxed);
-            result
+        let bytes = with_progress(&stem, kind.work_items(), kind.work_unit(), |progress| {
+            kind.build(progress)
         })
         .map_err(|e| format!("{stem}: {e}"))?;
-        progress.finish_and_clear();
         let path = out.join(format!("{stem}.tbl"));
         write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         eprintln!(
-            "built {} ({} bytes, {} nodes) in {:.1} s -> {}",
+            "built {} ({} bytes, {} {}) in {:.1} s -> {}",
             stem,
             bytes.len(),
             kind.work_items(),
+            kind.work_unit(),
             start.elapsed().as_secs_f64(),
             path.display()
         );
@@ -333,9 +343,91 @@ fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, Str
     Ok(ExitCode::SUCCESS)
 }
 
-/// Prints `name: pos/len nodes, elapsed, eta` every 30 s until `done`.
+/// Runs `work` with a progress bar of `len` units named `unit` (drawn on a
+/// terminal; elsewhere, as in CI logs or redirected output, a plain progress
+/// line every 30 s).
+fn with_progress<T>(name: &str, len: u64, unit: &str, work: impl FnOnce(&ProgressBar) -> T) -> T {
+    let progress = ProgressBar::new(len).with_style(
+        ProgressStyle::with_template(&format!(
+            "{{prefix:>14}} [{{bar:40}}] {{pos}}/{{len}} {unit}, {{elapsed}}, eta {{eta}}"
+        ))
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    progress.set_prefix(name.to_string());
+    let start = Instant::now();
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        if !std::io::stderr().is_terminal() {
+            scope.spawn(|| plain_progress(name, unit, &progress, &done, start));
+        }
+        let result = work(&progress);
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        result
+    });
+    progress.finish_and_clear();
+    result
+}
+
+/// `build t3 --shard K/N`: the shard file of T3's nodes.
+fn build_shard(
+    names: &[String],
+    out: &Path,
+    materials: &Path,
+    shard: &str,
+) -> Result<ExitCode, String> {
+    let shard = tables::t3::Shard::parse(shard)?;
+    let t4 = material_tables(materials, out)?;
+    let kinds = selected(names, &t4)?;
+    if names.is_empty() || kinds.iter().any(|k| k.id() != TableId::Convolution) {
+        return Err("--shard applies to T3 alone: `build t3 --shard K/N`".into());
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let name = shard.file_name();
+    let start = Instant::now();
+    let work = tables::t3::work(Some(shard));
+    let bytes = with_progress(&name, work, tables::t3::Conv.work_unit(), |progress| {
+        tables::t3::build_shard(shard, progress)
+    })
+    .map_err(|e| format!("{name}: {e}"))?;
+    let path = out.join(&name);
+    write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    eprintln!(
+        "built {name} ({} bytes) in {:.1} s -> {}",
+        bytes.len(),
+        start.elapsed().as_secs_f64(),
+        path.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `merge`: T3 from its shard files.
+fn merge(shards: &[PathBuf], out: &Path) -> Result<ExitCode, String> {
+    let files = shards
+        .iter()
+        .map(|p| {
+            std::fs::read(p)
+                .map(|bytes| (p.display().to_string(), bytes))
+                .map_err(|e| format!("cannot read {}: {e}", p.display()))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let bytes = tables::t3::merge(&files).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let path = out.join(tables::file_name(TableId::Convolution));
+    write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    eprintln!(
+        "merged {} shards ({} bytes) -> {}",
+        files.len(),
+        bytes.len(),
+        path.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Prints `name: pos/len unit, elapsed, eta` every 30 s until `done`.
 fn plain_progress(
     name: &str,
+    unit: &str,
     progress: &ProgressBar,
     done: &std::sync::atomic::AtomicBool,
     start: Instant,
@@ -355,7 +447,7 @@ fn plain_progress(
             } else {
                 "?".into()
             };
-            eprintln!("{name}: {pos}/{len} nodes, {elapsed:.0} s, eta {eta}");
+            eprintln!("{name}: {pos}/{len} {unit}, {elapsed:.0} s, eta {eta}");
         }
     }
 }

@@ -246,7 +246,58 @@ const WG: [f64; 5] = [
     0.295_524_224_714_752_870_173_9,
 ];
 
-/// One subinterval with its K21 value and error estimate.
+/// Nodes of the 15-point Kronrod rule on `[0, 1]`, descending, as [`XK`]:
+/// odd indices (1, 3, 5) and the centre are the nodes of the 7-point Gauss
+/// rule. The tests check them as for [`XK`] (Gauss nodes against
+/// [`gauss_legendre`], exactness of K15 to degree 22).
+#[allow(clippy::excessive_precision)]
+const XK15: [f64; 8] = [
+    0.991_455_371_120_812_639_206_854_697_526_329,
+    0.949_107_912_342_758_524_526_189_684_047_851,
+    0.864_864_423_359_769_072_789_712_788_640_926,
+    0.741_531_185_599_394_439_863_864_773_280_788,
+    0.586_087_235_467_691_130_294_144_845_693_013,
+    0.405_845_151_377_397_166_906_606_412_076_961,
+    0.207_784_955_007_898_467_600_689_403_773_245,
+    0.0,
+];
+
+/// Kronrod weights belonging to [`XK15`].
+#[allow(clippy::excessive_precision)]
+const WK15: [f64; 8] = [
+    0.022_935_322_010_529_224_963_732_008_058_970,
+    0.063_092_092_629_978_553_290_700_663_189_204,
+    0.104_790_010_322_250_183_839_876_322_541_518,
+    0.140_653_259_715_525_918_745_189_590_510_238,
+    0.169_004_726_639_267_902_826_583_426_598_550,
+    0.190_350_578_064_785_409_913_256_402_421_014,
+    0.204_432_940_075_298_892_414_161_999_234_649,
+    0.209_482_141_084_727_828_012_999_174_891_714,
+];
+
+/// Gauss weights of the nodes `XK15[1], XK15[3], XK15[5]` and of the centre.
+#[allow(clippy::excessive_precision)]
+const WG15: [f64; 4] = [
+    0.129_484_966_168_869_693_270_611_432_679_082,
+    0.279_705_391_489_276_667_901_467_771_423_780,
+    0.381_830_050_505_118_944_950_369_775_488_975,
+    0.417_959_183_673_469_387_755_102_040_816_327,
+];
+
+/// The Gauss–Kronrod pair of the adaptive rule ([`integrate_with_rule`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Rule {
+    /// G10–K21 (21 evaluations per interval, K21 exact to degree 31): the
+    /// default.
+    #[default]
+    Gk21,
+    /// G7–K15 (15 evaluations per interval, K15 exact to degree 22), with the
+    /// same error estimate: cheaper where a piece is smooth on its own scale
+    /// and one interval suffices at the tolerance asked.
+    Gk15,
+}
+
+/// One subinterval with its Kronrod value and error estimate.
 #[derive(Clone, Copy, Debug)]
 struct Segment {
     a: f64,
@@ -285,36 +336,59 @@ impl Ord for Priority {
     }
 }
 
-/// Applies the G10–K21 pair on `[a, b]`.
-fn gauss_kronrod_21<G>(g: &mut G, a: f64, b: f64) -> Result<Segment, QuadError>
+/// Applies `rule` on `[a, b]`.
+fn gauss_kronrod<G>(rule: Rule, g: &mut G, a: f64, b: f64) -> Result<Segment, QuadError>
 where
     G: FnMut(f64) -> Result<f64, QuadError>,
 {
+    match rule {
+        Rule::Gk21 => gauss_kronrod_pair(&XK, &WK, &WG, g, a, b),
+        Rule::Gk15 => gauss_kronrod_pair(&XK15, &WK15, &WG15, g, a, b),
+    }
+}
+
+/// Applies the Gauss–Kronrod pair with Kronrod nodes `xk` (on `[0, 1]`,
+/// descending, the centre last) and weights `wk`, and Gauss weights `wg` of
+/// the odd-indexed nodes (and of the centre when `wg` has one more entry than
+/// there are odd indices), on `[a, b]`.
+fn gauss_kronrod_pair<G, const N: usize, const M: usize>(
+    xk: &[f64; N],
+    wk: &[f64; N],
+    wg: &[f64; M],
+    g: &mut G,
+    a: f64,
+    b: f64,
+) -> Result<Segment, QuadError>
+where
+    G: FnMut(f64) -> Result<f64, QuadError>,
+{
+    let pairs = N - 1;
+    let centre_is_gauss = M > pairs / 2;
     let centre = 0.5 * a + 0.5 * b;
     let half = 0.5 * (b - a);
-    let mut fplus = [0.0; 10];
-    let mut fminus = [0.0; 10];
+    let mut fplus = [0.0; N];
+    let mut fminus = [0.0; N];
     let fc = g(centre)?;
-    let mut kronrod = WK[10] * fc;
-    let mut gauss = 0.0;
-    let mut abs_sum = WK[10] * fc.abs();
-    for j in 0..10 {
-        let dx = half * XK[j];
+    let mut kronrod = wk[pairs] * fc;
+    let mut gauss = if centre_is_gauss { wg[M - 1] * fc } else { 0.0 };
+    let mut abs_sum = wk[pairs] * fc.abs();
+    for j in 0..pairs {
+        let dx = half * xk[j];
         let f1 = g(centre - dx)?;
         let f2 = g(centre + dx)?;
         fminus[j] = f1;
         fplus[j] = f2;
-        kronrod += WK[j] * (f1 + f2);
-        abs_sum += WK[j] * (f1.abs() + f2.abs());
+        kronrod += wk[j] * (f1 + f2);
+        abs_sum += wk[j] * (f1.abs() + f2.abs());
         if j % 2 == 1 {
-            gauss += WG[j / 2] * (f1 + f2);
+            gauss += wg[j / 2] * (f1 + f2);
         }
     }
-    // ∫|f − mean| with the Kronrod weights (mean = K21 / 2 on [−1, 1]).
+    // ∫|f − mean| with the Kronrod weights (mean = K / 2 on [−1, 1]).
     let mean = 0.5 * kronrod;
-    let mut asc = WK[10] * (fc - mean).abs();
-    for j in 0..10 {
-        asc += WK[j] * ((fminus[j] - mean).abs() + (fplus[j] - mean).abs());
+    let mut asc = wk[pairs] * (fc - mean).abs();
+    for j in 0..pairs {
+        asc += wk[j] * ((fminus[j] - mean).abs() + (fplus[j] - mean).abs());
     }
     let scale = half.abs();
     let value = kronrod * half;
@@ -363,6 +437,7 @@ fn adapt<G>(
     b: f64,
     tol: Tolerance,
     max_intervals: usize,
+    rule: Rule,
 ) -> Result<Estimate, QuadError>
 where
     G: FnMut(f64) -> Result<f64, QuadError>,
@@ -372,7 +447,7 @@ where
         evaluations += 1;
         g(x)
     };
-    let first = gauss_kronrod_21(&mut counted, a, b)?;
+    let first = gauss_kronrod(rule, &mut counted, a, b)?;
     let mut segments = vec![first];
     let mut queue = BinaryHeap::new();
     queue.push(Priority {
@@ -411,8 +486,8 @@ where
                 evaluations,
             });
         }
-        let left = gauss_kronrod_21(&mut counted, seg.a, mid)?;
-        let right = gauss_kronrod_21(&mut counted, mid, seg.b)?;
+        let left = gauss_kronrod(rule, &mut counted, seg.a, mid)?;
+        let right = gauss_kronrod(rule, &mut counted, mid, seg.b)?;
         value += (left.value + right.value) - seg.value;
         error += (left.error + right.error) - seg.error;
         segments[worst.index] = left;
@@ -447,11 +522,23 @@ pub fn integrate(
 
 /// [`integrate`] with an explicit cap on the number of subintervals.
 pub fn integrate_with_limit(
+    f: impl FnMut(f64) -> f64,
+    a: f64,
+    b: f64,
+    tol: Tolerance,
+    max_intervals: usize,
+) -> Result<Estimate, QuadError> {
+    integrate_with_rule(f, a, b, tol, max_intervals, Rule::Gk21)
+}
+
+/// [`integrate_with_limit`] with the Gauss–Kronrod pair `rule`.
+pub fn integrate_with_rule(
     mut f: impl FnMut(f64) -> f64,
     a: f64,
     b: f64,
     tol: Tolerance,
     max_intervals: usize,
+    rule: Rule,
 ) -> Result<Estimate, QuadError> {
     tol.validate()?;
     if !(a.is_finite() && b.is_finite() && (b - a).is_finite()) {
@@ -473,9 +560,9 @@ pub fn integrate_with_limit(
         }
     };
     if a < b {
-        adapt(checked, a, b, tol, max_intervals)
+        adapt(checked, a, b, tol, max_intervals, rule)
     } else {
-        adapt(checked, b, a, tol, max_intervals)
+        adapt(checked, b, a, tol, max_intervals, rule)
             .map(|e| Estimate {
                 value: -e.value,
                 ..e
@@ -544,7 +631,7 @@ pub fn integrate_to_infinity_with_limit(
             Err(QuadError::NonFinite { x, fx: gt })
         }
     };
-    adapt(mapped, 0.0, 1.0, tol, max_intervals)
+    adapt(mapped, 0.0, 1.0, tol, max_intervals, Rule::Gk21)
 }
 
 /// The `n`-point Gauss–Legendre rule on `[−1, 1]`: `(nodes, weights)`, nodes
@@ -692,6 +779,42 @@ mod tests {
                 .sum();
             assert!(rel_err(q, 0.4 * 5f64.sin()) < 1e-13, "n={n}: {q}");
         }
+    }
+
+    #[test]
+    fn kronrod_15_constants_match_computed_gauss_rule_and_are_exact_to_degree_22() {
+        let (x, w) = gauss_legendre(7);
+        for j in 0..3 {
+            assert!((XK15[2 * j + 1] - x[6 - j]).abs() < 2e-16, "node {j}");
+            assert!(rel_err(WG15[j], w[6 - j]) < 2e-15, "weight {j}");
+        }
+        assert_eq!(x[3], 0.0);
+        assert!(rel_err(WG15[3], w[3]) < 2e-15);
+        // K15 integrates x^k exactly on [0, 1] for k ≤ 22 = 3·7 + 1, not 23.
+        let rule = |k: i32| {
+            let mut s = WK15[7] * 0.5f64.powi(k);
+            for j in 0..7 {
+                s += WK15[j] * ((0.5 * (1.0 - XK15[j])).powi(k) + (0.5 * (1.0 + XK15[j])).powi(k));
+            }
+            0.5 * s
+        };
+        for k in 0..=22 {
+            let exact = 1.0 / (k as f64 + 1.0);
+            assert!(rel_err(rule(k), exact) < 1e-14, "k={k}: {}", rule(k));
+        }
+        // On [−1, 1] the relative error for x^24 is 7.2e-8.
+        let sym24 = 2.0 * (0..7).map(|j| WK15[j] * XK15[j].powi(24)).sum::<f64>();
+        assert!((rel_err(sym24, 2.0 / 25.0) - 7.17e-8).abs() < 1e-9);
+        // Both rules agree on a smooth integral to their accuracy.
+        let f = |x: f64| (3.0 * x).cos() * x.exp();
+        let tol = Tolerance::relative(1e-12);
+        let a = integrate_with_rule(f, 0.0, 1.0, tol, 100, Rule::Gk15).unwrap();
+        let b = integrate_with_rule(f, 0.0, 1.0, tol, 100, Rule::Gk21).unwrap();
+        // ∫₀¹ eˣ cos 3x dx = (e (cos 3 + 3 sin 3) − 1) / 10.
+        let closed = (1f64.exp() * ((3.0f64).cos() + 3.0 * (3.0f64).sin()) - 1.0) / 10.0;
+        assert!(rel_err(a.value, closed) < 1e-13, "{}", a.value);
+        assert!(rel_err(b.value, closed) < 1e-13, "{}", b.value);
+        assert!(a.evaluations % 15 == 0 && b.evaluations % 21 == 0);
     }
 
     #[test]

@@ -70,7 +70,10 @@ pub use direct::{DirectOptions, DirectResult, Frame, convolution_direct};
 pub use limits::{
     kernel_integral, kernel_moment, narrow_kernel_limit, narrow_ndf_limit, ndf_integral, ndf_moment,
 };
-pub use zh::{ZhOptions, ZhProfile, convolution_zh, legendre_moments, zh_band_estimate, zh_series};
+pub use zh::{
+    MomentCache, ZhOptions, ZhProfile, convolution_zh, convolution_zh_cached, legendre_moments,
+    zh_band_estimate, zh_series,
+};
 
 use crate::quad::{QuadError, gauss_legendre};
 pub(crate) use crate::reference::epd::{ndf_peak, ndf_sin_cos as ndf_sc};
@@ -240,6 +243,16 @@ enum Lobe {
 }
 
 impl Lobe {
+    /// The lobe's kind and the bits of the parameters that define it (the
+    /// NDF's peak is a function of `β, p`): the key of its moments in
+    /// [`MomentCache`].
+    fn key(&self) -> (u8, [u64; 2]) {
+        match *self {
+            Lobe::Kernel { u, q } => (0, [u.to_bits(), q.to_bits()]),
+            Lobe::Ndf { beta, p, .. } => (1, [beta.to_bits(), p.to_bits()]),
+        }
+    }
+
     /// The lobe at polar angle θ from its axis, given `sin θ ≥ 0`, `cos θ`.
     fn value(&self, sin_t: f64, cos_t: f64) -> f64 {
         match *self {
@@ -413,6 +426,20 @@ pub fn convolution_profile_with_method(
     p: f64,
     theta_h: &[f64],
 ) -> Result<(Vec<f64>, Method), ConvError> {
+    convolution_profile_cached(u, c, beta, p, theta_h, &MomentCache::new())
+}
+
+/// [`convolution_profile_with_method`] taking the zonal-harmonic moments
+/// from `cache`, for many profiles that share lobes (the T3 grid): the
+/// results are bit-identical to the uncached ones (see [`MomentCache`]).
+pub fn convolution_profile_cached(
+    u: f64,
+    c: f64,
+    beta: f64,
+    p: f64,
+    theta_h: &[f64],
+    cache: &MomentCache,
+) -> Result<(Vec<f64>, Method), ConvError> {
     let params = Params::new(u, c, beta, p)?;
     for &t in theta_h {
         Params::validate_theta(t)?;
@@ -422,7 +449,7 @@ pub fn convolution_profile_with_method(
             max_band: ZH_MAX_BAND,
             ..ZhOptions::default()
         };
-        match convolution_zh(u, c, beta, p, theta_h, &opts) {
+        match convolution_zh_cached(u, c, beta, p, theta_h, &opts, cache) {
             Ok(zh) => {
                 let values = zh.values.into_iter().map(|v| v.max(0.0)).collect();
                 return Ok((

@@ -23,8 +23,15 @@ pub trait TableKind: Sync {
         self.id().name().to_string()
     }
 
-    /// Number of grid nodes to compute (for the progress bar).
+    /// Amount of work of a build, in [`TableKind::work_unit`]s (the length
+    /// of the progress bar).
     fn work_items(&self) -> u64;
+
+    /// What [`TableKind::work_items`] counts: grid nodes unless the table
+    /// weights its nodes by cost (T3).
+    fn work_unit(&self) -> &'static str {
+        "nodes"
+    }
 
     /// Computes the table and encodes it as the bytes of a file. Must be
     /// deterministic: the same bytes for every run and thread count.

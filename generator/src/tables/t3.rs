@@ -8,10 +8,15 @@
 //!
 //! Each node needs the exact profile at its 32 angles (the reference
 //! `convolution_profile`: zonal harmonics when affordable, otherwise direct
-//! 2-D quadrature per angle; 1 ms to ~1 s per node). 40 320 nodes take
-//! 57 min on the 2-core machine (16 u nodes took 33–37 min), so CI does not
-//! rebuild T3: it recomputes a spread of nodes and compares their bits with
-//! the committed file (`generator spot-check`).
+//! 2-D quadrature per angle; 1 ms to ~1 s per node). The build shares the
+//! zonal-harmonic moments between nodes ([`MomentCache`]: the kernel's
+//! depend on `(u, c)` only, the NDF's on `(β, p)` only), which leaves the
+//! direct quadrature of the narrow kernels (`u ≳ 150` on cusped `D`, a
+//! quarter of the nodes) as most of the cost. The progress bar counts
+//! estimated CPU time ([`node_cost`]), not nodes. The nodes can be computed
+//! in shards on several machines and merged bit-identically ([`Shard`],
+//! `generator build t3 --shard K/N`, `generator merge`). Measured times, the
+//! profile and a cluster example: docs/design/t3-build-speed.md.
 //!
 //! # The fit of T3a
 //!
@@ -42,7 +47,7 @@
 //! c to 0.67%, u and β to 0.74–0.75%; so p and c got the nodes, u and β gave
 //! some up. The c mapping's linear term is documented at [`C_AXIS`].
 
-use indicatif::{ParallelProgressIterator, ProgressBar};
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 use twoscale::conv::{
     AngleParams, ConvTable, Convolution, FIT_CHANNELS, kernel, tan_of_normalised_angle,
@@ -54,7 +59,10 @@ use twoscale::{Table, TableId};
 
 use super::{Accuracy, BuildError, GENERATOR_VERSION, SpotCheck, TableKind};
 use crate::fit::{WidthFitOptions, fit_k_lobe};
-use crate::reference::conv::{ConvError, Params, ProfileRule, convolution_profile};
+use crate::reference::conv::{
+    ConvError, MomentCache, Params, ProfileRule, ZH_MAX_BAND, convolution_profile,
+    convolution_profile_cached, zh_band_estimate,
+};
 use crate::rng::SplitMix64;
 
 /// u ∈ [0, 3000], evenly spaced in ln(u + 0.1).
@@ -141,6 +149,9 @@ pub const VALUE_FLOOR: f64 = 1e-12;
 /// Channels per node.
 pub const CHANNELS: usize = FIT_CHANNELS + ANGLES;
 
+mod shard;
+pub use shard::Shard;
+
 /// The T3 builder.
 pub struct Conv;
 
@@ -201,10 +212,17 @@ pub fn fit_paper_form(c: f64, thetas: &[f64], weights: &[f64], values: &[f64]) -
 
 /// The 34 stored values of node `index`.
 pub fn node_values(index: usize) -> Result<Vec<f32>, BuildError> {
+    node_values_cached(index, &MomentCache::new())
+}
+
+/// [`node_values`] with the zonal-harmonic moments shared through `cache`
+/// (bit-identical; the build shares one cache between all nodes).
+pub fn node_values_cached(index: usize, cache: &MomentCache) -> Result<Vec<f32>, BuildError> {
     let [u, c, beta, p] = node_params(index);
     let at = || format!("T3 node {index} (u = {u}, c = {c}, β = {beta}, p = {p})");
     let (thetas, weights) = angle_rule(u, beta, p);
-    let values = convolution_profile(u, c, beta, p, &thetas).map_err(|e| conv_error(at(), e))?;
+    let (values, _) = convolution_profile_cached(u, c, beta, p, &thetas, cache)
+        .map_err(|e| conv_error(at(), e))?;
     let peak = values.iter().cloned().fold(0.0f64, f64::max);
     if peak.is_nan() || peak <= 0.0 || peak.is_infinite() {
         return Err(BuildError::Convolution {
@@ -255,24 +273,81 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
     })?)
 }
 
+/// Estimated cost of node `index`, in units of 0.1 ms of CPU (the weights of
+/// the progress bar, so that its ETA is honest although node costs span four
+/// decades). Nodes whose zonal-harmonic band limit ([`zh_band_estimate`]) is
+/// affordable cost little once the lobes' moments are shared; the others take
+/// the direct quadrature at every angle, whose cost grows with the kernel's
+/// narrowness (more breakpoints): measured on a sample of nodes
+/// (`examples/t3_node_cost.rs`, docs/design/t3-build-speed.md).
+pub fn node_cost(index: usize) -> u64 {
+    let [u, c, beta, p] = node_params(index);
+    let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
+    if zh_band_estimate(&params) <= ZH_MAX_BAND {
+        ZH_NODE_COST
+    } else {
+        (DIRECT_NODE_COST * (1.0 + (u / 100.0).max(1.0).ln() / 3.4)) as u64
+    }
+}
+
+/// [`node_cost`] of a zonal-harmonic node (moments amortised), 0.1 ms units.
+const ZH_NODE_COST: u64 = 20;
+/// [`node_cost`] of a direct-quadrature node at `u = 100`, 0.1 ms units.
+const DIRECT_NODE_COST: f64 = 2000.0;
+
+/// Computes the nodes `indices` (in that order), advancing `progress` by
+/// each node's [`node_cost`]; one [`MomentCache`] is shared by all.
+fn compute_nodes(indices: &[usize], progress: &ProgressBar) -> Result<Vec<Vec<f32>>, BuildError> {
+    let cache = MomentCache::new();
+    indices
+        .par_iter()
+        .map(|&i| {
+            let values = node_values_cached(i, &cache);
+            progress.inc(node_cost(i));
+            values
+        })
+        .collect()
+}
+
+/// Total [`node_cost`] of the nodes of `shard` (all nodes: `None`).
+pub fn work(shard: Option<Shard>) -> u64 {
+    match shard {
+        Some(s) => s.indices().map(node_cost).sum(),
+        None => (0..node_count()).map(node_cost).sum(),
+    }
+}
+
+/// The bytes of the shard file of `shard` (see [`Shard`]).
+pub fn build_shard(shard: Shard, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
+    let indices: Vec<usize> = shard.indices().collect();
+    shard::encode(shard, &compute_nodes(&indices, progress)?)
+}
+
+/// The table from the shard files `files` (name, bytes) of one `N`-way
+/// split: bit-identical to [`Conv`]'s build.
+pub fn merge(files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, BuildError> {
+    encode_table(&shard::merge_grid(files)?)
+}
+
 impl TableKind for Conv {
     fn id(&self) -> TableId {
         TableId::Convolution
     }
 
     fn work_items(&self) -> u64 {
-        node_count() as u64
+        work(None)
+    }
+
+    fn work_unit(&self) -> &'static str {
+        "× 0.1 ms (estimated CPU)"
     }
 
     fn build(&self, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
-        // Expensive nodes (large u, wide β) cluster; interleaving the order
-        // of work does not change the output, which is collected by index.
-        let nodes = (0..node_count())
-            .into_par_iter()
-            .progress_with(progress.clone())
-            .map(node_values)
-            .collect::<Result<Vec<_>, BuildError>>()?;
-        let grid: Vec<f32> = nodes.into_iter().flatten().collect();
+        let indices: Vec<usize> = (0..node_count()).collect();
+        let grid: Vec<f32> = compute_nodes(&indices, progress)?
+            .into_iter()
+            .flatten()
+            .collect();
         encode_table(&grid)
     }
 
@@ -309,11 +384,12 @@ pub fn spot_check(bytes: &[u8], nodes: usize) -> Result<SpotCheck, BuildError> {
             }
         })
         .collect();
+    let cache = MomentCache::new();
     let mismatches = indices
         .par_iter()
         .map(|&i| {
             // The stored form: the node's quantisation pair and its codes.
-            let fresh = node_values(i)?;
+            let fresh = node_values_cached(i, &cache)?;
             let mut codes = [0u16; CHANNELS];
             let scale = quantise_node(&fresh, &mut codes);
             let bits = |x: &[f32]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();

@@ -284,6 +284,67 @@ fn frames_agree_on_hard_points() {
 }
 
 #[test]
+fn rules_agree_on_hard_points() {
+    // G7–K15 (the default) against G10–K21 in the same frame: the frames'
+    // hard points and T3 nodes of the direct quadrature (u ≥ 444, cusped D).
+    for &(t, u, c, beta, p) in &[
+        (1e-4, 3000.0, 1.01, 0.002, 0.2),
+        (0.002, 3000.0, 10.0, 0.002, 5.0),
+        (1.5697963267948966, 3000.0, 2.0, 1.0, 0.2),
+        (1.3, 300.0, 1.01, 1.0, 0.5),
+        (
+            0.05,
+            444.5686598259818,
+            1.01,
+            0.010892127693109842,
+            0.39776462853385935,
+        ),
+        (
+            0.3,
+            954.1808424736149,
+            4.409639507138689,
+            0.05931922284150511,
+            0.6295525494276792,
+        ),
+    ] {
+        let value = |rule| {
+            let opts = DirectOptions {
+                rule,
+                ..DirectOptions::default()
+            };
+            convolution_direct(t, u, c, beta, p, &opts).unwrap().value
+        };
+        let (k15, k21) = (
+            value(crate::quad::Rule::Gk15),
+            value(crate::quad::Rule::Gk21),
+        );
+        assert!(
+            rel(k15, k21) < 1e-12,
+            "θh={t} u={u} c={c} β={beta} p={p}: {k15} vs {k21}"
+        );
+    }
+}
+
+#[test]
+fn shared_moments_are_bit_identical() {
+    // Two profiles sharing the NDF lobe, and one sharing the kernel, through
+    // one cache: the same bits as computed alone.
+    let thetas = [0.0, 0.01, 0.3, 1.2, FRAC_PI_2];
+    let cache = MomentCache::new();
+    for &(u, c, beta, p) in &[
+        (30.0, 2.0, 0.05, 1.0),
+        (3.0, 2.0, 0.05, 1.0),
+        (3.0, 2.0, 0.3, 0.5),
+    ] {
+        let (shared, m1) = convolution_profile_cached(u, c, beta, p, &thetas, &cache).unwrap();
+        let (alone, m2) = convolution_profile_with_method(u, c, beta, p, &thetas).unwrap();
+        assert!(matches!(m1, Method::ZonalHarmonics { .. }) && m1 == m2);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&shared), bits(&alone), "{u} {c} {beta} {p}");
+    }
+}
+
+#[test]
 fn band_limit_doubling_converges() {
     // A narrow D (β = 0.002) under a moderately narrow kernel (u = 30): one
     // coefficient computation up to 4096, the series truncated at L.

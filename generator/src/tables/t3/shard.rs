@@ -1,0 +1,265 @@
+//! Partial T3 builds for clusters: `generator build t3 --shard K/N` computes
+//! the nodes `i` with `i mod N = K − 1` (interleaved, so every shard gets a
+//! like share of the expensive large-u nodes) into a shard file, and
+//! `generator merge` assembles the `N` shard files into the table, bit-identical
+//! to a single build (the same node values go through the same encoder).
+//!
+//! # Shard file (little-endian)
+//!
+//! ```text
+//!   magic "T3SHARD1" | fingerprint u64 | K u32 | N u32 | nodes u32 | channels u32
+//!   | the shard's nodes in ascending index order, `channels` f32 each
+//!   | FNV-1a 64 of everything before
+//! ```
+//!
+//! The fingerprint is an FNV-1a hash of the generator version and T3's
+//! layout (axes, header parameters, channels): shards of different
+//! generators or grids cannot be merged.
+
+use twoscale::format::{FNV_OFFSET, fnv1a};
+
+use super::{ANGLE, ANGLES, AXES, CHANNELS, header_params, node_count};
+use crate::tables::{BuildError, GENERATOR_VERSION};
+
+const MAGIC: &[u8; 8] = b"T3SHARD1";
+const HEAD: usize = 8 + 8 + 4 * 4;
+
+/// Shard `k` (1-based) of `n`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// Which shard, `1..=n`.
+    pub k: u32,
+    /// How many shards.
+    pub n: u32,
+}
+
+impl Shard {
+    /// Parses `K/N` with `1 ≤ K ≤ N`.
+    pub fn parse(text: &str) -> Result<Shard, String> {
+        let bad = || format!("invalid shard '{text}': expected K/N with 1 <= K <= N, e.g. 2/8");
+        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let k: u32 = k.trim().parse().map_err(|_| bad())?;
+        let n: u32 = n.trim().parse().map_err(|_| bad())?;
+        if k == 0 || k > n {
+            return Err(bad());
+        }
+        Ok(Shard { k, n })
+    }
+
+    /// The node indices of this shard, ascending.
+    pub fn indices(&self) -> impl Iterator<Item = usize> + use<> {
+        (self.k as usize - 1..node_count()).step_by(self.n as usize)
+    }
+
+    /// The shard's file name: `t3-convolution.shard-K-of-N`.
+    pub fn file_name(&self) -> String {
+        format!(
+            "{}.shard-{}-of-{}",
+            twoscale::TableId::Convolution.name(),
+            self.k,
+            self.n
+        )
+    }
+}
+
+/// Hash of the generator version and T3's layout.
+fn fingerprint() -> u64 {
+    let layout = format!(
+        "{GENERATOR_VERSION}|{AXES:?}|{:?}|{CHANNELS}",
+        header_params(ANGLES, &ANGLE)
+    );
+    fnv1a(FNV_OFFSET, layout.as_bytes())
+}
+
+fn shard_error(message: String) -> BuildError {
+    BuildError::Input {
+        path: "T3 shards".into(),
+        message,
+    }
+}
+
+/// The bytes of shard `shard` holding `nodes` (its nodes' values in
+/// ascending index order, [`CHANNELS`] each).
+pub fn encode(shard: Shard, nodes: &[Vec<f32>]) -> Result<Vec<u8>, BuildError> {
+    let expected = shard.indices().count();
+    if nodes.len() != expected || nodes.iter().any(|v| v.len() != CHANNELS) {
+        return Err(shard_error(format!(
+            "shard {}/{} must hold {expected} nodes of {CHANNELS} values",
+            shard.k, shard.n
+        )));
+    }
+    let mut out = Vec::with_capacity(HEAD + expected * CHANNELS * 4 + 8);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&fingerprint().to_le_bytes());
+    for v in [shard.k, shard.n, expected as u32, CHANNELS as u32] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in nodes.iter().flatten() {
+        out.extend_from_slice(&v.to_bits().to_le_bytes());
+    }
+    let sum = fnv1a(FNV_OFFSET, &out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    Ok(out)
+}
+
+/// One decoded shard file.
+struct Decoded {
+    shard: Shard,
+    values: Vec<f32>,
+}
+
+fn decode(name: &str, bytes: &[u8]) -> Result<Decoded, String> {
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
+    if bytes.len() < HEAD + 8 || &bytes[..8] != MAGIC {
+        return Err(format!("{name}: not a T3 shard file"));
+    }
+    let (body, sum) = bytes.split_at(bytes.len() - 8);
+    if fnv1a(FNV_OFFSET, body).to_le_bytes() != sum {
+        return Err(format!(
+            "{name}: checksum mismatch (truncated or corrupted)"
+        ));
+    }
+    if bytes[8..16] != fingerprint().to_le_bytes() {
+        return Err(format!(
+            "{name}: built by a different generator version or T3 layout \
+             (this is generator {GENERATOR_VERSION})"
+        ));
+    }
+    let (k, n, count, channels) = (u32_at(16), u32_at(20), u32_at(24), u32_at(28));
+    if k == 0 || k > n || channels as usize != CHANNELS {
+        return Err(format!(
+            "{name}: invalid shard header ({k}/{n}, {channels} channels)"
+        ));
+    }
+    let shard = Shard { k, n };
+    let expected = shard.indices().count();
+    if count as usize != expected || body.len() != HEAD + expected * CHANNELS * 4 {
+        return Err(format!(
+            "{name}: shard {k}/{n} holds {count} nodes, expected {expected}"
+        ));
+    }
+    let values = body[HEAD..]
+        .chunks_exact(4)
+        .map(|b| f32::from_bits(u32::from_le_bytes(b.try_into().expect("4 bytes"))))
+        .collect();
+    Ok(Decoded { shard, values })
+}
+
+/// The grid of the whole table (every node's [`CHANNELS`] values, in index
+/// order) from the `N` shard files `files` (name, bytes), in any order.
+/// Errors name the missing, repeated or mismatched shards.
+pub fn merge_grid(files: &[(String, Vec<u8>)]) -> Result<Vec<f32>, BuildError> {
+    let decoded = files
+        .iter()
+        .map(|(name, bytes)| decode(name, bytes))
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(shard_error)?;
+    let Some(first) = decoded.first() else {
+        return Err(shard_error("no shard files given".into()));
+    };
+    let n = first.shard.n;
+    if let Some((i, d)) = decoded.iter().enumerate().find(|(_, d)| d.shard.n != n) {
+        return Err(shard_error(format!(
+            "{} is shard {}/{} but {} is of {n} shards",
+            files[i].0, d.shard.k, d.shard.n, files[0].0
+        )));
+    }
+    let mut owner: Vec<Option<usize>> = vec![None; n as usize];
+    for (i, d) in decoded.iter().enumerate() {
+        let slot = &mut owner[d.shard.k as usize - 1];
+        if let Some(j) = *slot {
+            return Err(shard_error(format!(
+                "shard {}/{n} given twice: {} and {}",
+                d.shard.k, files[j].0, files[i].0
+            )));
+        }
+        *slot = Some(i);
+    }
+    let missing: Vec<String> = owner
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.is_none())
+        .map(|(k, _)| format!("{}/{n}", k + 1))
+        .collect();
+    if !missing.is_empty() {
+        let shown = missing.len().min(10);
+        let more = if missing.len() > shown {
+            format!(" and {} more", missing.len() - shown)
+        } else {
+            String::new()
+        };
+        return Err(shard_error(format!(
+            "missing shards: {}{more}",
+            missing[..shown].join(", ")
+        )));
+    }
+    let mut grid = vec![0.0f32; node_count() * CHANNELS];
+    for d in &decoded {
+        for (node, values) in d.shard.indices().zip(d.values.chunks_exact(CHANNELS)) {
+            grid[node * CHANNELS..(node + 1) * CHANNELS].copy_from_slice(values);
+        }
+    }
+    Ok(grid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fake shard's node values (the merge does not look at them).
+    fn fake(shard: Shard) -> Vec<Vec<f32>> {
+        shard
+            .indices()
+            .map(|i| (0..CHANNELS).map(|c| (i * CHANNELS + c) as f32).collect())
+            .collect()
+    }
+
+    fn files(shards: &[Shard]) -> Vec<(String, Vec<u8>)> {
+        shards
+            .iter()
+            .map(|&s| (s.file_name(), encode(s, &fake(s)).unwrap()))
+            .collect()
+    }
+
+    fn err(files: &[(String, Vec<u8>)]) -> String {
+        merge_grid(files).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn shards_partition_the_nodes_and_merge_in_any_order() {
+        let s = |k| Shard { k, n: 3 };
+        let mut all: Vec<usize> = (1..=3).flat_map(|k| s(k).indices()).collect();
+        all.sort_unstable();
+        assert_eq!(all, (0..node_count()).collect::<Vec<_>>());
+        let grid = merge_grid(&files(&[s(2), s(3), s(1)])).unwrap();
+        let want: Vec<f32> = (0..node_count() * CHANNELS).map(|x| x as f32).collect();
+        assert_eq!(grid, want);
+    }
+
+    #[test]
+    fn parse_accepts_k_of_n_only() {
+        assert_eq!(Shard::parse("2/8"), Ok(Shard { k: 2, n: 8 }));
+        for bad in ["0/3", "4/3", "3", "a/3", "1/0", ""] {
+            assert!(Shard::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn missing_repeated_mismatched_and_corrupt_shards_are_errors() {
+        let s = |k, n| Shard { k, n };
+        assert!(err(&files(&[s(1, 3), s(3, 3)])).ends_with("missing shards: 2/3"));
+        let many = err(&files(&[s(2, 40)]));
+        let want = "missing shards: 1/40, 3/40, 4/40, 5/40, 6/40, 7/40, 8/40, 9/40, 10/40, 11/40 and 29 more";
+        assert!(many.ends_with(want), "{many}");
+        assert!(err(&files(&[s(1, 2), s(1, 2), s(2, 2)])).contains("shard 1/2 given twice"));
+        assert!(err(&files(&[s(1, 2), s(2, 3)])).contains("of 2 shards"));
+        assert!(err(&[]).contains("no shard files"));
+        let mut f = files(&[s(1, 1)]);
+        let last = f[0].1.len() - 20;
+        f[0].1[last] ^= 1;
+        assert!(err(&f).contains("checksum mismatch"));
+        f[0].1.truncate(40);
+        assert!(err(&f).contains("checksum mismatch"));
+        assert!(err(&[("x".into(), b"not a shard".to_vec())]).contains("not a T3 shard"));
+    }
+}
