@@ -1,5 +1,5 @@
 //! Cost of the two-scale BRDF (`eval`, `sample`, `pdf`) against a GGX
-//! Cook–Torrance conductor evaluated in the same run (SPEC §7; the goal of
+//! Cook–Torrance conductor evaluated in the same run (docs/model.md §7; the goal of
 //! issue 5 is `eval` ≤ 3× GGX). Each iteration handles a batch of 1024
 //! pseudo-random inputs; compare the ratios, absolute times depend on the
 //! machine.

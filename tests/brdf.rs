@@ -1,5 +1,5 @@
 //! The two-scale BRDF of the runtime (`twoscale::brdf`) and the 2015 model
-//! (`twoscale::hp15`), verified physically (SPEC §7): the Beckmann limit,
+//! (`twoscale::hp15`), verified physically (docs/model.md §7): the Beckmann limit,
 //! reciprocity, the white furnace, χ² tests of the samplers against their
 //! pdfs, robustness over a dense sweep, and agreement with the f64 reference.
 //!
@@ -218,7 +218,7 @@ fn reciprocity() {
     assert!(max > 0.0 && max < 0.1, "asymmetry {max}");
 }
 
-/// White furnace (SPEC §7): with F ≡ Q̄ ≡ 1, `∫ ρ cos θo dωo ≤ 1` for a grid
+/// White furnace (docs/model.md §7): with F ≡ Q̄ ≡ 1, `∫ ρ cos θo dωo ≤ 1` for a grid
 /// of incidences and materials. The integral is estimated by importance
 /// sampling with the model's own sampler (validated by the χ² tests),
 /// 10⁵ samples; the bound is asserted with 4 standard errors of slack
@@ -317,7 +317,7 @@ fn white_furnace() {
 /// importance sampling with the model's sampler, 2·10⁴ samples per value
 /// (the printed ± is one standard error); C exact (`ProfileConvolution`, one
 /// profile per preset). Q̄ is not bounded by 1 away from the specular
-/// direction (SPEC §7), so nothing bounds the albedo by 1: the test prints
+/// direction (docs/model.md §7), so nothing bounds the albedo by 1: the test prints
 /// the table and lists the values above 1 by more than 4 standard errors;
 /// it asserts only that every albedo is finite and positive (even at normal
 /// incidence the real Q̄ can push a strong halo above 1: gold-rough).

@@ -1,4 +1,4 @@
-//! T3 (the convolution C of SPEC §2.5) through the runtime: the lookup
+//! T3 (the convolution C of docs/model.md §2.5) through the runtime: the lookup
 //! machinery on synthetic tables it must reproduce exactly, the documented
 //! behaviour outside the domain, the normalised angle, and the shipped table
 //! against the exact reference (at its nodes, and at random points with the

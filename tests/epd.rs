@@ -80,7 +80,7 @@ fn t1_is_within_target_at_random_points() {
     });
 }
 
-/// The reference values printed in SPEC §2.2, read from the table.
+/// The reference values printed in docs/model.md §2.2, read from the table.
 #[test]
 fn t1_reproduces_the_spec_table() {
     let spec = [
@@ -215,7 +215,7 @@ fn nothing_is_ever_nan_or_infinite() {
 }
 
 /// The polar angle of a sample against the f64 reference quantile
-/// (SPEC §2.1): relative error of tan θm ≤ 1e-6.
+/// (docs/model.md §2.1): relative error of tan θm ≤ 1e-6.
 #[test]
 fn sampled_tan_theta_matches_the_reference() {
     with_t1(|t1| {
@@ -243,7 +243,7 @@ fn sampled_tan_theta_matches_the_reference() {
     });
 }
 
-/// χ² goodness of fit of `sample` against `pdf` (SPEC §7): 10⁶ samples per
+/// χ² goodness of fit of `sample` against `pdf` (docs/model.md §7): 10⁶ samples per
 /// material, cells of equal reference probability in θ × 8 cells in φ,
 /// expected counts from the runtime pdf integrated by quadrature, cells with
 /// fewer than 5 expected pooled, Šidák-corrected α = 0.01 over the materials.

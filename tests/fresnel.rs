@@ -163,7 +163,7 @@ fn q_bar_equals_fresnel_in_the_specular_direction() {
 
 /// Q̄ is finite and non-negative everywhere, grazing and back-scattering
 /// included, and at double grazing back-scattering it reaches ≈ |η|⁴
-/// (SPEC §7: Q̄ is not bounded by 1).
+/// (docs/model.md §7: Q̄ is not bounded by 1).
 #[test]
 fn q_bar_is_finite_everywhere() {
     let mut rng = SplitMix64::new(77);

@@ -1,4 +1,4 @@
-//! `generator query g1` (SPEC §6): CSV in, CSV out; bad rows are reported and
+//! `generator query g1` (docs/model.md §6): CSV in, CSV out; bad rows are reported and
 //! skipped; `table` and `reference` agree with an independent reference.
 
 use generator::query;
@@ -69,7 +69,7 @@ fn header_and_quantity_errors_fail_fast() {
 
 /// Random points: `table` within 2e-5 of the reference, and `reference`
 /// within 1e-9 relative of an independent computation (the 2-D definition of
-/// Λ, SPEC §2.2; the Beckmann closed form at p = 1).
+/// Λ, docs/model.md §2.2; the Beckmann closed form at p = 1).
 #[test]
 fn answers_agree_with_an_independent_reference() {
     let mut rng = SplitMix64::new(31);

@@ -256,7 +256,7 @@ fn committed_rough_file_matches_the_two_scale_model() {
             |i, o| f64::from(table.eval(c, i.map(|v| v as f32), o.map(|v| v as f32))),
         );
         eprintln!("gold-rough λ{c}: rel RMS {rms:.3e}, p99 {p99:.3e}, max {max:.3e}");
-        // Measured (README, T4): see the bounds' comment in the README table.
+        // Measured: docs/design/t4-band-limits.md, "Result and cost".
         assert!(
             rms < RMS_BOUND && p99 < P99_BOUND && max < MAX_BOUND,
             "λ{c}"

@@ -4,7 +4,7 @@
 //!
 //! The stand-in ([`StandIn`]) is a Beckmann Cook–Torrance microfacet BRDF with
 //! the material's complex Fresnel factor and, for a plastic, the base layer of
-//! SPEC §2.6; it has no diffraction lobe, no EPD shape (`p` is ignored: the NDF
+//! docs/model.md §2.6; it has no diffraction lobe, no EPD shape (`p` is ignored: the NDF
 //! is Beckmann with `α = β`), and no σs, b, c. The committed T4 files project
 //! the two-scale model instead (`tables::t4`); the stand-in is
 //! `tables::t4::Projected::BeckmannStandIn` (header `brdf_model = 2`).
@@ -35,7 +35,7 @@ impl IsotropicBrdf for Lambertian {
 
 /// Beckmann Cook–Torrance: `ρ = F(i·h) D(h) G1(i) G1(o) / (4 cos θi cos θo)`,
 /// `D(h) = exp(−tan²θh/α²) / (π α² cos⁴θh)`, Smith `G1 = 1/(1 + Λ(α tan θ))`
-/// with Beckmann's closed-form Λ (SPEC §2.2 at p = 1). `eta = None` means
+/// with Beckmann's closed-form Λ (docs/model.md §2.2 at p = 1). `eta = None` means
 /// `F ≡ 1`. Reciprocal, and even in `φo − φi`.
 #[derive(Clone, Copy, Debug)]
 pub struct BeckmannCt {
@@ -47,7 +47,7 @@ pub struct BeckmannCt {
 
 impl BeckmannCt {
     /// Smith `G1 = 1/(1 + Λ(a))`, `a = α tan θ`, with Beckmann's closed form
-    /// `Λ = (e^{−μ²}/(μ√π) − erfc μ)/2`, `μ = 1/a` (SPEC §2.2). For μ > 6,
+    /// `Λ = (e^{−μ²}/(μ√π) − erfc μ)/2`, `μ = 1/a` (docs/model.md §2.2). For μ > 6,
     /// Λ < 1e-17 and is dropped; below, the difference loses at most a few
     /// digits of Λ, i.e. nothing visible in G1 (checked against
     /// `reference::epd::beckmann_lambda` in the tests).
@@ -86,7 +86,7 @@ impl IsotropicBrdf for BeckmannCt {
 
 /// The T4 stand-in for one material at one wavelength (see the module docs):
 /// a Beckmann Cook–Torrance lobe with complex Fresnel, plus for a plastic the
-/// base layer of SPEC §2.6,
+/// base layer of docs/model.md §2.6,
 /// `(1 − F(θi))(1 − F(θo)) ρd / (π η² (1 − ρd F_dr,int))`.
 #[derive(Clone, Copy, Debug)]
 pub struct StandIn {

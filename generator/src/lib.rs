@@ -2,11 +2,11 @@
 //! reference implementation every table is measured against.
 //!
 //! - [`quad`]: adaptive quadrature that reports convergence;
-//! - [`reference`](mod@reference): the f64 reference of SPEC §2 (EPD, Smith Λ, K-correlation, …);
+//! - [`reference`](mod@reference): the f64 reference of docs/model.md §2 (EPD, Smith Λ, K-correlation, …);
 //! - [`tables`]: one module per table: build (parallel, deterministic) and verify;
 //! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
 //!   forms of the convolution, table T3);
-//! - [`query`]: the batch CSV queries of SPEC §6;
+//! - [`query`]: the batch CSV queries of docs/model.md §6;
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
 //! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
 //! - [`rng`]: deterministic random points for verification.

@@ -155,12 +155,12 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
-    /// Batch query (SPEC §6): CSV on stdin, CSV on stdout with `table` and
+    /// Batch query (docs/model.md §6): CSV on stdin, CSV on stdout with `table` and
     /// `reference` columns. Quantities: g1 (columns p,a), sigma-ratio
     /// (columns theta_i,B,c; θi in radians), fresnel (columns n,k,cos_theta;
     /// `table` is the runtime's f32 value, which needs no table), conv
     /// (columns u,c,beta,p,theta_h; outputs fit = T3a, table = T3b,
-    /// reference = exact C), brdf (SPEC §6 columns; conductor two-scale model).
+    /// reference = exact C), brdf (docs/model.md §6 columns; conductor two-scale model).
     Query {
         /// The quantity.
         quantity: String,

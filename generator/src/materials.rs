@@ -38,7 +38,7 @@ pub struct Materials {
     pub materials: Vec<Material>,
 }
 
-/// Base layer under the microfacet interface (SPEC §2.6).
+/// Base layer under the microfacet interface (docs/model.md §2.6).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Base {
     /// No base: a conductor.

@@ -1,4 +1,4 @@
-//! Batch queries (SPEC §6): CSV with a header line in, CSV out with the input
+//! Batch queries (docs/model.md §6): CSV with a header line in, CSV out with the input
 //! columns followed by `table` (the runtime's value from the table files) and
 //! `reference` (the f64 reference).
 //!
@@ -164,7 +164,7 @@ pub fn run(
             )
         }
         "brdf" => {
-            // SPEC §6: the conductor two-scale model. `table` is the runtime
+            // docs/model.md §6: the conductor two-scale model. `table` is the runtime
             // model (`twoscale::brdf::TwoScale`, f32, baked from the table
             // set: the path a renderer calls); `reference` is
             // `reference::brdf::two_scale` (exact Λ, σrel, C).

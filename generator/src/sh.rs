@@ -1,5 +1,5 @@
 //! Projection of an isotropic BRDF onto the spherical-harmonic matrix of T4
-//! (\[WAT92\] §2, SPEC §2.9), generic over the BRDF.
+//! (\[WAT92\] §2, docs/model.md §2.9), generic over the BRDF.
 //!
 //! The layout, the odd completion and the real-SH convention are documented
 //! in `twoscale::sh`. Block `m` of the matrix is
@@ -44,10 +44,10 @@ use crate::quad::gauss_legendre;
 /// An isotropic BRDF `ρ(wi, wo)` in sr⁻¹, in the local frame (normal `+z`),
 /// with `wi` towards the light and `wo` towards the viewer, both unit vectors
 /// in the upper hemisphere. It must be even in `φo − φi` (mirror-symmetric),
-/// as every isotropic model of SPEC §2 is.
+/// as every isotropic model of docs/model.md §2 is.
 ///
 /// Any `Fn([f64; 3], [f64; 3]) -> f64 + Sync` is one. The two-scale f64
-/// reference of SPEC §2.5 plugs in here.
+/// reference of docs/model.md §2.5 plugs in here.
 pub trait IsotropicBrdf: Sync {
     /// `ρ(wi, wo)`.
     fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64;

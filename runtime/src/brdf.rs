@@ -1,4 +1,4 @@
-//! The two-scale BRDF of Holzschuch & Pacanowski 2017 (SPEC §2.5–§2.7):
+//! The two-scale BRDF of Holzschuch & Pacanowski 2017 (docs/model.md §2.5–§2.7):
 //! evaluation, importance sampling and the exact pdf of the sampler, at one
 //! wavelength ([`TwoScale`]) and at the three default RGB wavelengths
 //! ([`Rgb`]).
@@ -14,7 +14,7 @@
 //! `σrel = σrel(θi)` comes from T2 ([`SigmaRatioTable`]), D and G from the EPD
 //! distribution ([`Epd`], T1), `C` from any [`Convolution`] (the T3 tables, or
 //! an adapter), F and Q̄ from [`crate::fresnel`]. The constant of ρ_CTD makes
-//! the halo of a flat facet carry exactly `(1 − A) Q̄` (SPEC §2.5).
+//! the halo of a flat facet carry exactly `(1 − A) Q̄` (docs/model.md §2.5).
 //!
 //! # Conventions and guards
 //!
@@ -32,12 +32,12 @@
 //!
 //! With `σs = 0` the model is the EPD Cook–Torrance conductor and is
 //! reciprocal. With `σs > 0` it is not exactly, because σrel — hence A_spec
-//! and the halo's normalisation — depends on θi only (SPEC §7). The option
+//! and the halo's normalisation — depends on θi only (docs/model.md §7). The option
 //! [`SigmaRelMode::Symmetrised`] uses `σrel² = (σrel²(θi) + σrel²(θo))/2`,
 //! which makes the two-scale part reciprocal (Q̄, G, D, C and F(θd) are
 //! symmetric in i ↔ o) at the price of the halo's exact energy normalisation.
 //!
-//! # Sampling (SPEC §2.7)
+//! # Sampling (docs/model.md §2.7)
 //!
 //! One lobe is chosen with probabilities that depend on `i` only
 //! ([`TwoScale::lobe_weights`]); its direction is sampled; [`TwoScale::pdf`]
@@ -54,7 +54,7 @@ use crate::math;
 use crate::smith::SmithG1Table;
 use core::f64::consts::PI;
 
-/// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; SPEC §1).
+/// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];
 
 /// The largest f32 below one (sample inputs are clamped to [0, BELOW_ONE]).
@@ -75,13 +75,13 @@ pub struct Surface {
     pub c: f32,
 }
 
-/// What lies under the two-scale interface (SPEC §2.6).
+/// What lies under the two-scale interface (docs/model.md §2.6).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BaseLayer {
     /// A conductor: no base, `ρ_base = 0`.
     Conductor,
     /// A dielectric varnish of real index `η = n` (the material's index) over a
-    /// diffuse layer of albedo ρd (HP17 43, corrected in SPEC §2.6):
+    /// diffuse layer of albedo ρd (HP17 43, corrected in docs/model.md §2.6):
     /// `ρ_base = (1 − F(θi))(1 − F(θo)) ρd / (π η² (1 − ρd F_dr,int(η)))`.
     Plastic {
         /// Albedo ρd ∈ [0, 1] of the diffuse layer.
@@ -115,7 +115,7 @@ pub struct Material {
     pub eta_rgb: [Complex; 3],
 }
 
-/// Which shadowing–masking term G the model uses (SPEC §2.2).
+/// Which shadowing–masking term G the model uses (docs/model.md §2.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Masking {
     /// `G = G1(i) G1(o)`, as both papers (the default).
@@ -125,7 +125,7 @@ pub enum Masking {
     HeightCorrelated,
 }
 
-/// How σrel enters A_spec and the halo's normalisation (SPEC §7).
+/// How σrel enters A_spec and the halo's normalisation (docs/model.md §7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SigmaRelMode {
     /// `σrel = σrel(θi)` (HP17 19), the paper's model (the default). Not reciprocal.
@@ -141,7 +141,7 @@ pub enum ColourTerms {
     /// F of (HP17 3-4) and Q̄ of (HP17 10) from the complex index (the default).
     #[default]
     Physical,
-    /// `F ≡ 1` and `Q̄ ≡ 1`: the white-furnace configuration of SPEC §7. The
+    /// `F ≡ 1` and `Q̄ ≡ 1`: the white-furnace configuration of docs/model.md §7. The
     /// base layers then receive no light (T = 0); the Lambertian term stays.
     White,
 }
@@ -152,13 +152,13 @@ pub enum HaloWeight {
     /// `A = A_spec(θd)` at every `o`, as printed (HP17 32-33; the default).
     /// The halo's normalisation by σrel(θi) assumes `1 − A(θi)`, so wherever
     /// `cos θd > cos θi` it gets more: the model gains energy at oblique
-    /// incidence when the halo is strong (README, white furnace).
+    /// incidence when the halo is strong (docs/design/halo-weight-incident.md).
     #[default]
     Printed,
     /// `A = A(θi) = exp(−(4π σrel cos θi / λ)²)` for the halo (the specular
     /// lobe keeps `A_spec(θd)`): a flat facet's halo then carries exactly
     /// `(1 − A(θi)) Q̄`, its specular peak `A(θi) F`. Not the paper's model;
-    /// offered because it keeps the white furnace ≤ 1 (measured in the README).
+    /// offered because it keeps the white furnace ≤ 1 (measured in docs/design/halo-weight-incident.md).
     Incident,
 }
 
@@ -550,7 +550,7 @@ impl<'a> TwoScale<'a> {
         let rho_ct = self.fresnel_at(cos_d) * d * g / (4.0 * cos_i * cos_o);
         let specular = a_spec * rho_ct;
 
-        // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, SPEC §2.5)
+        // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
         let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && g > 0.0 {
             let q = if self.white() {
                 1.0
@@ -600,7 +600,7 @@ impl<'a> TwoScale<'a> {
         }
     }
 
-    /// `ρ_base + k_d/π` (SPEC §2.6; HP17 42-47).
+    /// `ρ_base + k_d/π` (docs/model.md §2.6; HP17 42-47).
     fn base_value(
         &self,
         at_i: &DirectionValues,
@@ -617,7 +617,7 @@ impl<'a> TwoScale<'a> {
         let base = match self.base {
             BaseLayer::Conductor => 0.0,
             BaseLayer::Plastic { albedo } => {
-                // (HP17 43) with SPEC §2.6's corrections (ρd in the bracket, 1/η²).
+                // (HP17 43) with docs/model.md §2.6's corrections (ρd in the bracket, 1/η²).
                 let rho_d = f64::from(albedo);
                 transmitted * rho_d / (PI * n * n * (1.0 - rho_d * self.f_dr_int))
             }

@@ -1,5 +1,5 @@
 //! The normalised spherical convolution `C(θh; u, c, β, p)` of the diffraction
-//! lobe with the EPD NDF (SPEC §2.5, HP17 32–33, 39–41), and its table T3.
+//! lobe with the EPD NDF (docs/model.md §2.5, HP17 32–33, 39–41), and its table T3.
 //!
 //! ```text
 //!   C(θh; u, c, β, p) = ∫_{h·m > 0} k(2u sin∠(h,m)) cos²∠(h,m) D(m) dω_m
@@ -22,7 +22,7 @@
 //!   `C ≈ s · k(2 g sin θh)` with `ln s` and `ln(g² + g_offset)` blended by
 //!   the same per-axis weights (Catmull–Rom by default; the issue asked for
 //!   quadrilinear, which `with_cubic_axes([false; 4])` gives, but it misses
-//!   SPEC's 1% interpolation target by a factor 2, Catmull–Rom meets it at
+//!   the 1% interpolation target of docs/model.md §3 by a factor 2, Catmull–Rom meets it at
 //!   the median).
 //!
 //! Both live in one file (table id [`TableId::Convolution`], channels
@@ -70,13 +70,12 @@
 //!   `C` shows no cliff: the softened exponent `p'` spends the nodes on the
 //!   profile's real width instead. (With `κ = 0`, 32 angles left `e_L2` of ξ
 //!   interpolation alone at 5.1% for `p = 5`, `c ≈ 5`; `κ = 1` brings the
-//!   worst of 60 such profiles to 1.0%: `examples/t3_spline_study.rs`,
-//!   `T3_ANGLE_STUDY`.) For `u_e β ≪ p`, `p'` tends to 0 and the NDF term
+//!   worst of 60 such profiles to 1.0%: `studies t3-angle-softening`.) For `u_e β ≪ p`, `p'` tends to 0 and the NDF term
 //!   keeps growing down to `τ ~ 1e-59`, so the first few angles of such
 //!   nodes hold `C(0)` (where `C` is flat): wasted, not wrong.
 //!
 //! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3` were chosen with
-//! `examples/t3_spline_study.rs` (README, T3). Everything is known at lookup
+//! `studies t3-angle-forms` (docs/design/t3-normalised-angle.md). Everything is known at lookup
 //! time. `τ_max`, `u_floor`, `λ`, `Y`, `κ`, `w_h`, `w_e`, `s_e` and `τ_f` are
 //! stored in the header (`params`), so the file is self-describing.
 //!
@@ -98,7 +97,7 @@ use crate::format::{FormatError, Header, Kernel, Quantised, Table, TableId, Valu
 use crate::interp::Axis;
 use crate::math;
 
-/// A source of `C(θh; u, c, β, p)` (SPEC §2.5).
+/// A source of `C(θh; u, c, β, p)` (docs/model.md §2.5).
 ///
 /// Implementations never panic and never return NaN or ∞ for finite inputs;
 /// each documents what it does outside its domain.
@@ -618,7 +617,7 @@ impl<'a> ConvTable<'a> {
         };
         // Catmull–Rom like T3b (multilinear with `with_cubic_axes([false; 4])`):
         // interpolation error against the form fitted at the point, e_L2
-        // median 0.28% vs 1.9% multilinear (40 verify profiles; README).
+        // median 0.28% vs 1.9% multilinear (40 verify profiles; docs/design/t3-interpolation.md).
         let [ln_s, ln_g2] = self.blend_params::<2>(self.cells(&k), 0);
         let s = math::expf(ln_s) * k.factor;
         let g2 = math::expf(ln_g2) - self.g_offset;
@@ -739,7 +738,7 @@ impl ConvSlice<'_> {
 }
 
 /// Which parameter axes (u, c, β, p) both forms interpolate with Catmull–Rom by
-/// default (see the README for the measurement behind the choice).
+/// default (docs/design/t3-interpolation.md has the measurement behind the choice).
 pub const DEFAULT_CUBIC_AXES: [bool; 4] = [true, true, true, true];
 
 /// Catmull–Rom weights of nodes `i−1, i, i+1, i+2` at fraction `t` of cell `i`.

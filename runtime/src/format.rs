@@ -70,8 +70,8 @@ pub enum TableId {
     /// the EPD NDF over (u, c, β, p): the paper's `s, g` (T3a) and `ln C` at
     /// 32 normalised angles (T3b) per node; see [`crate::conv`].
     Convolution = 4,
-    /// T4: spherical-harmonic BRDF matrix of one material (\[WAT92\] §2, SPEC
-    /// §2.9), one channel per wavelength; see [`crate::sh`].
+    /// T4: spherical-harmonic BRDF matrix of one material (\[WAT92\] §2,
+    /// docs/model.md §2.9), one channel per wavelength; see [`crate::sh`].
     ShBrdf = 6,
 }
 
@@ -116,13 +116,13 @@ impl TableId {
                 "sigma_rel/sigma_s of the K-correlation spectrum (HP17 17-19) divided by its closed form at normal incidence; cubic B-spline coefficients"
             }
             TableId::DiffuseFresnel => {
-                "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, SPEC 2.6); cubic B-spline coefficients"
+                "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, docs/model.md 2.6); cubic B-spline coefficients"
             }
             TableId::Convolution => {
                 "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); u16 codes per node; Catmull-Rom in the parameters and in xi"
             }
             TableId::ShBrdf => {
-                "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, SPEC 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
+                "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, docs/model.md 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
             }
         }
     }

@@ -1,7 +1,7 @@
 //! Fresnel reflectance of a complex index of refraction (HP17 3-4), the colour
 //! term Q̄ of the diffraction lobe (HP17 10), and T5, the internal diffuse
 //! Fresnel reflectance `F_dr,int(η)` of the plastic base layer (HP17 43;
-//! SPEC §2.3, §2.6).
+//! docs/model.md §2.3, §2.6).
 //!
 //! # The index of refraction
 //!
@@ -188,7 +188,7 @@ impl Index {
 
 /// Unpolarised Fresnel reflectance of the interface from outside (index 1)
 /// into a material of complex index `η = n + i k`, at incidence `cos θ`
-/// (HP17 3-4; SPEC §2.3):
+/// (HP17 3-4; docs/model.md §2.3):
 ///
 /// ```text
 /// c  = (η² − sin²θ)^½          (principal root)
@@ -286,7 +286,7 @@ impl Direction {
 /// of first-order (Rayleigh–Rice) scattering by a smooth surface; the cross
 /// terms `Qsp`, `Qps` transfer power between polarisations. Q sums the four
 /// channels; unpolarised light carries half its power in each incident
-/// polarisation, hence `Q̄ = Q/2` (SPEC §2.3, §8).
+/// polarisation, hence `Q̄ = Q/2` (docs/model.md §2.3, §8).
 ///
 /// **Specular check**: for `o` the mirror direction of `i` (`θo = θi`,
 /// `φo = φi + π`, so φ = 0) `Qsp = Qps = 0`, `|Qss|² = Fs`, `|Qpp|² = Fp`, so
@@ -394,7 +394,7 @@ const ETA_MIN: f32 = 1.0;
 const ETA_MAX: f32 = 3.0;
 
 /// T5 viewed in place: the internal diffuse Fresnel reflectance of a
-/// dielectric of real index η ∈ [1, 3] (SPEC §2.6, §3),
+/// dielectric of real index η ∈ [1, 3] (docs/model.md §2.6, §3),
 ///
 /// ```text
 /// F_dr,int(η) = 2 ∫₀¹ F(1/η, μ) μ dμ
@@ -403,7 +403,7 @@ const ETA_MAX: f32 = 3.0;
 ///
 /// the cosine-weighted hemispherical reflectance seen from inside the
 /// dielectric, total internal reflection (μ < √(1 − 1/η²)) included; it is
-/// the `F_dr` of the plastic base layer (HP17 43; SPEC §2.6, which corrects
+/// the `F_dr` of the plastic base layer (HP17 43; docs/model.md §2.6, which corrects
 /// the `ρd/π` misprint there).
 ///
 /// **Layout**: one axis, `η ∈ [1, 3]`, 48 nodes evenly spaced in

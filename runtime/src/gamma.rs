@@ -8,7 +8,7 @@
 //! P + Q = 1
 //! ```
 //!
-//! The EPD normal distribution samples `y = Q⁻¹(1/p, u)` (SPEC §2.1): `y = (x/β²)^p`
+//! The EPD normal distribution samples `y = Q⁻¹(1/p, u)` (docs/model.md §2.1): `y = (x/β²)^p`
 //! is Gamma(1/p, 1) distributed, so `a = 1/p ∈ [0.2, 5]` in practice.
 //!
 //! # Method
@@ -301,7 +301,7 @@ pub fn inverse_gamma_p(a: f64, prob: f64) -> f64 {
 
 /// Inverse of [`gamma_q`] in `x`: the `x ≥ 0` with `Q(a, x) = q`.
 ///
-/// This is the EPD sampling map `y = Q⁻¹(1/p, u)` of SPEC §2.1.
+/// This is the EPD sampling map `y = Q⁻¹(1/p, u)` of docs/model.md §2.1.
 ///
 /// # Method
 ///

@@ -1,4 +1,4 @@
-//! The 2015 model of Holzschuch & Pacanowski (INRIA RR-8807; SPEC §2.8) at one
+//! The 2015 model of Holzschuch & Pacanowski (INRIA RR-8807; docs/model.md §2.8) at one
 //! wavelength: a Cook–Torrance lobe with the EPD NDF and Schlick's Fresnel, a
 //! diffraction lobe `S_z(f)`, and a Lambertian term:
 //!
@@ -12,7 +12,7 @@
 //!
 //! `E_{a,λ}` normalises the diffraction lobe. (HP15 17) prints
 //! `E = π(1 + 1/(a²λ²))`; the exact energy of `S_z` at normal incidence is
-//! `∫ S_z cos θo dωo = π / (1 + 1/(a²λ²))` (SPEC §2.8, §8). [`Energy::Exact`]
+//! `∫ S_z cos θo dωo = π / (1 + 1/(a²λ²))` (docs/model.md §2.8, §8). [`Energy::Exact`]
 //! (the default) uses the exact one, [`Energy::Printed`] the printed one.
 //!
 //! G is the separable EPD Smith term (T1), as in the paper (HP15 §5.5).

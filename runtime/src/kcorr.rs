@@ -1,5 +1,5 @@
 //! The K-correlation (ABC) roughness spectrum and T2, its renormalisation
-//! σrel/σs over the disc of reachable frequencies (HP17 14-20; SPEC §2.4).
+//! σrel/σs over the disc of reachable frequencies (HP17 14-20; docs/model.md §2.4).
 //!
 //! ```text
 //! S_HS(f)    = (c − 1)/(2π) · σs² b² · (1 + b² f²)^(−(c+1)/2)              (HP17 16)
@@ -12,14 +12,14 @@
 //! [0.66, 1]; exactly 1 at θi = 0 and as B → 0), so that the table only carries
 //! the dependence on the incidence, and the runtime multiplies r0 back in.
 //!
-//! **Layout** (chosen by a measured design study; see the README):
+//! **Layout** (chosen by a measured design study: docs/design/t2-tricubic-bspline.md):
 //! - axis 0: `cos θi ∈ [0, 1]`, 72 nodes evenly spaced in `ln(cos θi + 0.003) + 1.5 cos θi`
 //!   (dense near grazing, where r drops from r0 to ~r0/√2 in a boundary layer at
 //!   `cos θi ≈ (B √((c−1)/2))^(−½)`);
 //! - axis 1: `B ∈ [0.05, 3000]`, 68 nodes evenly spaced in `ln B`;
 //! - axis 2: `c ∈ [1, 100]`, 32 nodes evenly spaced in `ln(c − 0.8)`; the node at
 //!   c = 1 holds the limit c → 1 (computed at c − 1 = 1e-12);
-//! - **tricubic B-spline**, the payload holds prefiltered coefficients. SPEC §3
+//! - **tricubic B-spline**, the payload holds prefiltered coefficients. docs/model.md §3
 //!   says trilinear, but the study measured trilinear at 1.5e-3 relative error
 //!   at best within the 1 MiB budget (target 1e-4); the B-spline reaches
 //!   ~2.6e-5 with 74·70·34 coefficients (688 KiB).

@@ -3,7 +3,7 @@
 //! Indices are given at the default RGB wavelengths 0.645, 0.526, 0.444 µm
 //! ([`crate::brdf::RGB_WAVELENGTHS`]). Geometry parameters are in the ranges
 //! HP17 fits to measured materials; HP17's nickel fit is β = 0.0598,
-//! σs = 0.0273 µm, b = 4.8418 µm (SPEC §1: lengths in µm).
+//! σs = 0.0273 µm, b = 4.8418 µm (docs/model.md §1: lengths in µm).
 //!
 //! **Gold** optical constants: P. B. Johnson and R. W. Christy, "Optical
 //! constants of the noble metals", Phys. Rev. B 6, 4370 (1972), Table I (as
@@ -36,7 +36,7 @@ pub const VARNISH_ETA: [Complex; 3] = [Complex::real(1.5), Complex::real(1.5), C
 /// HP17's nickel geometry (HP17 Figs. 16-17): β = 0.0598, σs = 0.0273 µm,
 /// b = 4.8418. The caption of Fig. 17 prints `b = 4.8418 µm⁻¹`, but in
 /// (HP17 16) `b f` is dimensionless with f in µm⁻¹, so b is a length (µm), as
-/// SPEC §1 has it. The captions give neither p nor c: p = 1 (Beckmann) and
+/// docs/model.md §1 has it. The captions give neither p nor c: p = 1 (Beckmann) and
 /// c = 2 are **our** choices, not fitted values.
 pub const HP17_NICKEL_SURFACE: Surface = Surface {
     beta: 0.0598,

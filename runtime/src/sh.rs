@@ -1,4 +1,4 @@
-//! T4: spherical-harmonic BRDF matrices (\[WAT92\] §2, SPEC §2.9), and the real
+//! T4: spherical-harmonic BRDF matrices (\[WAT92\] §2, docs/model.md §2.9), and the real
 //! spherical harmonics they are built on.
 //!
 //! # The representation
@@ -74,7 +74,7 @@
 //! A truncated SH series cannot follow a lobe narrower than about `1/L`
 //! radians; glossy materials need `L ~ 1/width` and the table grows like `L³`.
 //! Dividing by `cos θi cos θo` magnifies the truncation error near grazing
-//! (\[WAT92\] §5). Measured figures are in the README (T4 section).
+//! (\[WAT92\] §5). Measured figures: docs/design/t4-band-limits.md.
 
 // Index loops mirror the recurrences and the block formulas of the docs.
 #![allow(clippy::needless_range_loop)]
@@ -119,7 +119,7 @@ pub const PARAM_NAMES: [&str; 8] = [
 /// Names of the auxiliary values of T4 (after the coefficients).
 ///
 /// - `brdf_model`: what was projected: 1 Lambertian, 2 Beckmann Cook–Torrance
-///   stand-in (no diffraction), 3 the two-scale model of SPEC §2.5;
+///   stand-in (no diffraction), 3 the two-scale model of docs/model.md §2.5;
 /// - `phi_nodes`: midpoint nodes in `Δφ ∈ [0, π]` of the azimuthal Fourier
 ///   decomposition;
 /// - `beta`, `p`, `sigma_s` (µm), `b` (µm), `c`: the material's two-scale
@@ -347,7 +347,7 @@ pub enum ProjectedModel {
     /// diffraction (`generator::analytic::StandIn`): analytic, for tests and
     /// convergence studies.
     BeckmannStandIn,
-    /// The two-scale model of SPEC §2.5–§2.6 as this runtime evaluates it
+    /// The two-scale model of docs/model.md §2.5–§2.6 as this runtime evaluates it
     /// ([`crate::brdf::TwoScale`], default options: σrel(θi), separable G,
     /// physical F and Q̄) with T1, T2, T5 and C from T3b
     /// ([`crate::ConvTable`]), at the file's wavelengths. Not reciprocal

@@ -1,7 +1,7 @@
 //! T1: Smith masking G1 of the Exponential Power Distribution NDF.
 //!
 //! Smith's Λ for the EPD depends on the shape `p` and on `a = β tan θ` only
-//! (HP17 36-38, with the factor 2 of the slope marginal restored; SPEC §2.2).
+//! (HP17 36-38, with the factor 2 of the slope marginal restored; docs/model.md §2.2).
 //! Its asymptote is `Λ(a) = k_p·a − 1/2 + O(1/a)`, with
 //! `k_p = Γ(3/(2p)) / (π Γ(1/p))`, and `k_p` spans 0.207 (p = 5) to 24.8
 //! (p = 0.2): the transition from G1 ≈ 1 to G1 ≈ 1/(k_p a) moves by two decades
@@ -197,7 +197,7 @@ impl SmithShape<'_> {
 }
 
 /// The asymptotic slope of Smith Λ for the EPD, `k_p = Γ(3/(2p)) / (π Γ(1/p))`
-/// (SPEC §2.2): `k_p = ∫₀^∞ r P2(r) dr`, half the mean |slope| along one axis.
+/// (docs/model.md §2.2): `k_p = ∫₀^∞ r P2(r) dr`, half the mean |slope| along one axis.
 pub fn asymptotic_slope(p: f64) -> f64 {
     crate::math::exp(crate::math::ln_gamma(1.5 / p) - crate::math::ln_gamma(1.0 / p))
         / core::f64::consts::PI

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Independent check of `generator query brdf` (SPEC §2.5, conductor) with SciPy.
+"""Independent check of `generator query brdf` (docs/model.md §2.5, conductor) with SciPy.
 
-Rebuilds the two-scale BRDF from SPEC's formulas, written here from scratch:
-Λ from the 1-D form of SPEC §2.2 (QUADPACK), σrel/σs from SPEC §2.4, F and
-Q̄ = Q/2 from SPEC §2.3 / (HP17 10) in complex arithmetic, C from
+Rebuilds the two-scale BRDF from the formulas of docs/model.md §2, written here from scratch:
+Λ from the 1-D form of docs/model.md §2.2 (QUADPACK), σrel/σs from docs/model.md §2.4, F and
+Q̄ = Q/2 from docs/model.md §2.3 / (HP17 10) in complex arithmetic, C from
 `conv_scipy.conv` (nested QUADPACK around the half vector), and
 
     ρ = A ρ_CT + ρ_CTD,   A = exp(−(4π σrel cos θd / λ)²),

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent check of `generator query conv` (SPEC §2.5's C) with SciPy.
+"""Independent check of `generator query conv` (docs/model.md §2.5's C) with SciPy.
 
 Recomputes C(θh; u, c, β, p) by nested adaptive quadrature (QUADPACK through
 scipy.integrate.quad) in polar coordinates around the half vector h — the

@@ -3,7 +3,7 @@
 
 Draws random (p, a) points, asks the generator binary for `table` and
 `reference`, and recomputes G1 = 1/(1 + Λ) with mpmath from the 1-D form of
-SPEC §2.2, written here from scratch (no code shared with the Rust reference).
+docs/model.md §2.2, written here from scratch (no code shared with the Rust reference).
 
     pip install mpmath
     cargo build --release -p generator

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Independent check of `generator query sigma-ratio` against mpmath (30 digits).
 
-Draws random (θi, B, c) over the SPEC domain (θi uniform, and half the points
+Draws random (θi, B, c) over T2's domain (docs/model.md §3) (θi uniform, and half the points
 with cos θi log-uniform down to 1e-4 to probe grazing incidence), asks the
 generator for `table` and `reference`, and recomputes σrel/σs with mpmath from
-the 1-D form of SPEC §2.4, written here from scratch, with breakpoints at the
+the 1-D form of docs/model.md §2.4, written here from scratch, with breakpoints at the
 features near φ = π/2 (widths ~cos θi and ~B cos²θi).
 
     pip install mpmath

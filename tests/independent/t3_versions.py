@@ -11,7 +11,7 @@ is the part inside brdf_scipy.py's ranges (β ≥ 0.05, p ≥ 0.5, u ≤ 100,
     NEW=target/release/generator python3 tests/independent/t3_versions.py [points] [seed]
 
 Used to compare the format-1 table (commit f2bd3e8, built with its own
-generator) with the format-2 one (README, T3). Needs no SciPy.
+generator) with the format-2 one (docs/design/t3-normalised-angle.md). Needs no SciPy.
 """
 import math
 import os

@@ -1,4 +1,4 @@
-//! `f64` reference of the two-scale BRDF of SPEC §2.5 (HP17 24-33) for a
+//! `f64` reference of the two-scale BRDF of docs/model.md §2.5 (HP17 24-33) for a
 //! conductor, with every ingredient exact: Smith Λ by quadrature
 //! ([`epd::lambda`]), σrel by quadrature ([`kcorr::sigma_ratio`]), C by the
 //! direct 2-D quadrature ([`conv::convolution`]), F and Q̄ in f64
@@ -17,7 +17,7 @@ use twoscale::brdf::{ColourTerms, HaloWeight, Masking, Options, SigmaRelMode};
 
 use crate::reference::{conv, epd, fresnel, kcorr};
 
-/// The parameters of the conductor two-scale model (SPEC §6 `query brdf`).
+/// The parameters of the conductor two-scale model (docs/model.md §6 `query brdf`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     /// EPD width β.
@@ -43,7 +43,7 @@ pub struct Params {
 pub struct Value {
     /// `A_spec · ρ_CT` (HP17 25-26).
     pub specular: f64,
-    /// `ρ_CTD` (HP17 32-33 with SPEC §2.5's constant).
+    /// `ρ_CTD` (HP17 32-33 with docs/model.md §2.5's constant).
     pub diffraction: f64,
 }
 

@@ -1,4 +1,4 @@
-//! Exact `f64` reference of the normalised spherical convolution of SPEC §2.5:
+//! Exact `f64` reference of the normalised spherical convolution of docs/model.md §2.5:
 //!
 //! ```text
 //!   C(θh; u, c, β, p) = ∫_{h·m > 0} k(2u sin∠(h,m)) cos²∠(h,m) D(m) dω_m      (HP17 32–33)
@@ -9,7 +9,7 @@
 //! `D` is centred on the normal `n`, the kernel `K(γ) = k(2u sin γ) cos²γ` on
 //! the half vector `h`, which is at the angle `θh` from `n`. Both lobes are cut
 //! at their own horizon: `D(m) = 0` for `n·m ≤ 0` and `K = 0` for `h·m ≤ 0`
-//! (the cut-off of SPEC §2.5). `C` is a function of the single angle `θh`
+//! (the cut-off of docs/model.md §2.5). `C` is a function of the single angle `θh`
 //! because both lobes are rotationally symmetric about their axes.
 //!
 //! # Methods
@@ -35,7 +35,7 @@
 //! [`convolution_profile`] (many angles at one parameter point) chooses:
 //! zonal harmonics when the band limit they need is affordable, the direct
 //! quadrature otherwise (see [`convolution_profile_with_method`]). [`e_l2`] implements the error metric
-//! of SPEC §2.5 with a quadrature in `θh` graded to the profile's width.
+//! of docs/model.md §2.5 with a quadrature in `θh` graded to the profile's width.
 //!
 //! # Accuracy target
 //!
@@ -151,7 +151,7 @@ pub struct Params {
 impl Params {
     /// Validates a parameter point. The reference is defined for any finite
     /// `u ≥ 0`, `c > 1`, `β > 0`, `p > 0`; it is verified on the table domain
-    /// of SPEC §3 (`u ≤ 3000`, `c ∈ [1.01, 10]`, `β ∈ [0.002, 1]`,
+    /// of docs/model.md §3 (`u ≤ 3000`, `c ∈ [1.01, 10]`, `β ∈ [0.002, 1]`,
     /// `p ∈ [0.2, 5]`).
     pub fn new(u: f64, c: f64, beta: f64, p: f64) -> Result<Self, ConvError> {
         let check = |name, value: f64, ok: bool, expected| {
@@ -223,7 +223,7 @@ impl Params {
 }
 
 /// The kernel `K(γ) = k(2u sin γ) cos²γ` with `k(x) = (1 + x²)^(−q)`,
-/// `q = (c+1)/2`, cut to zero for `cos γ ≤ 0` (SPEC §2.5).
+/// `q = (c+1)/2`, cut to zero for `cos γ ≤ 0` (docs/model.md §2.5).
 fn kernel_sc(u: f64, q: f64, sin_gamma: f64, cos_gamma: f64) -> f64 {
     if cos_gamma.is_nan() || cos_gamma <= 0.0 {
         return 0.0;
@@ -365,7 +365,7 @@ pub enum Method {
 /// cost of 30–60 direct evaluations.
 pub const ZH_MAX_BAND: usize = 16384;
 
-/// `C(θh; u, c, β, p)` (SPEC §2.5, HP17 32–33) at one angle, by the direct
+/// `C(θh; u, c, β, p)` (docs/model.md §2.5, HP17 32–33) at one angle, by the direct
 /// quadrature ([`convolution_direct`] with the default [`DirectOptions`],
 /// 1–30 ms): for a single angle it is cheaper than the zonal harmonics,
 /// whose cost is per profile.
@@ -538,7 +538,7 @@ impl ProfileRule {
     }
 }
 
-/// SPEC §2.5's error metric of a representation `C̃` of `C` at one parameter
+/// docs/model.md §2.5's error metric of a representation `C̃` of `C` at one parameter
 /// point, given the exact profile on `rule.nodes`:
 ///
 /// ```text

@@ -1,5 +1,5 @@
 //! Reference implementation of the Exponential Power Distribution (EPD)
-//! normal distribution and of its Smith masking term (`SPEC.md` §2.1–2.2).
+//! normal distribution and of its Smith masking term (docs/model.md §2.1–2.2).
 //!
 //! # Notation
 //!
@@ -265,7 +265,7 @@ fn v_minus_atan(v: f64) -> f64 {
 ///
 /// Writing the slope plane in polar coordinates `(r, q) = ρ (cos φ, sin φ)`,
 /// the definition `Λ(a) = a ∫∫_{r > μ} (r − μ) P22₁(r² + q²) dr dq`, `μ = 1/a`,
-/// becomes (`SPEC.md` §2.2)
+/// becomes (docs/model.md §2.2)
 ///
 /// ```text
 ///   Λ(a) = 2a ∫_μ^∞ ρ P22₁(ρ²) (sqrt(ρ² − μ²) − μ acos(μ/ρ)) dρ
@@ -436,7 +436,7 @@ pub fn lambda_2d(p: f64, a: f64) -> Result<f64, QuadError> {
     }
 }
 
-/// Slope of the asymptote `Λ(a) = k_p a − ½ + O(1/a)` (SPEC §2.2):
+/// Slope of the asymptote `Λ(a) = k_p a − ½ + O(1/a)` (docs/model.md §2.2):
 /// `k_p = Γ(3/(2p)) / (π Γ(1/p))`.
 ///
 /// Derivation: `k_p = ∫_0^∞ r P2(r) dr` is the mean of the positive part of

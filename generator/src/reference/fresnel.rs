@@ -1,6 +1,6 @@
 //! f64 reference of the Fresnel reflectance of a complex index (HP17 3-4),
 //! the diffraction colour term Q of (HP17 10), and the diffuse Fresnel
-//! reflectances of a dielectric (SPEC §2.3, §2.6).
+//! reflectances of a dielectric (docs/model.md §2.3, §2.6).
 //!
 //! It is written independently of the runtime's `twoscale::fresnel`, so that
 //! comparing the two means something: its own complex type (square root from
@@ -270,7 +270,7 @@ pub fn q(eta: Complex64, i: [f64; 3], o: [f64; 3]) -> Result<f64, QuadError> {
     Ok(value)
 }
 
-/// `Q̄ = Q/2`, the colour term for unpolarised light (SPEC §2.3); see [`q`].
+/// `Q̄ = Q/2`, the colour term for unpolarised light (docs/model.md §2.3); see [`q`].
 pub fn q_bar(eta: Complex64, i: [f64; 3], o: [f64; 3]) -> Result<f64, QuadError> {
     Ok(0.5 * q(eta, i, o)?)
 }
@@ -320,7 +320,7 @@ pub fn diffuse_reflectance(eta_rel: f64) -> Result<f64, QuadError> {
 
 /// The internal diffuse Fresnel reflectance of a dielectric of index η ≥ 1,
 /// seen from inside: `F_dr,int(η) = F_dr(1/η) = 2 ∫₀¹ F(1/η, μ) μ dμ`
-/// (SPEC §2.6, HP17 43), by quadrature ([`diffuse_reflectance`]).
+/// (docs/model.md §2.6, HP17 43), by quadrature ([`diffuse_reflectance`]).
 pub fn diffuse_internal(eta: f64) -> Result<f64, QuadError> {
     if !(eta >= 1.0 && eta.is_finite()) {
         return Err(invalid("eta", eta, "a finite real index >= 1"));

@@ -1,5 +1,5 @@
 //! The K-correlation (ABC) roughness spectrum and its renormalisation over the
-//! disc of reachable frequencies (HP17 14-20; SPEC §2.4).
+//! disc of reachable frequencies (HP17 14-20; docs/model.md §2.4).
 //!
 //! ```text
 //! S_HS(f) = (c − 1)/(2π) · σs² b² · (1 + b² f²)^(−(c+1)/2),   c > 1     (HP17 16)
@@ -95,7 +95,7 @@ pub fn sigma_ratio_sq_normal(big_b: f64, c: f64) -> f64 {
     captured_fraction(big_b, 1.0, c)
 }
 
-/// `(σrel/σs)²(θi, B, c)` by the 1-D integral of SPEC §2.4, relative accuracy
+/// `(σrel/σs)²(θi, B, c)` by the 1-D integral of docs/model.md §2.4, relative accuracy
 /// [`SIGMA_RATIO_TOL`].
 ///
 /// The integral is taken in `ψ = |φ − π/2|` on each half of the circle, where

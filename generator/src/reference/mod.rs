@@ -1,4 +1,4 @@
-//! The `f64` reference implementation of the models of `SPEC.md` §2.
+//! The `f64` reference implementation of the models of docs/model.md §2.
 //!
 //! Every table the generator writes is measured against these functions, so
 //! they favour accuracy and explicit error reporting over speed. Numerical
@@ -12,11 +12,11 @@
 //! * [`kcorr`]: the K-correlation spectrum (HP17 16) and the renormalisation
 //!   σrel/σs (HP17 17–19).
 //! * [`conv`]: the normalised spherical convolution `C(θh; u, c, β, p)` of
-//!   SPEC §2.5 (HP17 32–33, 61–64), by zonal harmonics and by direct 2-D
+//!   docs/model.md §2.5 (HP17 32–33, 61–64), by zonal harmonics and by direct 2-D
 //!   quadrature.
 //! * [`fresnel`]: the Fresnel reflectance of a complex index (HP17 3-4), the
 //!   diffraction colour term Q of (HP17 10), and the diffuse Fresnel
-//!   reflectances of a dielectric (SPEC §2.6).
+//!   reflectances of a dielectric (docs/model.md §2.6).
 
 pub mod brdf;
 pub mod conv;

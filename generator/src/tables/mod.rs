@@ -106,7 +106,7 @@ pub struct Accuracy {
     pub p99: f64,
     /// Where the largest error occurred.
     pub worst_at: String,
-    /// The target (SPEC §3 or the issue's) for the gated quantile.
+    /// The target (docs/model.md §3 or the issue's) for the gated quantile.
     pub target: f64,
     /// Which quantile the target applies to (1 = the maximum).
     pub gate_quantile: f64,

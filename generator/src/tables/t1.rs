@@ -2,8 +2,7 @@
 //! are documented where the runtime reads it, in `twoscale::smith`.
 //!
 //! Node count and mappings were chosen by measuring the linear-interpolation
-//! error of G1 at cell midpoints against the reference (see the README's T1
-//! section): with ã nodes evenly spaced in ln(ã + 0.01) the a-direction error
+//! error of G1 at cell midpoints against the reference (docs/design/t1-scaled-axis.md): with ã nodes evenly spaced in ln(ã + 0.01) the a-direction error
 //! peaks at the steep p = 5 transition near ã ≈ 0.33 and falls as 1/N²; with
 //! p nodes evenly spaced in p^−½ the p-direction error is flat across p.
 //! 64 × 1000 nodes leave both near 5e-6, well inside the 2e-5 target, in
@@ -40,7 +39,7 @@ pub const SCALED_AXIS: AxisHeader = AxisHeader {
     param2: 0.0,
 };
 
-/// Target of SPEC §3: max |G1 − G1_ref| ≤ 2e-5.
+/// Target of docs/model.md §3: max |G1 − G1_ref| ≤ 2e-5.
 pub const TARGET_MAX_ABS_ERROR: f64 = 2e-5;
 
 /// The T1 builder.

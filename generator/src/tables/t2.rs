@@ -1,7 +1,7 @@
 //! T2: σrel/σs of the K-correlation spectrum over (cos θi, B = b/λ, c), stored
 //! as tricubic B-spline coefficients of `q = r / r0(B, c)`. The layout and the
 //! out-of-domain rules are documented where the runtime reads it, in
-//! `twoscale::kcorr`; why it is a B-spline and not trilinear is in the README.
+//! `twoscale::kcorr`; why it is a B-spline and not trilinear is in docs/design/t2-tricubic-bspline.md.
 
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
@@ -48,7 +48,7 @@ pub const C_AXIS: AxisHeader = AxisHeader {
 /// The c = 1 node is evaluated at c = 1 + this (the c → 1 limit of q).
 pub const C_MINUS_1_AT_FIRST_NODE: f64 = 1e-12;
 
-/// Target of SPEC §3: max relative error ≤ 1e-4.
+/// Target of docs/model.md §3: max relative error ≤ 1e-4.
 pub const TARGET_MAX_REL_ERROR: f64 = 1e-4;
 
 /// The T2 builder.
@@ -150,7 +150,7 @@ pub fn error_at(
     Ok(((got - reference) / reference).abs())
 }
 
-/// Random points over the SPEC domain θi ∈ [0, π/2], B ∈ [0.1, 3000],
+/// Random points over T2's domain (docs/model.md §3) θi ∈ [0, π/2], B ∈ [0.1, 3000],
 /// c ∈ [1.01, 100] (returned as cos θi, B, c, each rounded to f32 as the
 /// runtime API takes them): ln B and ln(c − 1) uniform; θi uniform for half
 /// the points, and cos θi log-uniform in [1e-4, 1] for the other half, to

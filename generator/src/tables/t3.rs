@@ -1,5 +1,5 @@
 //! T3: the convolution `C(θh; u, c, β, p)` of the diffraction kernel with the
-//! EPD NDF (SPEC §2.5), in both forms of `twoscale::conv` (where the layout,
+//! EPD NDF (docs/model.md §2.5), in both forms of `twoscale::conv` (where the layout,
 //! the normalised angle and the out-of-domain rules are documented): the
 //! paper's `s · k(2 g sin θh)` (T3a) and `ln C` at 32 normalised angles
 //! (T3b), at every node of a `(u, c, β, p)` grid, in one file.
@@ -20,7 +20,7 @@
 //!
 //! # The fit of T3a
 //!
-//! `s, g` minimise the SPEC §2.5 metric `e_L2` of `s · k(2g sin θh)` against
+//! `s, g` minimise the docs/model.md §2.5 metric `e_L2` of `s · k(2g sin θh)` against
 //! the node's exact profile (variable projection: `s` in closed form, `ln g`
 //! by scan + golden section; `generator::fit`), with the metric's integral
 //! `∫ (…)² sin θh dθh` discretised on the node's 32 angles: trapezoid weights
@@ -33,16 +33,16 @@
 //! [1.01, 10]; β: 12 in ln β over [0.002, 1]; p: 12 in p^−½ over [0.2, 5].
 //! 40 320 nodes × 34 channels, stored quantised per node (`ValueType::U16`:
 //! 34 u16 codes and an f32 offset and step per node, 76 bytes instead of
-//! 136; error ≤ 3.4e-4 in ln C, the largest node range being 44) = 3.06 MB, so that T1–T3 stay within SPEC's
-//! 4 MiB. The u axis got the nodes that quantisation freed: measured along u
-//! alone (`examples/t3_spline_study.rs`, `T3_AXIS_STUDY=30 T3_AXIS=u`, 30
+//! 136; error ≤ 3.4e-4 in ln C, the largest node range being 44) = 3.06 MB, so that T1–T3 stay within the 4 MiB budget
+//! of docs/model.md §3. The u axis got the nodes that quantisation freed: measured along u
+//! alone (`studies t3-axis u --triples 30`, 30
 //! random (c, β, p), exact profiles), 16 → 28 nodes cut the 95th percentile
 //! of the pointwise error where C > 1e-3 C(0) from 2.4% to 0.31% on
 //! `brdf_scipy.py`'s distribution (1.3% → 0.16% on verify's), and where
 //! 1e-9 < C/C(0) < 1e-3 from 3.2% to 0.46% (5.7% → 1.4%). Moving the offset
 //! to ln(u + 1) or ln(u + 3) made it worse (p95 12% and 40% at 16 nodes):
 //! the profile changes fastest for u ≲ 1. The first layout (20 × 8 × 14 × 9, from the design
-//! study `examples/t3_study.rs`) was measured with its nodes snapped to the
+//! study, now only in git history) was measured with its nodes snapped to the
 //! grid one axis at a time: snapping p cut the mean e_L2 from 0.76% to 0.47%,
 //! c to 0.67%, u and β to 0.74–0.75%; so p and c got the nodes, u and β gave
 //! some up. The c mapping's linear term is documented at [`C_AXIS`].
@@ -79,7 +79,7 @@ pub const U_AXIS: AxisHeader = AxisHeader {
 /// c = 1, where the narrow-kernel limit `ln C ≈ ln D − ln(c − 1) + …` is linear
 /// in ln(c − 1), and linear for large c, where the kernel's tail
 /// `ln C ≈ −(c+1)/2 · ln(1 + 4u² sin²θh)` is linear in c. Measured along c
-/// alone (`examples/t3_spline_study.rs`, `T3_AXIS_STUDY`, 40 random
+/// alone (`studies t3-axis c`, 40 random
 /// (u, β, p), 80 random c, 32 angles each; Catmull–Rom): the 95th percentile
 /// of the relative error where 1e-9 < C/C(0) < 1e-3 is 18% with pure
 /// ln(c − 1) spacing, 7.8% with slope ¼, 2.7% with ½ (1.7% on
@@ -118,15 +118,15 @@ pub const ANGLES: usize = 32;
 
 /// The normalised angle's constants (`twoscale::conv`): `τ_max = 1e4`,
 /// `u_floor = 1`, `λ = 1`, `Y = 30` (the design study's choice), `κ = 1`
-/// (`examples/t3_spline_study.rs`, `T3_ANGLE_STUDY`: of κ ∈ {0, ½, 1, 2, 4},
+/// (`studies t3-angle-softening`: of κ ∈ {0, ½, 1, 2, 4},
 /// 1 gave the lowest ξ-interpolation error on `brdf_scipy.py`'s parameter
 /// distribution, e_L2 max 5.1% → 1.0%, and verify's max 3.5% → 1.6%), and
 /// the horizon and edge terms `w_h = ½`, `w_e = ½`, smoothed over 2 kernel
-/// widths, faded with `τ_f = 3` (`T3_XI_AT_POINTS` and
-/// `T3_ANGLE_VARIABLE_STUDY`, ξ interpolation alone: at the BRDF check's 400
+/// widths, faded with `τ_f = 3` (`studies t3-angle-at-points`
+/// and `studies t3-angle-forms`, ξ interpolation alone: at the BRDF check's 400
 /// points p95 4.3% → 0.37%, max 11% → 3.7% against format 1's angle; on
 /// verify's distribution e_L2 max 0.99% → 0.46%, pointwise p95 0.46% →
-/// 0.77%; README, T3).
+/// 0.77%; docs/design/t3-normalised-angle.md).
 pub const ANGLE: AngleParams = AngleParams {
     tau_max: 1e4,
     kernel_scale_floor: 1.0,
@@ -452,12 +452,12 @@ pub struct ProfileErrors {
     /// `e_L2` of the T3a form fitted at this point itself against exact C.
     pub fit_at_point_e_l2: f64,
     /// `e_L2` between the interpolated T3a form and the form fitted at this
-    /// point (SPEC §3: "s, g interpolation").
+    /// point (docs/model.md §3: "s, g interpolation").
     pub fit_interpolation_e_l2: f64,
 }
 
 /// Measures both forms of `table` at one parameter point against the exact
-/// profile on the SPEC metric's rule ([`ProfileRule::with_order`], 8 nodes per
+/// profile on the rule of the e_L2 metric (docs/model.md §2.5) ([`ProfileRule::with_order`], 8 nodes per
 /// interval).
 pub fn verify_point(table: &ConvTable<'_>, point: [f64; 4]) -> Result<ProfileErrors, BuildError> {
     let [u, c, beta, p] = point;
@@ -559,7 +559,7 @@ pub fn verify(bytes: &[u8], profiles: usize, seed: u64) -> Result<Vec<Accuracy>,
         // The acceptance figures for T3b: pointwise where C > 1e-3 C(0).
         Accuracy::from_errors("T3b rel err (C>1e-3C0) p50", 0.01, pointwise.clone()).gated_at(0.5),
         Accuracy::from_errors("T3b rel err (C>1e-3C0) p95", 0.05, pointwise).gated_at(0.95),
-        // SPEC §3's targets, reported (not met everywhere; see the README).
+        // docs/model.md §3's targets, reported (not met everywhere; see the README).
         Accuracy::from_errors(
             "T3b e_L2 vs exact C",
             0.01,

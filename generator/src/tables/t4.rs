@@ -1,12 +1,12 @@
 //! T4: the spherical-harmonic BRDF matrix of each material of the materials
-//! file (\[WAT92\] §2, SPEC §2.9), one file `t4-<material>.tbl` per material,
+//! file (\[WAT92\] §2, docs/model.md §2.9), one file `t4-<material>.tbl` per material,
 //! one channel per wavelength. Layout and conventions: `twoscale::sh`;
 //! projection: [`crate::sh`].
 //!
 //! # What is projected
 //!
 //! The committed files project the **runtime two-scale model**
-//! (`twoscale::brdf::TwoScale`, SPEC §2.5–§2.6, default [`Options`]: the
+//! (`twoscale::brdf::TwoScale`, docs/model.md §2.5–§2.6, default [`Options`]: the
 //! paper's `σrel(θi)`, separable G, physical F and Q̄) at each channel's
 //! wavelength, reading T1 (`t1-smith-g1.tbl`), T2 (`t2-sigma-ratio.tbl`), T5
 //! (`t5-diffuse-fresnel.tbl`) and C from T3b (`t3-convolution.tbl` through
@@ -24,7 +24,7 @@
 //! so a full build into an empty directory projects the tables just built.
 //!
 //! The two-scale model with `σs > 0` is not reciprocal (σrel depends on θi
-//! only, SPEC §7): the asymmetry `‖M − Mᵀ‖/‖M‖` (WAT92 26-27) measured before
+//! only, docs/model.md §7): the asymmetry `‖M − Mᵀ‖/‖M‖` (WAT92 26-27) measured before
 //! symmetrising is written into the header (`asymmetry`).
 //!
 //! The Beckmann Cook–Torrance stand-in of [`crate::analytic::StandIn`]
@@ -65,7 +65,7 @@ pub const INPUTS: [TableId; 4] = [
 /// grazing incidence and exitance near the mirror azimuth, where the specular
 /// peak is narrower in `Δφ` than any band limit can follow. The target, 0.5,
 /// only catches a broken table; the p99 and median are the figures to read
-/// (README, T4).
+/// (docs/design/t4-band-limits.md).
 pub const TARGET_MAX_REL_F_ERROR: f64 = 0.5;
 
 /// Which BRDF a T4 builder projects.

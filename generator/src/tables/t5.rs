@@ -34,7 +34,7 @@ pub const ETA_AXIS: AxisHeader = AxisHeader {
     param2: 0.5,
 };
 
-/// Target: max |F_dr,int − reference| ≤ 1e-6 (SPEC §3 sets none for T5; the
+/// Target: max |F_dr,int − reference| ≤ 1e-6 (docs/model.md §3 sets none for T5; the
 /// plastic base divides by `1 − ρd F_dr,int`, so this keeps the base layer
 /// within ~1e-6 relative for ρd ≤ 0.5).
 pub const TARGET_MAX_ABS_ERROR: f64 = 1e-6;

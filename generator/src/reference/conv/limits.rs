@@ -29,7 +29,7 @@
 //!
 //! `W_D ≠ 1`: with `x = tan²θ`, `∫ D dω = π ∫ P22(x) √(1+x) dx`, the mean of
 //! `√(1 + x)` under the slope density; with `x = β² y^(1/p)`,
-//! `y ~ Gamma(1/p, 1)` (SPEC §2.1),
+//! `y ~ Gamma(1/p, 1)` (docs/model.md §2.1),
 //! `W_D = E[√(1 + β² y^(1/p))]`, which grows like `β Γ(3/(2p))/Γ(1/p)` for wide
 //! lobes (`W_D ≈ 78` at `β = 1`, `p = 0.2`) and is `1 + O(β²)` for narrow
 //! ones.

@@ -832,7 +832,7 @@ fn profile_timings() {
     }
 }
 
-/// SPEC §2.5 says `L = 400` leaves `e_L2 ≈ 2e-4` at `p = 0.2, u = 30,
+/// docs/model.md §2.5 says `L = 400` leaves `e_L2 ≈ 2e-4` at `p = 0.2, u = 30,
 /// β = 0.5`; prints the measured value for several `c`.
 #[test]
 #[ignore]

@@ -14,7 +14,7 @@
 //! ```
 //!
 //! with both integrals over the upper hemisphere of each lobe only (the cut
-//! of SPEC §2.5). This is (HP17 64): with `Y_l⁰ = √((2l+1)/4π) P_l` (HP17 61),
+//! of docs/model.md §2.5). This is (HP17 64): with `Y_l⁰ = √((2l+1)/4π) P_l` (HP17 61),
 //! `S_l = 2π √((2l+1)/4π) a_l` (HP17 62), `D_l = 2π √((2l+1)/4π) b_l`
 //! (HP17 63), `S_l D_l √(4π/(2l+1)) Y_l⁰ = π (2l+1) a_l b_l P_l`. Checks of the
 //! convention: `K ≡ 1`, `D ≡ 1` on the whole sphere give `a_0 = b_0 = 2` and
