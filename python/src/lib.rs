@@ -171,8 +171,13 @@ fn in_range(name: &str, x: f32, lo: f32, hi: f32) -> PyResult<()> {
 fn surface(beta: f32, p: f32, sigma_s: f32, b: f32, c: f32) -> PyResult<Surface> {
     in_range("beta", beta, BETA_RANGE.0, BETA_RANGE.1)?;
     in_range("p", p, P_RANGE.0, P_RANGE.1)?;
-    in_range("sigma_s", sigma_s, 0.0, f32::MAX)?;
-    in_range("b", b, 0.0, f32::MAX)?;
+    for (name, x) in [("sigma_s", sigma_s), ("b", b)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(value_error(format!(
+                "{name} must be finite and ≥ 0 (µm), got {x}"
+            )));
+        }
+    }
     if !(c > 1.0 && c.is_finite()) {
         return Err(value_error(format!(
             "c must be finite and > 1 (the K-correlation exponent), got {c}"

@@ -200,3 +200,14 @@ def test_white_furnace(name, theta):
     print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
     # the channels differ through λ (σrel and the halo), not through F
     assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
+
+
+def test_context_without_glossy_component_gives_zero():
+    bsdf = mi.load_dict({"type": "twoscale", "material": "gold-rough"})
+    si = make_si([[0.0, 0.0, 1.0]])
+    wo = mi.Vector3f(0.3, 0.0, 0.95)
+    ctx = mi.BSDFContext()
+    assert float(np.asarray(bsdf.eval(ctx, si, wo))[0].item()) > 0
+    ctx.type_mask = +mi.BSDFFlags.DiffuseReflection
+    assert np.all(np.asarray(bsdf.eval(ctx, si, wo)) == 0)
+    assert np.all(np.asarray(bsdf.pdf(ctx, si, wo)) == 0)

@@ -172,6 +172,8 @@ def test_bad_parameters_raise_value_error():
         twoscale.Material(beta=0.1, p=7, eta=gold)
     with pytest.raises(ValueError, match="beta must be in"):
         twoscale.Material(beta=-1, p=1, eta=gold)
+    with pytest.raises(ValueError, match="sigma_s must be finite and ≥ 0"):
+        twoscale.Material(beta=0.1, p=1, eta=gold, sigma_s=-0.1)
     with pytest.raises(ValueError, match="c must be finite and > 1"):
         twoscale.Material(beta=0.1, p=1, eta=gold, c=1.0)
     with pytest.raises(ValueError, match="eta must be three"):

@@ -19,6 +19,10 @@ wo)`` has ``wi`` towards the light), and the model is not reciprocal for
 - ``pdf(si, wo) = Material.pdf(wi=si.wi, wo=wo)``, the exact density of that
   sampler, and ``sample``'s weight is ``eval / pdf`` at the sampled direction.
 
+This is radiance transport (``ctx.mode == TransportMode.Radiance``, what
+the path tracers use); particle tracing (importance transport) is not
+supported: it would need the two roles swapped.
+
 So ``eval``, ``pdf``, ``sample`` and ``eval_pdf`` are mutually consistent
 (the χ² test checks ``sample`` against ``pdf``; the tests check the weight is
 ``eval / pdf`` and that ``eval_pdf`` returns both).
@@ -73,7 +77,7 @@ def _material(props):
     if "material" in props:
         return twoscale.Material.preset(props["material"], **options)
     keywords = {k: float(props[k]) for k in FLOAT_KEYS if k in props}
-    if not "eta" in props:
+    if "eta" not in props:
         raise ValueError("twoscale BSDF: give material= (a preset) or beta=, p=, eta=, ...")
     keywords["eta"] = _parse_eta(props["eta"])
     if "base" in props:
@@ -128,6 +132,11 @@ def _bsdf_class():
             value = self.material.eval(light, camera)
             return value * np.maximum(light[:, 2:3], 0.0)
 
+        @staticmethod
+        def _active(ctx, active):
+            """``active`` where the context asks for the glossy component."""
+            return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
+
         def sample(self, ctx, si, sample1, sample2, active=True):
             u1 = np.asarray(sample1, dtype=np.float32).reshape(1, -1)
             u2 = np.asarray(sample2, dtype=np.float32).reshape(2, -1)
@@ -142,19 +151,22 @@ def _bsdf_class():
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)
-            active = mi.Bool(active) & (bs.pdf > 0)
+            active = self._active(ctx, active) & (bs.pdf > 0)
             return bs, dr.select(active, _color(weight), 0.0)
 
         def eval(self, ctx, si, wo, active=True):
-            return dr.select(active, _color(self._eval_rows(*_rows(si.wi, wo))), 0.0)
+            value = _color(self._eval_rows(*_rows(si.wi, wo)))
+            return dr.select(self._active(ctx, active), value, 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            return dr.select(active, _float(self.material.pdf(*_rows(si.wi, wo))), 0.0)
+            pdf = _float(self.material.pdf(*_rows(si.wi, wo)))
+            return dr.select(self._active(ctx, active), pdf, 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             camera, light = _rows(si.wi, wo)
             value = _color(self._eval_rows(camera, light))
             pdf = _float(self.material.pdf(camera, light))
+            active = self._active(ctx, active)
             return dr.select(active, value, 0.0), dr.select(active, pdf, 0.0)
 
         def to_string(self):
