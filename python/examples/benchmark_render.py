@@ -1,0 +1,81 @@
+"""Render cost per sample of the ``twoscale`` BSDF against Mitsuba's
+``roughconductor`` (Beckmann), in ``llvm_ad_rgb`` and ``scalar_rgb``.
+
+    python python/examples/benchmark_render.py [--size 64] [--spp 64]
+
+Renders the sphere of the Beckmann-limit check (constant emitter and a
+directional light, path tracer of depth 2) with each BSDF, once to warm up
+(JIT compilation, plugin construction) and then ``--repeat`` times, and
+prints the process CPU time (user + system, all threads) per sample
+(pixels × spp) of the timed renders, and the ratio to ``roughconductor`` in
+the same variant, in the same run. Each variant runs in its own process.
+"""
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+
+LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+
+
+def measure(variant, size, spp, repeat):
+    import mitsuba as mi
+
+    mi.set_variant(variant)
+    import twoscale.mitsuba as tm
+
+    tm.register()
+    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
+    bsdfs = {
+        "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
+        "twoscale Beckmann (p=1, σs=0)": {"type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
+                                          "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))},
+        "roughconductor beckmann": {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.1,
+                                    "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}},
+    }
+    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
+    cost = {}
+    for name, bsdf in bsdfs.items():
+        scene = mi.load_dict({
+            "type": "scene",
+            "integrator": {"type": "path", "max_depth": 2},
+            "sensor": {"type": "perspective", "fov": 30, "to_world": look,
+                       "film": {"type": "hdrfilm", "width": size, "height": size},
+                       "sampler": {"type": "independent", "sample_count": spp}},
+            "sphere": {"type": "sphere", "bsdf": bsdf},
+            "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
+            "sun": {"type": "directional", "direction": [-1, -1, -2],
+                    "irradiance": {"type": "rgb", "value": 5.0}},
+        })
+        mi.render(scene, spp=spp)  # warm-up
+        start = time.process_time()
+        for seed in range(repeat):
+            mi.render(scene, seed=seed + 1, spp=spp)
+        cost[name] = (time.process_time() - start) / (repeat * size * size * spp)
+    base = cost["roughconductor beckmann"]
+    for name, c in cost.items():
+        print(f"{variant:12s} {name:32s} {c * 1e9:10.1f} ns CPU/sample  ×{c / base:.1f}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=64)
+    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--variant")
+    args = parser.parse_args()
+    if args.variant:
+        measure(args.variant, args.size, args.spp, args.repeat)
+        return
+    env = dict(os.environ)
+    if os.path.exists(LLVM):
+        env.setdefault("DRJIT_LIBLLVM_PATH", LLVM)
+    for variant in ("llvm_ad_rgb", "scalar_rgb"):
+        subprocess.run([sys.executable, __file__, "--variant", variant, "--size", str(args.size),
+                        "--spp", str(args.spp), "--repeat", str(args.repeat)], env=env, check=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,734 @@
+//! Python bindings of the two-scale BRDF: the RGB model of a material over
+//! NumPy arrays of directions, the table lookups (T1 G1, T2 σrel/σs, T3 C),
+//! and the f64 reference of each quantity (`generator::reference`).
+//!
+//! Conventions are the runtime's (`twoscale::brdf`): unit vectors in the
+//! local frame (normal `+z`), `wi` towards the light, `wo` towards the
+//! viewer; lengths in µm. Arrays of directions are `(N, 3)`, float32 or
+//! float64; results are float32 (the runtime's precision) for the model and
+//! the lookups, float64 for the reference. The GIL is released while rows are
+//! evaluated; batches of 2048 rows or more (`PARALLEL_ROWS`) are split over
+//! rayon's threads.
+
+use std::collections::BTreeMap;
+use std::sync::LazyLock;
+
+use generator::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
+use generator::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
+use numpy::ndarray::{Array1, Array2, ArrayView2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use twoscale::brdf::{
+    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
+};
+use twoscale::epd::{BETA_RANGE, P_RANGE};
+use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
+
+/// The committed tables, compiled into the extension.
+static TABLES: LazyLock<TableSet<'static>> = LazyLock::new(TableSet::embedded);
+
+/// Batches of at least this many rows are evaluated on rayon's threads.
+const PARALLEL_ROWS: usize = 2048;
+
+/// `f(k)` for `k in 0..n`, on rayon's threads when `n ≥ PARALLEL_ROWS`.
+fn rows<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    if n >= PARALLEL_ROWS {
+        (0..n).into_par_iter().map(&f).collect()
+    } else {
+        (0..n).map(f).collect()
+    }
+}
+
+fn value_error(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}
+
+/// An `(N, 3)` float32 or float64 array as rows of f32 vectors.
+fn directions(name: &str, array: &Bound<'_, PyAny>) -> PyResult<Vec<[f32; 3]>> {
+    fn collect<T: Copy>(view: ArrayView2<'_, T>, f: impl Fn(T) -> f32) -> Vec<[f32; 3]> {
+        view.rows()
+            .into_iter()
+            .map(|r| [f(r[0]), f(r[1]), f(r[2])])
+            .collect()
+    }
+    let shape_ok = |shape: &[usize]| shape.len() == 2 && shape[1] == 3;
+    let rows = if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f32>>() {
+        shape_ok(a.as_array().shape()).then(|| collect(a.as_array(), |x| x))
+    } else if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f64>>() {
+        shape_ok(a.as_array().shape()).then(|| collect(a.as_array(), |x| x as f32))
+    } else {
+        let described = describe(array);
+        return Err(value_error(format!(
+            "{name} must be a float32 or float64 array of shape (N, 3), got {described}"
+        )));
+    };
+    rows.ok_or_else(|| {
+        value_error(format!(
+            "{name} must have shape (N, 3), got {}",
+            describe(array)
+        ))
+    })
+}
+
+/// "an array of dtype D and shape S" or the Python type's name.
+fn describe(object: &Bound<'_, PyAny>) -> String {
+    let attr = |name: &str| {
+        object
+            .getattr(name)
+            .and_then(|a| a.str().map(|s| s.to_string()))
+    };
+    match (attr("dtype"), attr("shape")) {
+        (Ok(dtype), Ok(shape)) => format!("an array of dtype {dtype} and shape {shape}"),
+        _ => match object.get_type().name() {
+            Ok(name) => format!("a {name}"),
+            Err(_) => "an object of unknown type".into(),
+        },
+    }
+}
+
+/// Checks that two batches have the same number of rows.
+fn same_rows(a: (&str, usize), b: (&str, usize)) -> PyResult<()> {
+    if a.1 == b.1 {
+        Ok(())
+    } else {
+        Err(value_error(format!(
+            "{} has {} rows but {} has {}",
+            a.0, a.1, b.0, b.1
+        )))
+    }
+}
+
+fn matrix(py: Python<'_>, values: Vec<[f32; 3]>) -> Bound<'_, PyArray2<f32>> {
+    let n = values.len();
+    let flat: Vec<f32> = values.into_iter().flatten().collect();
+    Array2::from_shape_vec((n, 3), flat)
+        .expect("n rows of 3 values")
+        .into_pyarray(py)
+}
+
+fn parse_choice<T: Copy>(what: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
+    choices
+        .iter()
+        .find(|(name, _)| *name == given)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| {
+            let names: Vec<_> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
+            value_error(format!(
+                "{what} must be one of {}, got '{given}'",
+                names.join(", ")
+            ))
+        })
+}
+
+const MASKING: [(&str, Masking); 2] = [
+    ("separable", Masking::Separable),
+    ("height-correlated", Masking::HeightCorrelated),
+];
+const SIGMA_REL: [(&str, SigmaRelMode); 2] = [
+    ("incident", SigmaRelMode::Incident),
+    ("symmetrised", SigmaRelMode::Symmetrised),
+];
+const COLOUR: [(&str, ColourTerms); 2] = [
+    ("physical", ColourTerms::Physical),
+    ("white", ColourTerms::White),
+];
+const HALO_WEIGHT: [(&str, HaloWeight); 2] = [
+    ("printed", HaloWeight::Printed),
+    ("incident", HaloWeight::Incident),
+];
+
+fn name_of<T: PartialEq>(value: T, choices: &[(&'static str, T)]) -> &'static str {
+    choices
+        .iter()
+        .find(|(_, v)| *v == value)
+        .map_or("?", |(n, _)| n)
+}
+
+fn options(masking: &str, sigma_rel: &str, colour: &str, halo_weight: &str) -> PyResult<Options> {
+    Ok(Options {
+        masking: parse_choice("masking", masking, &MASKING)?,
+        sigma_rel: parse_choice("sigma_rel", sigma_rel, &SIGMA_REL)?,
+        colour: parse_choice("colour", colour, &COLOUR)?,
+        halo_weight: parse_choice("halo_weight", halo_weight, &HALO_WEIGHT)?,
+    })
+}
+
+/// Checks `lo ≤ x ≤ hi` (and that x is finite).
+fn in_range(name: &str, x: f32, lo: f32, hi: f32) -> PyResult<()> {
+    if x.is_finite() && (lo..=hi).contains(&x) {
+        Ok(())
+    } else {
+        Err(value_error(format!(
+            "{name} must be in [{lo}, {hi}], got {x}"
+        )))
+    }
+}
+
+/// The surface parameters as the runtime's model accepts them without
+/// clamping: β and p in the EPD's domain, σs and b finite and ≥ 0, c > 1.
+fn surface(beta: f32, p: f32, sigma_s: f32, b: f32, c: f32) -> PyResult<Surface> {
+    in_range("beta", beta, BETA_RANGE.0, BETA_RANGE.1)?;
+    in_range("p", p, P_RANGE.0, P_RANGE.1)?;
+    for (name, x) in [("sigma_s", sigma_s), ("b", b)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(value_error(format!(
+                "{name} must be finite and ≥ 0 (µm), got {x}"
+            )));
+        }
+    }
+    if !(c > 1.0 && c.is_finite()) {
+        return Err(value_error(format!(
+            "c must be finite and > 1 (the K-correlation exponent), got {c}"
+        )));
+    }
+    Ok(Surface {
+        beta,
+        p,
+        sigma_s,
+        b,
+        c,
+    })
+}
+
+fn complex_index(name: &str, n: f32, k: f32) -> PyResult<Complex> {
+    if n.is_finite() && k.is_finite() && n > 0.0 && k >= 0.0 {
+        Ok(Complex::new(n, k))
+    } else {
+        Err(value_error(format!(
+            "{name} must be (n, k) with finite n > 0 and k ≥ 0, got ({n}, {k})"
+        )))
+    }
+}
+
+/// `(wo, pdf, weight)` of [`Material::sample`].
+type SampleArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray2<f32>>,
+);
+
+/// The RGB two-scale model of one material (at 0.645, 0.526, 0.444 µm),
+/// built once (the runtime bakes its per-material tables) and evaluated over
+/// arrays of directions.
+#[pyclass(frozen, module = "twoscale")]
+struct Material {
+    model: Box<Rgb<'static>>,
+    material: twoscale::brdf::Material,
+    options: Options,
+}
+
+impl Material {
+    fn build(material: twoscale::brdf::Material, options: Options) -> Self {
+        Material {
+            model: Box::new(TABLES.rgb(&material, options)),
+            material,
+            options,
+        }
+    }
+}
+
+#[pymethods]
+impl Material {
+    /// Material(*, beta, p, sigma_s=0, b=1, c=2, eta, base="conductor",
+    /// albedo=0, lambertian=0, masking="separable", sigma_rel="incident",
+    /// colour="physical", halo_weight="printed")
+    ///
+    /// `eta` is three (n, k) pairs, at 0.645, 0.526 and 0.444 µm; σs and b
+    /// are in µm. `albedo` is the base layer's (plastic or subsurface).
+    #[new]
+    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base="conductor",
+        albedo=None, lambertian=0.0, masking="separable", sigma_rel="incident",
+        colour="physical", halo_weight="printed"))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        beta: f32,
+        p: f32,
+        eta: Vec<(f32, f32)>,
+        sigma_s: f32,
+        b: f32,
+        c: f32,
+        base: &str,
+        albedo: Option<f32>,
+        lambertian: f32,
+        masking: &str,
+        sigma_rel: &str,
+        colour: &str,
+        halo_weight: &str,
+    ) -> PyResult<Self> {
+        let surface = surface(beta, p, sigma_s, b, c)?;
+        let [r, g, bl]: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
+            value_error(format!(
+                "eta must be three (n, k) pairs (red, green, blue), got {}",
+                e.len()
+            ))
+        })?;
+        let eta_rgb = [
+            complex_index("eta[0]", r.0, r.1)?,
+            complex_index("eta[1]", g.0, g.1)?,
+            complex_index("eta[2]", bl.0, bl.1)?,
+        ];
+        let albedo_of = |albedo: Option<f32>| -> PyResult<f32> {
+            let a = albedo.ok_or_else(|| value_error(format!("base '{base}' needs albedo=")))?;
+            in_range("albedo", a, 0.0, 1.0)?;
+            Ok(a)
+        };
+        let base = match base {
+            "conductor" => match albedo {
+                None => BaseLayer::Conductor,
+                Some(_) => {
+                    return Err(value_error(
+                        "albedo= is for base 'plastic' or 'subsurface', not 'conductor'",
+                    ));
+                }
+            },
+            "plastic" => BaseLayer::Plastic {
+                albedo: albedo_of(albedo)?,
+            },
+            "subsurface" => BaseLayer::Subsurface {
+                albedo: albedo_of(albedo)?,
+            },
+            other => {
+                return Err(value_error(format!(
+                    "base must be 'conductor', 'plastic' or 'subsurface', got '{other}'"
+                )));
+            }
+        };
+        in_range("lambertian", lambertian, 0.0, 1.0)?;
+        let material = twoscale::brdf::Material {
+            layer: Layer {
+                surface,
+                base,
+                lambertian,
+            },
+            eta_rgb,
+        };
+        let options = options(masking, sigma_rel, colour, halo_weight)?;
+        Ok(Material::build(material, options))
+    }
+
+    /// Material.preset(name, *, masking=..., ...): a shipped preset
+    /// (`Material.presets()` lists them) with the given options.
+    #[staticmethod]
+    #[pyo3(signature = (name, *, masking="separable", sigma_rel="incident",
+        colour="physical", halo_weight="printed"))]
+    fn preset(
+        name: &str,
+        masking: &str,
+        sigma_rel: &str,
+        colour: &str,
+        halo_weight: &str,
+    ) -> PyResult<Self> {
+        let material = twoscale::materials::preset(name)
+            .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
+        let options = options(masking, sigma_rel, colour, halo_weight)?;
+        Ok(Material::build(material, options))
+    }
+
+    /// The names of the shipped presets.
+    #[staticmethod]
+    fn presets() -> Vec<&'static str> {
+        twoscale::materials::PRESETS
+            .iter()
+            .map(|(n, _)| *n)
+            .collect()
+    }
+
+    /// ρ(wi, wo) per channel, sr⁻¹: (N, 3) float32. `wi` towards the light,
+    /// `wo` towards the viewer; 0 below the horizon.
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
+        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+        let model = &*self.model;
+        let values = py.detach(|| rows(wi.len(), |k| model.eval(wi[k], wo[k])));
+        Ok(matrix(py, values))
+    }
+
+    /// The solid-angle density of `sample(wi, ·)` at `wo`: (N,) float32.
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
+        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+        let model = &*self.model;
+        let values = py.detach(|| rows(wi.len(), |k| model.pdf(wi[k], wo[k])));
+        Ok(values.into_pyarray(py))
+    }
+
+    /// Samples `wo` given `wi` with three uniform numbers per row `u` (N, 3).
+    /// Returns `(wo, pdf, weight)`: (N, 3), (N,), (N, 3) float32 with
+    /// `weight = ρ(wi, wo) cos θo / pdf`; rows where sampling fails (below
+    /// the horizon) are all zeros.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<SampleArrays<'py>> {
+        let (wi, u) = (directions("wi", wi)?, directions("u", u)?);
+        same_rows(("wi", wi.len()), ("u", u.len()))?;
+        let model = &*self.model;
+        let samples = py.detach(|| {
+            rows(wi.len(), |k| match model.sample(wi[k], u[k]) {
+                Some(s) => (s.o, s.pdf, s.value.map(|v| v * s.o[2] / s.pdf)),
+                None => ([0.0; 3], 0.0, [0.0; 3]),
+            })
+        });
+        let n = samples.len();
+        let (mut dirs, mut pdf, mut weight) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for (o, p, w) in samples {
+            dirs.push(o);
+            pdf.push(p);
+            weight.push(w);
+        }
+        Ok((matrix(py, dirs), pdf.into_pyarray(py), matrix(py, weight)))
+    }
+
+    /// The f64 reference ρ(wi, wo) per channel (exact Λ, σrel, C;
+    /// `generator::reference::brdf`), for conductors without a Lambertian
+    /// term: (N, 3) float64. Costs 1–30 ms per row and channel.
+    fn eval_reference<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let layer = self.material.layer;
+        if layer.base != BaseLayer::Conductor || layer.lambertian != 0.0 {
+            return Err(value_error(
+                "the f64 reference covers conductors without a Lambertian term",
+            ));
+        }
+        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
+        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+        let s = layer.surface;
+        let params: [ref_brdf::Params; 3] = std::array::from_fn(|ch| ref_brdf::Params {
+            beta: s.beta.into(),
+            p: s.p.into(),
+            sigma_s: s.sigma_s.into(),
+            b: s.b.into(),
+            c: s.c.into(),
+            n: self.material.eta_rgb[ch].re.into(),
+            k: self.material.eta_rgb[ch].im.into(),
+            lambda: twoscale::brdf::RGB_WAVELENGTHS[ch].into(),
+        });
+        let options = self.options;
+        let values = py.detach(|| {
+            (0..wi.len() * 3)
+                .into_par_iter()
+                .map(|j| {
+                    let (k, ch) = (j / 3, j % 3);
+                    let f64s = |v: [f32; 3]| v.map(f64::from);
+                    ref_brdf::two_scale(&params[ch], f64s(wi[k]), f64s(wo[k]), &options)
+                        .map(|v| v.total())
+                        .map_err(|e| format!("row {k}: {e}"))
+                })
+                .collect::<Result<Vec<f64>, String>>()
+        });
+        let values = values.map_err(value_error)?;
+        Ok(Array2::from_shape_vec((wi.len(), 3), values)
+            .expect("n rows of 3 values")
+            .into_pyarray(py))
+    }
+
+    #[getter]
+    fn beta(&self) -> f32 {
+        self.material.layer.surface.beta
+    }
+    #[getter]
+    fn p(&self) -> f32 {
+        self.material.layer.surface.p
+    }
+    #[getter]
+    fn sigma_s(&self) -> f32 {
+        self.material.layer.surface.sigma_s
+    }
+    #[getter]
+    fn b(&self) -> f32 {
+        self.material.layer.surface.b
+    }
+    #[getter]
+    fn c(&self) -> f32 {
+        self.material.layer.surface.c
+    }
+    /// The three (n, k) pairs, red, green, blue.
+    #[getter]
+    fn eta(&self) -> Vec<(f32, f32)> {
+        self.material.eta_rgb.iter().map(|e| (e.re, e.im)).collect()
+    }
+    /// "conductor", "plastic" or "subsurface".
+    #[getter]
+    fn base(&self) -> &'static str {
+        match self.material.layer.base {
+            BaseLayer::Conductor => "conductor",
+            BaseLayer::Plastic { .. } => "plastic",
+            BaseLayer::Subsurface { .. } => "subsurface",
+        }
+    }
+    /// The base layer's albedo (None for a conductor).
+    #[getter]
+    fn albedo(&self) -> Option<f32> {
+        match self.material.layer.base {
+            BaseLayer::Conductor => None,
+            BaseLayer::Plastic { albedo } | BaseLayer::Subsurface { albedo } => Some(albedo),
+        }
+    }
+    #[getter]
+    fn lambertian(&self) -> f32 {
+        self.material.layer.lambertian
+    }
+    /// The options as a dict of keyword names to values.
+    #[getter]
+    fn options(&self) -> BTreeMap<&'static str, &'static str> {
+        let o = self.options;
+        BTreeMap::from([
+            ("masking", name_of(o.masking, &MASKING)),
+            ("sigma_rel", name_of(o.sigma_rel, &SIGMA_REL)),
+            ("colour", name_of(o.colour, &COLOUR)),
+            ("halo_weight", name_of(o.halo_weight, &HALO_WEIGHT)),
+        ])
+    }
+
+    fn __repr__(&self) -> String {
+        let s = self.material.layer.surface;
+        format!(
+            "twoscale.Material(beta={}, p={}, sigma_s={}, b={}, c={}, eta={:?}, base='{}', albedo={:?}, lambertian={})",
+            s.beta,
+            s.p,
+            s.sigma_s,
+            s.b,
+            s.c,
+            self.eta(),
+            self.base(),
+            self.albedo(),
+            self.material.layer.lambertian,
+        )
+    }
+}
+
+/// Columns of equal length as rows of `K` values.
+fn columns<const K: usize>(
+    names: [&str; K],
+    cols: [PyReadonlyArray1<'_, f64>; K],
+) -> PyResult<Vec<[f64; K]>> {
+    let views = cols.each_ref().map(|c| c.as_array());
+    let n = views[0].len();
+    for (name, view) in names.iter().zip(&views) {
+        same_rows((names[0], n), (name, view.len()))?;
+    }
+    Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// Evaluates `f` on every row without the GIL; the first failing row's error
+/// becomes a `ValueError`.
+fn evaluate<'py, const K: usize>(
+    py: Python<'py>,
+    rows_in: Vec<[f64; K]>,
+    parallel: bool,
+    f: impl Fn([f64; K]) -> Result<f64, String> + Sync,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let out = py.detach(|| {
+        let row = |(k, x): (usize, &[f64; K])| f(*x).map_err(|e| format!("row {k}: {e}"));
+        if parallel || rows_in.len() >= PARALLEL_ROWS {
+            rows_in.par_iter().enumerate().map(row).collect()
+        } else {
+            rows_in
+                .iter()
+                .enumerate()
+                .map(row)
+                .collect::<Result<Vec<f64>, String>>()
+        }
+    });
+    Ok(Array1::from_vec(out.map_err(value_error)?).into_pyarray(py))
+}
+
+/// G1 of the EPD at shape `p` and `a = cot θ / β` (HP17 36–37): table T1,
+/// or the f64 reference (Λ by quadrature) with `reference=True`.
+#[pyfunction]
+#[pyo3(signature = (p, a, *, reference))]
+fn g1<'py>(
+    py: Python<'py>,
+    p: PyReadonlyArray1<'py, f64>,
+    a: PyReadonlyArray1<'py, f64>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let rows_in = columns(["p", "a"], [p, a])?;
+    if reference {
+        return evaluate(py, rows_in, true, |[p, a]| {
+            ref_epd::g1(p, a).map_err(|e| e.to_string())
+        });
+    }
+    let t = TABLES.smith;
+    evaluate(py, rows_in, false, |[p, a]| {
+        Ok(t.g1(p as f32, a as f32).into())
+    })
+}
+
+/// σrel/σs at incidence θi (radians), `B = b/λ` and exponent c (HP17 19):
+/// table T2, or the f64 reference (quadrature of the spectrum).
+#[pyfunction]
+#[pyo3(signature = (theta_i, big_b, c, *, reference))]
+fn sigma_ratio<'py>(
+    py: Python<'py>,
+    theta_i: PyReadonlyArray1<'py, f64>,
+    big_b: PyReadonlyArray1<'py, f64>,
+    c: PyReadonlyArray1<'py, f64>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let rows_in = columns(["theta_i", "B", "c"], [theta_i, big_b, c])?;
+    if reference {
+        return evaluate(py, rows_in, true, |[th, bb, c]| {
+            ref_kcorr::sigma_ratio(th, bb, c).map_err(|e| e.to_string())
+        });
+    }
+    let t = TABLES.sigma_ratio;
+    evaluate(py, rows_in, false, |[th, bb, c]| {
+        Ok(t.sigma_ratio(th as f32, bb as f32, c as f32).into())
+    })
+}
+
+/// Which source of C [`conv`] reads.
+const CONV_SOURCES: [&str; 3] = ["table", "fit", "reference"];
+
+/// The convolution `C(θh; u, c, β, p)` (HP17 40) from `source`: "table"
+/// (T3b), "fit" (the paper's fitted form, T3a) or "reference" (the f64
+/// direct 2-D quadrature).
+#[pyfunction]
+#[pyo3(signature = (theta_h, u, c, beta, p, *, source))]
+#[allow(clippy::too_many_arguments)]
+fn conv<'py>(
+    py: Python<'py>,
+    theta_h: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    c: PyReadonlyArray1<'py, f64>,
+    beta: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray1<'py, f64>,
+    source: &str,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let rows_in = columns(["theta_h", "u", "c", "beta", "p"], [theta_h, u, c, beta, p])?;
+    let (t3b, t3a) = (TABLES.convolution, TABLES.convolution.fit());
+    let table: &(dyn Convolution + Sync) = match source {
+        "table" => &t3b,
+        "fit" => &t3a,
+        "reference" => {
+            return evaluate(py, rows_in, true, |[th, u, c, beta, p]| {
+                ref_conv::convolution(th, u, c, beta, p).map_err(|e| e.to_string())
+            });
+        }
+        other => {
+            let known = CONV_SOURCES.map(|s| format!("'{s}'")).join(", ");
+            return Err(value_error(format!(
+                "source must be one of {known}, got '{other}'"
+            )));
+        }
+    };
+    evaluate(py, rows_in, false, |[th, u, c, beta, p]| {
+        let (sin, cos) = (th.sin() as f32, th.cos() as f32);
+        Ok(table
+            .convolution_sin_cos(sin, cos, u as f32, c as f32, beta as f32, p as f32)
+            .into())
+    })
+}
+
+/// The unpolarised Fresnel reflectance F(η = n + ik, cos θ): the runtime's
+/// (f32), or the f64 reference with `reference=True`.
+#[pyfunction]
+#[pyo3(signature = (n, k, cos_theta, *, reference))]
+fn fresnel<'py>(
+    py: Python<'py>,
+    n: PyReadonlyArray1<'py, f64>,
+    k: PyReadonlyArray1<'py, f64>,
+    cos_theta: PyReadonlyArray1<'py, f64>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let rows_in = columns(["n", "k", "cos_theta"], [n, k, cos_theta])?;
+    evaluate(py, rows_in, false, |[n, k, cos]| {
+        if reference {
+            ref_fresnel::fresnel(ref_fresnel::Complex64::new(n, k), cos).map_err(|e| e.to_string())
+        } else {
+            let eta = Complex::new(n as f32, k as f32);
+            Ok(twoscale::fresnel::fresnel(eta, cos as f32).into())
+        }
+    })
+}
+
+/// The one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model of `query
+/// brdf`, SPEC §6), with the paper's options: the runtime (`TwoScale`, T3b)
+/// or, with `reference=True`, the f64 reference (exact Λ, σrel and C).
+#[pyfunction]
+#[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference))]
+#[allow(clippy::too_many_arguments)]
+fn brdf<'py>(
+    py: Python<'py>,
+    wi: &Bound<'py, PyAny>,
+    wo: &Bound<'py, PyAny>,
+    beta: f64,
+    p: f64,
+    sigma_s: f64,
+    b: f64,
+    c: f64,
+    n: f64,
+    k: f64,
+    lam: f64,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
+    same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+    let options = Options::default();
+    if reference {
+        let params = ref_brdf::Params {
+            beta,
+            p,
+            sigma_s,
+            b,
+            c,
+            n,
+            k,
+            lambda: lam,
+        };
+        let rows_in: Vec<[f64; 6]> = wi
+            .iter()
+            .zip(&wo)
+            .map(|(i, o)| [i[0], i[1], i[2], o[0], o[1], o[2]].map(f64::from))
+            .collect();
+        return evaluate(py, rows_in, true, |x| {
+            ref_brdf::two_scale(&params, [x[0], x[1], x[2]], [x[3], x[4], x[5]], &options)
+                .map(|v| v.total())
+        });
+    }
+    let f = |v: f64| v as f32;
+    let layer = Layer {
+        surface: surface(f(beta), f(p), f(sigma_s), f(b), f(c))?,
+        base: BaseLayer::Conductor,
+        lambertian: 0.0,
+    };
+    let eta = complex_index("(n, k)", f(n), f(k))?;
+    let model = TwoScale::new(&TABLES.brdf_tables(), layer, f(lam), eta, options);
+    let values = py.detach(|| rows(wi.len(), |j| f64::from(model.eval(wi[j], wo[j]))));
+    Ok(Array1::from_vec(values).into_pyarray(py))
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Material>()?;
+    m.add("RGB_WAVELENGTHS", twoscale::brdf::RGB_WAVELENGTHS.to_vec())?;
+    m.add_function(wrap_pyfunction!(g1, m)?)?;
+    m.add_function(wrap_pyfunction!(sigma_ratio, m)?)?;
+    m.add_function(wrap_pyfunction!(conv, m)?)?;
+    m.add_function(wrap_pyfunction!(fresnel, m)?)?;
+    m.add_function(wrap_pyfunction!(brdf, m)?)?;
+    Ok(())
+}

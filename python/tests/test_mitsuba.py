@@ -1,0 +1,213 @@
+"""The Mitsuba 3 plugin, checked with Mitsuba's own tools (llvm_ad_rgb):
+the χ² test of its sampler, the Beckmann limit against `roughconductor`,
+a white furnace, and the consistency of eval, pdf, sample and eval_pdf."""
+
+import os
+
+import numpy as np
+import pytest
+
+LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if os.path.exists(LLVM):
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", LLVM)
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+
+import twoscale  # noqa: E402
+import twoscale.mitsuba as tm  # noqa: E402
+
+mi.set_variant("llvm_ad_rgb")
+tm.register()
+
+GOLD = "0.163 3.56, 0.584 2.15, 1.403 1.925"
+
+
+def direction(theta_deg):
+    t = np.radians(theta_deg)
+    return [float(np.sin(t)), 0.0, float(np.cos(t))]
+
+
+def xml(**props):
+    """Plugin properties as the XML the χ² adapter expects."""
+    out = []
+    for key, value in props.items():
+        kind = "float" if isinstance(value, float) else "string"
+        out.append(f'<{kind} name="{key}" value="{value}"/>')
+    return "".join(out)
+
+
+STRONG_HALO = dict(beta=0.1, p=1.0, sigma_s=0.1, b=3.0, c=1.6, eta=GOLD)
+CHI2_CASES = [
+    ("gold-hp17-geometry, 40°", dict(material="gold-hp17-geometry"), 40),
+    ("gold-rough, 30°", dict(material="gold-rough"), 30),
+    ("gold-rough, grazing 85°", dict(material="gold-rough"), 85),
+    ("white-plastic, 50°", dict(material="white-plastic"), 50),
+    ("marble, 10°", dict(material="marble"), 10),
+    ("strong halo, 20°", STRONG_HALO, 20),
+    ("strong halo, grazing 80°", STRONG_HALO, 80),
+]
+
+
+@pytest.mark.parametrize("label,props,theta", CHI2_CASES, ids=[c[0] for c in CHI2_CASES])
+def test_chi2(label, props, theta, record_property):
+    sample, pdf = mi.chi2.BSDFAdapter("twoscale", xml(**props), wi=direction(theta))
+    # ires=16: the tester integrates the pdf over each cell with 16×16 points;
+    # its default (4) under-resolves lobes of β ≈ 0.06 (docs/python.md).
+    test = mi.chi2.ChiSquareTest(
+        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
+        sample_dim=3, ires=16,
+    )
+    passed = test.run(quiet=True)
+    record_property("p_value", test.p_value)
+    print(f"chi2 {label}: p = {test.p_value:.4f}")
+    assert passed, test.messages
+
+
+def make_si(wi):
+    si = dr.zeros(mi.SurfaceInteraction3f, len(wi))
+    si.wi = mi.Vector3f(np.ascontiguousarray(np.asarray(wi, dtype=np.float32).T))
+    si.n = mi.Normal3f(0, 0, 1)
+    si.sh_frame = mi.Frame3f(si.n)
+    return si
+
+
+def test_eval_pdf_sample_consistent_and_directions():
+    """eval takes Mitsuba's wo (the light) as the model's incident direction;
+    pdf is the sampler's density given si.wi; sample's weight is eval / pdf;
+    eval_pdf returns both. The material is non-reciprocal (strong halo), so
+    swapped directions would fail the first check."""
+    material = twoscale.Material(**{**STRONG_HALO, "eta": [(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)]})
+    bsdf = mi.load_dict(tm.bsdf_dict(material))
+    rng = np.random.default_rng(3)
+    n = 2000
+    cam = np.stack([np.full(n, np.sin(1.2)), np.zeros(n), np.full(n, np.cos(1.2))], axis=1)
+    si = make_si(cam)
+    ctx = mi.BSDFContext()
+    bs, weight = bsdf.sample(ctx, si, mi.Float(rng.random(n, dtype=np.float32)),
+                             mi.Point2f(rng.random((2, n), dtype=np.float32)))
+    wo = np.asarray(bs.wo, dtype=np.float32).T
+    pdf = np.asarray(bs.pdf)
+    ok = pdf > 0
+    assert ok.mean() > 0.9
+    value, pdf2 = bsdf.eval_pdf(ctx, si, mi.Vector3f(np.ascontiguousarray(wo.T)))
+    value = np.asarray(value).T
+    np.testing.assert_allclose(np.asarray(bsdf.eval(ctx, si, mi.Vector3f(np.ascontiguousarray(wo.T)))).T, value)
+    np.testing.assert_allclose(np.asarray(bsdf.pdf(ctx, si, mi.Vector3f(np.ascontiguousarray(wo.T)))), pdf2)
+    np.testing.assert_allclose(np.asarray(pdf2)[ok], pdf[ok], rtol=1e-5)
+    np.testing.assert_allclose(np.asarray(weight).T[ok], value[ok] / pdf[ok, None], rtol=1e-4)
+    expected = material.eval(wo[ok], cam[ok]) * wo[ok, 2:3]
+    np.testing.assert_allclose(value[ok], expected, rtol=1e-6)
+    swapped = material.eval(cam[ok], wo[ok]) * wo[ok, 2:3]
+    # the swap differs by far more than the tolerance above
+    assert (np.abs(swapped - expected) / expected).max() > 1e-2
+
+
+def sphere_scene(bsdf):
+    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 2},
+        "sensor": {
+            "type": "perspective", "fov": 30, "to_world": look,
+            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": 64},
+        },
+        "sphere": {"type": "sphere", "bsdf": bsdf},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
+        "sun": {"type": "directional", "direction": [-1, -1, -2],
+                "irradiance": {"type": "rgb", "value": 5.0}},
+    })
+
+
+def beckmann_limit(alpha):
+    """Mean |difference| between twoscale (p = 1, σs = 0) and roughconductor
+    (beckmann, same α, η, k) renders, over the noise level expected for two
+    independent renders, from two seeds of each."""
+    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
+    twoscale_bsdf = {"type": "twoscale", "beta": alpha, "p": 1.0, "sigma_s": 0.0,
+                     "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))}
+    rough = {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha,
+             "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}}
+    img = {}
+    for name, bsdf in (("twoscale", twoscale_bsdf), ("rough", rough)):
+        scene = sphere_scene(bsdf)
+        for seed in (0, 1):
+            img[name, seed] = np.asarray(mi.render(scene, seed=seed, spp=64))
+    mad = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731
+    noise_rough = mad(img["rough", 0], img["rough", 1])
+    noise_twoscale = mad(img["twoscale", 0], img["twoscale", 1])
+    diff = (mad(img["twoscale", 0], img["rough", 1]) + mad(img["twoscale", 1], img["rough", 0])) / 2
+    # independent renders A, B: E|A − B| ∝ sqrt(σA² + σB²)
+    noise = np.sqrt((noise_rough**2 + noise_twoscale**2) / 2)
+    bias = (img["twoscale", 0] + img["twoscale", 1]).mean() / (img["rough", 0] + img["rough", 1]).mean() - 1
+    return diff, noise, bias
+
+
+@pytest.mark.parametrize("alpha", [0.1, 0.3])
+def test_beckmann_limit(alpha, record_property):
+    diff, noise, bias = beckmann_limit(alpha)
+    print(f"Beckmann limit α={alpha}: mean|Δ| = {diff:.5f}, noise = {noise:.5f}, "
+          f"ratio = {diff / noise:.3f}, mean bias = {bias:+.4%}")
+    record_property("ratio", diff / noise)
+    assert diff / noise < 1.1
+    assert abs(bias) < 0.01
+
+
+def furnace_albedo(material, theta_deg, k=1500):
+    """∫ ρ(i, o) cos θi dωi for the viewer at θo, by the midpoint rule in
+    (cos θi, φi) over the runtime's eval."""
+    o = np.array([direction(theta_deg)])
+    z = (np.arange(k) + 0.5) / k
+    phi = (np.arange(2 * k) + 0.5) / (2 * k) * 2 * np.pi
+    total = np.zeros(3)
+    for zi in np.array_split(z, 10):
+        zz, pp = np.meshgrid(zi, phi, indexing="ij")
+        r = np.sqrt(1 - zz**2)
+        wi = np.stack([r * np.cos(pp), r * np.sin(pp), zz], axis=-1).reshape(-1, 3)
+        value = material.eval(wi, np.broadcast_to(o, wi.shape))
+        total += (value * wi[:, 2:3]).sum(axis=0)
+    return total * (1 / k) * (np.pi / k)
+
+
+def furnace_render(bsdf, theta_deg, seed):
+    """A flat patch seen by an orthographic camera at θo under a constant
+    emitter of radiance 1: every pixel estimates the albedo."""
+    t = np.radians(theta_deg)
+    look = mi.ScalarTransform4f().look_at(origin=[5 * np.sin(t), 0, 5 * np.cos(t)],
+                                          target=[0, 0, 0], up=[0, 1, 0])
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 2},
+        "sensor": {
+            "type": "orthographic", "to_world": look @ mi.ScalarTransform4f().scale([0.5, 0.5, 1]),
+            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": 64},
+        },
+        "patch": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale(5), "bsdf": bsdf},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 1.0}},
+    })
+    return np.asarray(mi.render(scene, seed=seed, spp=64)).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
+def test_white_furnace(name, theta):
+    material = twoscale.Material.preset(name, colour="white")
+    expected = furnace_albedo(material, theta)
+    pixels = furnace_render(tm.bsdf_dict(material), theta, seed=0)
+    mean = pixels.mean(axis=0)
+    standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
+    print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
+    # the channels differ through λ (σrel and the halo), not through F
+    assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
+
+
+def test_context_without_glossy_component_gives_zero():
+    bsdf = mi.load_dict({"type": "twoscale", "material": "gold-rough"})
+    si = make_si([[0.0, 0.0, 1.0]])
+    wo = mi.Vector3f(0.3, 0.0, 0.95)
+    ctx = mi.BSDFContext()
+    assert float(np.asarray(bsdf.eval(ctx, si, wo))[0].item()) > 0
+    ctx.type_mask = +mi.BSDFFlags.DiffuseReflection
+    assert np.all(np.asarray(bsdf.eval(ctx, si, wo)) == 0)
+    assert np.all(np.asarray(bsdf.pdf(ctx, si, wo)) == 0)
