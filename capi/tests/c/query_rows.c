@@ -3,12 +3,16 @@
  * wavelength per row): both evaluate the same f32 path, so they must agree
  * within 1e-6 relative.
  *
- *   query_rows rows N SEED > in.csv      N random materials and direction
- *                                        pairs, one CSV row per channel
+ *   query_rows rows M P SEED > in.csv    M random materials, P random
+ *                                        direction pairs each, one CSV row
+ *                                        per channel (3 M P rows)
  *   generator query brdf < in.csv > out.csv
- *   query_rows compare out.csv N         rebuilds each material through
+ *   query_rows compare out.csv M P       rebuilds each material through
  *                                        ts_material_new and compares
  *                                        ts_eval_rgb with the `table` column
+ *
+ * Materials are few and pairs many because building a material is what
+ * valgrind makes slow (≈0.3 s each).
  */
 #include "twoscale.h"
 
@@ -41,44 +45,52 @@ static void direction(float w[3]) {
     w[2] = (float)z;
 }
 
-static int rows(long n) {
+static int rows(long n, long pairs) {
     float lambda[3];
     if (ts_rgb_wavelengths(lambda) != TS_OK) {
         fprintf(stderr, "ts_rgb_wavelengths: %s\n", ts_last_error());
         return 1;
     }
     /* %.9g prints an f32 exactly enough to read back the same f32. */
-    printf("sample,channel,beta,p,sigma_s,b,c,n,k,lambda,ix,iy,iz,ox,oy,oz\n");
+    printf("sample,pair,channel,beta,p,sigma_s,b,c,n,k,lambda,ix,iy,iz,ox,oy,oz\n");
     for (long s = 0; s < n; s++) {
         float beta = log_in(0.01, 0.6), p = in(0.4, 3.0);
         float sigma_s = uniform() < 0.2 ? 0.0f : log_in(0.003, 0.1);
         float b = log_in(0.5, 15.0), c = in(1.3, 4.0);
-        float wi[3], wo[3];
-        direction(wi);
-        if (wi[2] < 0.0f && uniform() < 0.8) wi[2] = -wi[2];
-        if (uniform() < 0.5) {
-            /* near the mirror direction, where the lobes peak */
-            wo[0] = -wi[0] + in(-0.1, 0.1);
-            wo[1] = -wi[1] + in(-0.1, 0.1);
-            wo[2] = wi[2];
-        } else {
-            direction(wo);
-            if (wo[2] < 0.0f && uniform() < 0.8) wo[2] = -wo[2];
-        }
+        float n_re[3], k_im[3];
         for (int ch = 0; ch < 3; ch++) {
-            float n_re = in(0.1, 2.5), k_im = uniform() < 0.2 ? 0.0f : in(0.0, 5.0);
-            printf("%ld,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                   s, ch, beta, p, sigma_s, b, c, n_re, k_im, lambda[ch], wi[0], wi[1], wi[2],
-                   wo[0], wo[1], wo[2]);
+            n_re[ch] = in(0.1, 2.5);
+            k_im[ch] = uniform() < 0.2 ? 0.0f : in(0.0, 5.0);
+        }
+        for (long pair = 0; pair < pairs; pair++) {
+            float wi[3], wo[3];
+            direction(wi);
+            if (wi[2] < 0.0f && uniform() < 0.8) wi[2] = -wi[2];
+            if (uniform() < 0.5) {
+                /* near the mirror direction, where the lobes peak */
+                wo[0] = -wi[0] + in(-0.1, 0.1);
+                wo[1] = -wi[1] + in(-0.1, 0.1);
+                wo[2] = wi[2];
+            } else {
+                direction(wo);
+                if (wo[2] < 0.0f && uniform() < 0.8) wo[2] = -wo[2];
+            }
+            for (int ch = 0; ch < 3; ch++)
+                printf("%ld,%ld,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
+                       "%.9g\n",
+                       s, pair, ch, beta, p, sigma_s, b, c, n_re[ch], k_im[ch], lambda[ch], wi[0],
+                       wi[1], wi[2], wo[0], wo[1], wo[2]);
         }
     }
     return 0;
 }
 
-enum { SAMPLE, CHANNEL, BETA, P, SIGMA_S, B, C, N, K, LAMBDA, IX, IY, IZ, OX, OY, OZ, TABLE, COLUMNS };
+enum { SAMPLE, PAIR, CHANNEL, BETA, P, SIGMA_S, B, C, N, K, LAMBDA, IX, IY, IZ, OX, OY, OZ, TABLE, COLUMNS };
 
 static int compare(const char *path, long expected) {
-    static const char *names[COLUMNS] = {"sample", "channel", "beta", "p", "sigma_s", "b",
+    ts_material *m = NULL;
+    double current = -1.0;
+    static const char *names[COLUMNS] = {"sample", "pair", "channel", "beta", "p", "sigma_s", "b",
                                          "c", "n", "k", "lambda", "ix", "iy", "iz", "ox",
                                          "oy", "oz", "table"};
     FILE *f = fopen(path, "r");
@@ -131,21 +143,26 @@ static int compare(const char *path, long expected) {
         if (filled < 3) continue;
         filled = 0;
         const double *g = group[0];
-        ts_material_desc desc;
-        memset(&desc, 0, sizeof desc); /* conductor, the paper's options */
-        desc.beta = (float)g[BETA];
-        desc.p = (float)g[P];
-        desc.sigma_s = (float)g[SIGMA_S];
-        desc.b = (float)g[B];
-        desc.c = (float)g[C];
-        for (int ch = 0; ch < 3; ch++) {
-            desc.eta_re[ch] = (float)group[ch][N];
-            desc.eta_im[ch] = (float)group[ch][K];
-        }
-        ts_material *m = ts_material_new(tables, &desc);
-        if (!m) {
-            fprintf(stderr, "sample %g: ts_material_new: %s\n", g[SAMPLE], ts_last_error());
-            return 1;
+        if (g[SAMPLE] != current) {
+            /* a new material: its parameters are on each of its rows */
+            ts_material_free(m);
+            ts_material_desc desc;
+            memset(&desc, 0, sizeof desc); /* conductor, the paper's options */
+            desc.beta = (float)g[BETA];
+            desc.p = (float)g[P];
+            desc.sigma_s = (float)g[SIGMA_S];
+            desc.b = (float)g[B];
+            desc.c = (float)g[C];
+            for (int ch = 0; ch < 3; ch++) {
+                desc.eta_re[ch] = (float)group[ch][N];
+                desc.eta_im[ch] = (float)group[ch][K];
+            }
+            m = ts_material_new(tables, &desc);
+            current = g[SAMPLE];
+            if (!m) {
+                fprintf(stderr, "sample %g: ts_material_new: %s\n", g[SAMPLE], ts_last_error());
+                return 1;
+            }
         }
         float wi[3] = {(float)g[IX], (float)g[IY], (float)g[IZ]};
         float wo[3] = {(float)g[OX], (float)g[OY], (float)g[OZ]};
@@ -160,14 +177,14 @@ static int compare(const char *path, long expected) {
             double rel = scale > 0.0 ? fabs(got - expected_value) / scale : 0.0;
             if (!(rel <= 1e-6) || !isfinite(got)) {
                 failures++;
-                fprintf(stderr, "sample %g channel %d: C API %.9g, query %.9g (rel %.3g)\n",
-                        g[SAMPLE], ch, got, expected_value, rel);
+                fprintf(stderr, "sample %g pair %g channel %d: C API %.9g, query %.9g (rel %.3g)\n",
+                        g[SAMPLE], g[PAIR], ch, got, expected_value, rel);
             }
             if (got > 0.0) nonzero++;
             if (rel > worst) worst = rel;
         }
-        ts_material_free(m);
     }
+    ts_material_free(m);
     fclose(f);
     ts_tables_free(tables);
     printf("%ld rows, %ld nonzero, max relative difference %.3g, %ld over 1e-6\n", rows,
@@ -185,12 +202,12 @@ static int compare(const char *path, long expected) {
 }
 
 int main(int argc, char **argv) {
-    if (argc == 4 && strcmp(argv[1], "rows") == 0) {
-        state = strtoull(argv[3], NULL, 10);
-        return rows(strtol(argv[2], NULL, 10));
+    if (argc == 5 && strcmp(argv[1], "rows") == 0) {
+        state = strtoull(argv[4], NULL, 10);
+        return rows(strtol(argv[2], NULL, 10), strtol(argv[3], NULL, 10));
     }
-    if (argc == 4 && strcmp(argv[1], "compare") == 0)
-        return compare(argv[2], strtol(argv[3], NULL, 10));
-    fprintf(stderr, "usage: %s rows N SEED | compare FILE N\n", argv[0]);
+    if (argc == 5 && strcmp(argv[1], "compare") == 0)
+        return compare(argv[2], strtol(argv[3], NULL, 10) * strtol(argv[4], NULL, 10));
+    fprintf(stderr, "usage: %s rows M P SEED | compare FILE M P\n", argv[0]);
     return 2;
 }

@@ -3,10 +3,11 @@
 # generates, compiles the C tests with the system `cc` against the shared and
 # the static library, and runs them under valgrind memcheck (any error or leak
 # fails). Needs cbindgen 0.29 and valgrind on PATH (.ci/run installs them).
-# Usage: capi/tests/c/run.sh [ROWS]   (ROWS random materials, 3 channels each)
+# Usage: capi/tests/c/run.sh [MATERIALS [PAIRS]]   (3 rows per pair: R, G, B)
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
-rows=${1:-334}
+materials=${1:-34}
+pairs=${2:-10}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
@@ -32,9 +33,9 @@ cc "${cflags[@]}" capi/tests/c/misuse.c "$lib/libtwoscale_capi.a" \
 memcheck=(valgrind --error-exitcode=1 --leak-check=full
   --errors-for-leak-kinds=definite,indirect,possible -q)
 "${memcheck[@]}" "$out/misuse" tables
-"$out/query_rows" rows "$rows" 2026 > "$out/rows.csv"
+"$out/query_rows" rows "$materials" "$pairs" 2026 > "$out/rows.csv"
 "$lib/generator" query brdf --tables tables < "$out/rows.csv" > "$out/answered.csv"
-"${memcheck[@]}" "$out/query_rows" compare "$out/answered.csv" "$rows"
+"${memcheck[@]}" "$out/query_rows" compare "$out/answered.csv" "$materials" "$pairs"
 
 # The example of docs/c-api.md (its one ```c block) compiles, runs, and prints
 # three positive values.
