@@ -368,8 +368,10 @@ ts_material *ts_material_preset(const ts_tables *t,
 
 /**
  * The material `desc` describes. Construction bakes per-material tables
- * (tens of µs to ms): build once per material, not per evaluation. NULL on
- * failure (`TS_ERR_INVALID` names the field).
+ * (milliseconds): build once per material, not per evaluation. The model
+ * (~100 KB) is built on the calling thread's stack before it moves to the
+ * heap, so call `ts_material_*` from a thread whose stack is well above
+ * that. NULL on failure (`TS_ERR_INVALID` names the field).
  *
  * # Safety
  *
