@@ -740,6 +740,8 @@ pub unsafe extern "C" fn ts_material_free(m: *mut ts_material) {
 ///
 /// `m` is NULL or a live material; each array is NULL or holds 3 floats.
 /// cbindgen:ptrs-as-arrays=[[wi;3], [wo;3], [out;3]]
+// The annotation's brackets are cbindgen syntax, not links.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ts_eval_rgb(
     m: *const ts_material,
@@ -759,6 +761,8 @@ pub unsafe extern "C" fn ts_eval_rgb(
 /// `m` is NULL or a live material; `wi`, `wo` are NULL or hold 3 floats;
 /// `pdf` is NULL or writable.
 /// cbindgen:ptrs-as-arrays=[[wi;3], [wo;3]]
+// The annotation's brackets are cbindgen syntax, not links.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ts_pdf(
     m: *const ts_material,
@@ -779,6 +783,8 @@ pub unsafe extern "C" fn ts_pdf(
 /// `m` is NULL or a live material; `wi`, `u` are NULL or hold 3 floats;
 /// `out` is NULL or writable.
 /// cbindgen:ptrs-as-arrays=[[wi;3], [u;3]]
+// The annotation's brackets are cbindgen syntax, not links.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ts_sample_rgb(
     m: *const ts_material,
