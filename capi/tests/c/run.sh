@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Builds the C library, checks the committed header is what cbindgen
+# generates, compiles the C tests with the system `cc` against the shared and
+# the static library, and runs them under valgrind memcheck (any error or leak
+# fails). Needs cbindgen 0.29 and valgrind on PATH (.ci/run installs them).
+# Usage: capi/tests/c/run.sh [MATERIALS [PAIRS]]   (3 rows per pair: R, G, B)
+set -euo pipefail
+cd "$(dirname "$0")/../../.."
+materials=${1:-34}
+pairs=${2:-10}
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+cbindgen --config capi/cbindgen.toml --crate twoscale-capi --output "$out/twoscale.h"
+if ! diff -u capi/include/twoscale.h "$out/twoscale.h"; then
+  echo "capi/include/twoscale.h is stale: regenerate it with" >&2
+  echo "  cbindgen --config capi/cbindgen.toml --crate twoscale-capi --output capi/include/twoscale.h" >&2
+  exit 1
+fi
+
+cargo build -p twoscale-capi -p generator --release --locked
+lib=target/release
+cflags=(-std=c11 -Wall -Wextra -Werror -pedantic -O2 -g -I capi/include)
+for t in misuse query_rows; do
+  cc "${cflags[@]}" "capi/tests/c/$t.c" -L "$lib" -ltwoscale_capi -Wl,-rpath,"$PWD/$lib" \
+    -lm -lpthread -o "$out/$t"
+done
+# The static library links on its own with the system libraries Rust's std needs.
+cc "${cflags[@]}" capi/tests/c/misuse.c "$lib/libtwoscale_capi.a" \
+  -lgcc_s -lutil -lrt -lpthread -lm -ldl -lc -o "$out/misuse-static"
+"$out/misuse-static" tables
+
+memcheck=(valgrind --error-exitcode=1 --leak-check=full
+  --errors-for-leak-kinds=definite,indirect,possible -q)
+"${memcheck[@]}" "$out/misuse" tables
+"$out/query_rows" rows "$materials" "$pairs" 2026 > "$out/rows.csv"
+"$lib/generator" query brdf --tables tables < "$out/rows.csv" > "$out/answered.csv"
+"${memcheck[@]}" "$out/query_rows" compare "$out/answered.csv" "$materials" "$pairs"
+
+# The example of docs/c-api.md (its one ```c block) compiles, runs, and prints
+# three positive values.
+awk '/^```c$/{on=1; next} /^```$/{on=0} on' docs/c-api.md > "$out/example.c"
+cc "${cflags[@]}" "$out/example.c" -L "$lib" -ltwoscale_capi -Wl,-rpath,"$PWD/$lib" -lm \
+  -o "$out/example"
+"${memcheck[@]}" "$out/example" | tee "$out/example.txt"
+awk '{ exit !($3 > 0 && $4 > 0 && $5 > 0) }' "$out/example.txt"
