@@ -50,15 +50,12 @@ use crate::conv::Convolution;
 use crate::epd::Epd;
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
 use crate::kcorr::SigmaRatioTable;
-use crate::math;
+use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
 use core::f64::consts::PI;
 
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];
-
-/// The largest f32 below one (sample inputs are clamped to [0, BELOW_ONE]).
-const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The micro- and nano-geometry of a surface (wavelength independent).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -244,22 +241,6 @@ fn finite_or_zero(x: f64) -> f32 {
     }
 }
 
-/// A direction normalised in f64, or `None` when it is not finite, zero, or
-/// at/below the horizon.
-#[inline]
-fn upper(v: [f32; 3]) -> Option<[f64; 3]> {
-    let [x, y, z] = v.map(f64::from);
-    let len = math::sqrt(x * x + y * y + z * z);
-    if !(len > 0.0 && len < f64::INFINITY) {
-        return None;
-    }
-    let w = [x / len, y / len, z / len];
-    if !(w[2] > 0.0) {
-        return None;
-    }
-    Some(w)
-}
-
 #[inline]
 fn to_f32(v: [f64; 3]) -> [f32; 3] {
     v.map(|x| x as f32)
@@ -355,11 +336,7 @@ impl<'a> TwoScale<'a> {
             b: nonneg(s.b),
             c: if c_ok { s.c.min(1e6) } else { 2.0 },
         };
-        let lambda = if lambda > 0.0 {
-            f64::from(lambda).max(0.01).min(100.0)
-        } else {
-            0.526
-        };
+        let lambda = math::sanitised_wavelength(lambda);
         let unit = |x: f32| f64::from(x.max(0.0).min(1.0));
         let base = match layer.base {
             BaseLayer::Conductor => BaseLayer::Conductor,
@@ -469,7 +446,7 @@ impl<'a> TwoScale<'a> {
     /// The wavelength-independent part of `eval` at `(i, o)`: geometry, D
     /// and G; `None` below the horizon.
     fn pair(&self, i: [f32; 3], o: [f32; 3]) -> Option<Pair> {
-        let (wi, wo) = (upper(i)?, upper(o)?);
+        let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
         // |i + o| ≥ z_i + z_o > 0.
         let len = math::sqrt(dot(sum, sum));
@@ -657,7 +634,7 @@ impl<'a> TwoScale<'a> {
     /// `sample` and `pdf` read the same table, so the pdf stays the sampler's
     /// exact density.
     pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
-        let Some(wi) = upper(i) else {
+        let Some(wi) = upper_unit(i) else {
             return [0.0; 3];
         };
         let w = self.weights(wi[2]);
@@ -701,7 +678,7 @@ impl<'a> TwoScale<'a> {
     /// [`TwoScale::lobe_weights`] and the lobe densities of
     /// [`TwoScale::pdf_lobe`]. 0 below the horizon.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
+        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
             return 0.0;
         };
         let w = self.weights(wi[2]);
@@ -728,7 +705,7 @@ impl<'a> TwoScale<'a> {
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
     pub fn pdf_lobe(&self, lobe: Lobe, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (upper(i), upper(o)) else {
+        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
             return 0.0;
         };
         finite_or_zero(self.pdf_lobe_f64(lobe, wi, wo))
@@ -812,7 +789,7 @@ impl<'a> TwoScale<'a> {
     ///   mirror direction towards `i`'s side);
     /// * base: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
-        let wi = upper(i)?;
+        let wi = upper_unit(i)?;
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
@@ -854,7 +831,7 @@ impl<'a> TwoScale<'a> {
                 ]
             }
         };
-        let o = upper(to_f32(o))?;
+        let o = upper_unit(to_f32(o))?;
         Some(to_f32(o))
     }
 
@@ -864,7 +841,7 @@ impl<'a> TwoScale<'a> {
     /// Returns the direction, [`TwoScale::pdf`] there (> 0) and ρ there;
     /// `None` when nothing can be sampled (see `sample_lobe`).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
-        let wi = upper(i)?;
+        let wi = upper_unit(i)?;
         let w = self.weights(wi[2]);
         let pick = f64::from(u[0].max(0.0).min(BELOW_ONE));
         let lobe = pick_lobe(pick, w);

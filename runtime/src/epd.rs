@@ -15,11 +15,8 @@
 //! local frame (normal = +z) as unit vectors `[x, y, z]`.
 
 use crate::gamma::inverse_gamma_q;
-use crate::math;
+use crate::math::{self, BELOW_ONE};
 use crate::smith::{SmithG1Table, SmithShape};
-
-/// The largest f32 below one: sample inputs are clamped to [0, BELOW_ONE].
-const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Smallest and largest accepted β.
 pub const BETA_RANGE: (f32, f32) = (1e-4, 10.0);

@@ -26,7 +26,7 @@
 //! Guards as in [`crate::brdf`]: 0 below the horizon, never NaN/∞.
 
 use crate::epd::Epd;
-use crate::math;
+use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
 use core::f64::consts::PI;
 
@@ -73,8 +73,6 @@ pub struct Hp15<'a> {
     weights: [f64; 2],
 }
 
-const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
-
 impl<'a> Hp15<'a> {
     /// The model with `params` at wavelength `lambda` (µm). Colours and F0
     /// are clamped to ≥ 0 (F0 ≤ 1), a to ≥ 1e-6 µm⁻¹, λ as in
@@ -87,11 +85,7 @@ impl<'a> Hp15<'a> {
                 0.0
             }
         };
-        let lambda = if lambda > 0.0 {
-            f64::from(lambda).max(0.01).min(100.0)
-        } else {
-            0.526
-        };
+        let lambda = math::sanitised_wavelength(lambda);
         let a = nonneg(params.a).max(1e-6);
         let inv_al_sq = 1.0 / (a * lambda * a * lambda);
         let e_exact = PI / (1.0 + inv_al_sq);
@@ -124,7 +118,7 @@ impl<'a> Hp15<'a> {
 
     /// ρ(i, o) (HP15 24), sr⁻¹; 0 below the horizon.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (unit_upper(i), unit_upper(o)) else {
+        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
             return 0.0;
         };
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -157,7 +151,7 @@ impl<'a> Hp15<'a> {
     /// The density of [`Hp15::sample`]:
     /// `w_ct · D(h) cos θh / (4 i·h) + (1 − w_ct) · cos θo / π`.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (unit_upper(i), unit_upper(o)) else {
+        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
             return 0.0;
         };
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -181,7 +175,7 @@ impl<'a> Hp15<'a> {
     /// `w_ct`) or the cosine lobe, `u[1], u[2]` sample it. Returns `(o, pdf)`,
     /// or `None` below the horizon.
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<([f32; 3], f32)> {
-        let wi = unit_upper(i)?;
+        let wi = upper_unit(i)?;
         let u1 = f64::from(u[1].max(0.0).min(BELOW_ONE));
         let u2 = f64::from(u[2].max(0.0).min(BELOW_ONE));
         let o = if f64::from(u[0].max(0.0).min(BELOW_ONE)) < self.weights[0] {
@@ -193,7 +187,7 @@ impl<'a> Hp15<'a> {
             let phi = 2.0 * PI * u2;
             [r * math::cos(phi), r * math::sin(phi), math::sqrt(1.0 - u1)]
         };
-        let o = unit_upper(o.map(|x| x as f32))?.map(|x| x as f32);
+        let o = upper_unit(o.map(|x| x as f32))?.map(|x| x as f32);
         let pdf = self.pdf(i, o);
         (pdf > 0.0).then_some((o, pdf))
     }
@@ -202,14 +196,4 @@ impl<'a> Hp15<'a> {
     pub fn wavelength(&self) -> f32 {
         self.lambda as f32
     }
-}
-
-fn unit_upper(v: [f32; 3]) -> Option<[f64; 3]> {
-    let [x, y, z] = v.map(f64::from);
-    let len = math::sqrt(x * x + y * y + z * z);
-    if !(len > 0.0 && len < f64::INFINITY) {
-        return None;
-    }
-    let w = [x / len, y / len, z / len];
-    (w[2] > 0.0).then_some(w)
 }

@@ -78,3 +78,31 @@ pub fn ln_gamma(x: f64) -> f64 {
 pub fn erfc(x: f64) -> f64 {
     libm::erfc(x)
 }
+
+/// The largest f32 below one: uniforms for samplers are clamped to
+/// `[0, BELOW_ONE]`.
+pub const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A direction normalised in f64, or `None` when it is not finite, zero, or
+/// at/below the horizon (`z ≤ 0`).
+#[inline]
+pub fn upper_unit(v: [f32; 3]) -> Option<[f64; 3]> {
+    let [x, y, z] = v.map(f64::from);
+    let len = sqrt(x * x + y * y + z * z);
+    if !(len > 0.0 && len < f64::INFINITY) {
+        return None;
+    }
+    let w = [x / len, y / len, z / len];
+    (w[2] > 0.0).then_some(w)
+}
+
+/// A wavelength (µm) as the models use it: NaN or ≤ 0 → 0.526 µm (green),
+/// otherwise clamped to [0.01, 100] µm.
+#[inline]
+pub fn sanitised_wavelength(lambda: f32) -> f64 {
+    if lambda > 0.0 {
+        f64::from(lambda).max(0.01).min(100.0)
+    } else {
+        0.526
+    }
+}
