@@ -143,7 +143,8 @@ pub fn convolution_direct(
 /// absolute error small against `rel_tol · S`, `S ≈ C`.
 ///
 /// `S` comes from [`coarse_estimate`] (a fixed 4-point Gauss rule on every
-/// piece of both integrals, ≈ 1/20 of the cost of a pass). Only a too large
+/// piece of both integrals: 4 × 4 points per pair of pieces against at least
+/// 15 × 15 in a pass). Only a too large
 /// `S` could loosen the result, so when `S > 2 C` the accurate pass is
 /// repeated with `S = C`; when the estimate is not positive or the accurate
 /// pass fails, `S` comes from a rough adaptive pass (relative `1e-4`,
