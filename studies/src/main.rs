@@ -14,6 +14,7 @@ mod common;
 mod t3_angle;
 mod t3_axes;
 mod t3_interp;
+mod t3_node_cost;
 mod t3_thresholds;
 mod t4_band_limits;
 
@@ -126,6 +127,14 @@ enum Study {
         #[arg(long, default_value = "")]
         snap: String,
     },
+    /// Where the T3 build's time goes: the reference profile and fit of every
+    /// `stride`-th node, timed on one thread, CSV on stdout, totals on stderr
+    /// (docs/design/t3-build-speed.md).
+    T3NodeCost {
+        /// Time every `stride`-th node.
+        #[arg(long, default_value_t = 61)]
+        stride: usize,
+    },
     /// The paper's thresholds for T3a's g (HP17 §4.4) read from the
     /// committed table (docs/design/t3-paper-form.md).
     T3Thresholds,
@@ -183,6 +192,10 @@ fn main() -> ExitCode {
             snap,
         } => {
             t3_interp::spline(profiles, seed, distribution, &snap);
+            Ok(())
+        }
+        Study::T3NodeCost { stride } => {
+            t3_node_cost::run(stride);
             Ok(())
         }
         Study::T3Thresholds => {

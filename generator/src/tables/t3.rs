@@ -279,7 +279,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
 /// affordable cost little once the lobes' moments are shared; the others take
 /// the direct quadrature at every angle, whose cost grows with the kernel's
 /// narrowness (more breakpoints): measured on a sample of nodes
-/// (`examples/t3_node_cost.rs`, docs/design/t3-build-speed.md).
+/// (`studies t3-node-cost`, docs/design/t3-build-speed.md).
 pub fn node_cost(index: usize) -> u64 {
     let [u, c, beta, p] = node_params(index);
     let params = Params::new(u, c, beta, p).expect("grid nodes are valid");

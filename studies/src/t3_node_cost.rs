@@ -1,13 +1,8 @@
-//! Where the T3 build's time goes: times the reference profile and the fit of
-//! a deterministic sample of T3 nodes (every `T3_COST_STRIDE`-th node, default
-//! 61, coprime with every axis length, so the sample spreads over all four
-//! axes) and prints one CSV row per node, then the totals by method and by
-//! u node, extrapolated to the whole grid (×stride).
-//!
-//! ```text
-//! T3_COST_STRIDE=61 cargo run --release -p generator --example t3_node_cost > cost.csv
-//! ```
-//!
+//! Where the T3 build's time goes (docs/design/t3-build-speed.md): times the
+//! reference profile and the fit of a deterministic sample of T3 nodes (every
+//! `stride`-th node; 61 is coprime with every axis length, so the sample
+//! spreads over all four axes) and prints one CSV row per node, then the
+//! totals by method and by u node, extrapolated to the whole grid (×stride).
 //! One thread (the per-node CPU time is what the figures are about).
 
 use generator::reference::conv::{Method, MomentCache, convolution_profile_cached};
@@ -15,11 +10,9 @@ use generator::tables::t3::{angle_rule, fit_paper_form, node_params};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-fn main() {
-    let stride: usize = std::env::var("T3_COST_STRIDE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(61);
+/// Times every `stride`-th node; CSV rows on stdout, totals on stderr.
+pub fn run(stride: usize) {
+    let stride = stride.max(1);
     let total = 28 * 10 * 12 * 12;
     println!("index,u,c,beta,p,method,band,profile_s,fit_s");
     let mut by_method: BTreeMap<String, (usize, f64)> = BTreeMap::new();
