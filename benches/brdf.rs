@@ -40,10 +40,12 @@ impl Ggx {
         2.0 / (1.0 + libm::sqrtf(1.0 + self.alpha * self.alpha * tan2))
     }
 
+    /// `cos θd` and `D G1(i) G1(o) / (4 cos θi cos θo)`, or `None` below
+    /// the horizon.
     #[inline]
-    fn eval(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+    fn cos_d_and_dg(&self, i: [f32; 3], o: [f32; 3]) -> Option<(f32, f32)> {
         if !(i[2] > 0.0 && o[2] > 0.0) {
-            return 0.0;
+            return None;
         }
         let s = [i[0] + o[0], i[1] + o[1], i[2] + o[2]];
         let inv = 1.0 / libm::sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
@@ -53,26 +55,24 @@ impl Ggx {
         let c2 = h[2] * h[2];
         let t = a2 * c2 + (1.0 - c2);
         let d = a2 / (core::f32::consts::PI * t * t);
-        let f = twoscale::fresnel::fresnel(self.eta, cos_d);
-        f * d * self.g1(i) * self.g1(o) / (4.0 * i[2] * o[2])
+        Some((cos_d, d * self.g1(i) * self.g1(o) / (4.0 * i[2] * o[2])))
+    }
+
+    #[inline]
+    fn eval(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        match self.cos_d_and_dg(i, o) {
+            Some((cos_d, dg)) => twoscale::fresnel::fresnel(self.eta, cos_d) * dg,
+            None => 0.0,
+        }
     }
 
     /// The RGB GGX conductor: D and G once, Fresnel per channel.
     #[inline]
     fn eval_rgb(&self, etas: &[Complex; 3], i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
-        if !(i[2] > 0.0 && o[2] > 0.0) {
-            return [0.0; 3];
+        match self.cos_d_and_dg(i, o) {
+            Some((cos_d, dg)) => etas.map(|eta| twoscale::fresnel::fresnel(eta, cos_d) * dg),
+            None => [0.0; 3],
         }
-        let s = [i[0] + o[0], i[1] + o[1], i[2] + o[2]];
-        let inv = 1.0 / libm::sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-        let h = s.map(|x| x * inv);
-        let cos_d = (i[0] * h[0] + i[1] * h[1] + i[2] * h[2]).clamp(0.0, 1.0);
-        let a2 = self.alpha * self.alpha;
-        let c2 = h[2] * h[2];
-        let t = a2 * c2 + (1.0 - c2);
-        let d = a2 / (core::f32::consts::PI * t * t);
-        let dg = d * self.g1(i) * self.g1(o) / (4.0 * i[2] * o[2]);
-        etas.map(|eta| twoscale::fresnel::fresnel(eta, cos_d) * dg)
     }
 
     /// Samples a visible normal (Heitz 2018, "Sampling the GGX Distribution
