@@ -158,6 +158,15 @@ fn edge_cases_are_defined() {
         assert_eq!(epd.d(below), 0.0);
         assert_eq!(epd.d([f32::NAN; 3]), 0.0);
         assert_eq!(epd.g_height_correlated(horizon, normal), 0.0);
+        // Not a unit vector: cos⁴θ underflows to 0 while tan²θ = 0 (found by
+        // the proptest in CI). D stays finite.
+        for m in [[-0.0, 0.0, 1.5e-15], [0.0, 0.0, f32::MIN_POSITIVE]] {
+            let lowest = Epd::new(0.0, 0.0, t1);
+            assert!(
+                lowest.d(m).is_finite() && lowest.pdf(m).is_finite(),
+                "{m:?}"
+            );
+        }
     });
 }
 

@@ -91,7 +91,8 @@ impl<'a> Epd<'a> {
             // Also covers z so small that cos⁴θ underflows (tan² = ∞).
             return 0.0;
         }
-        self.norm * falloff / (cos_sq * cos_sq)
+        // A unit `m` has cos⁴θ ≫ 0 here; a shorter one can underflow it to 0.
+        (self.norm * falloff / (cos_sq * cos_sq)).min(f32::MAX)
     }
 
     /// Smith Λ (HP17 37) of direction `w`, from T1. Normal incidence → 0; at or
