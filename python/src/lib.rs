@@ -666,7 +666,7 @@ fn fresnel<'py>(
 }
 
 /// The one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model of `query
-/// brdf`, SPEC §6), with the paper's options: the runtime (`TwoScale`, T3b)
+/// brdf`, docs/model.md §2.5), with the paper's options: the runtime (`TwoScale`, T3b)
 /// or, with `reference=True`, the f64 reference (exact Λ, σrel and C).
 #[pyfunction]
 #[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference))]
