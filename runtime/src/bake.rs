@@ -10,7 +10,8 @@
 //!   horizon (G1 = 0).
 //! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 32 × 160
 //!   nodes, `u = B cos θd ∈ [0, B]` even in `ln(1 + u/u₀)` and θh even in
-//!   `x = ln((1 + sin θh / w) / cos θh)`, Catmull–Rom in both (edge cells
+//!   `x = ln((1 + sin θh / w) / cos θh)` (both logarithms are
+//!   [`math::log2_axis`], a cheap C¹ stand-in), Catmull–Rom in both (edge cells
 //!   extrapolate linearly: a ghost node on each side). `w` is a quarter of the narrowest core the lobe
 //!   can have, so the core gets nodes and the power-law tail (linear in
 //!   `ln sin θh`) is interpolated almost exactly; the `1/cos θh` term spends
@@ -141,6 +142,14 @@ impl DirectionBake {
         self
     }
 
+    /// F alone at `cos θ` (clamped to [0, 1]).
+    #[inline]
+    pub fn fresnel_at(&self, cos: f32) -> f32 {
+        let (i, t) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
+        let (a, b) = (self.rows[i][0], self.rows[i + 1][0]);
+        a + t * (b - a)
+    }
+
     /// The values at `cos θ` (clamped to [0, 1]).
     #[inline]
     pub fn at(&self, cos: f32) -> DirectionValues {
@@ -213,14 +222,18 @@ impl ConvBake {
         if !(big_b > 0.0 && big_b.is_finite()) {
             return None;
         }
-        let u_span = math::lnf(1.0 + big_b / U0);
+        let u_span = math::log2_axis(1.0 + big_b / U0);
         // The narrowest core: the kernel at u = B (width ~1/(2B) in sin θh),
         // or the NDF's, where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
         let kernel_width = 0.5 / big_b;
         let ndf_width = beta * math::powff(0.1, 0.5 / p);
         let w = (0.25 * kernel_width.max(ndf_width)).max(1e-6).min(0.25);
-        let angle_x =
-            |theta: f64| math::ln((1.0 + math::sin(theta) / f64::from(w)) / math::cos(theta));
+        let inv_w = 1.0 / w;
+        // The axis exactly as `at` computes it (f32).
+        let angle_x = |theta: f64| {
+            let (sin, cos) = (math::sin(theta) as f32, math::cos(theta) as f32);
+            f64::from(math::log2_axis((1.0 + sin * inv_w) / cos))
+        };
         let theta_max = math::acos(COS_H_MIN);
         let s_span = angle_x(theta_max);
         // θh of each node, by bisection of the increasing x(θh).
@@ -244,8 +257,8 @@ impl ConvBake {
         let mut ln_c = [0.0f32; PADDED_U * PADDED_S];
         let mut top = f32::MIN;
         for j in 0..CONV_U_NODES {
-            let x_u = j as f32 / (CONV_U_NODES - 1) as f32 * u_span;
-            let u = U0 * math::expf(x_u) - U0;
+            let x_u = j as f64 / (CONV_U_NODES - 1) as f64 * f64::from(u_span);
+            let u = (f64::from(U0) * (math::exp2_axis(x_u) - 1.0)) as f32;
             let u = if j + 1 == CONV_U_NODES { big_b } else { u };
             let mut profile = [0.0f32; CONV_S_NODES];
             slice.profile_at_tans(u, &tans, &mut profile);
@@ -276,7 +289,7 @@ impl ConvBake {
         }
         Some(ConvBake {
             u_scale: (CONV_U_NODES - 1) as f32 / u_span,
-            inv_w: 1.0 / w,
+            inv_w,
             s_scale: (CONV_S_NODES - 1) as f32 / s_span,
             ln_c,
         })
@@ -285,9 +298,9 @@ impl ConvBake {
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
-        let x_u = math::lnf(1.0 + u.max(0.0) / U0) * self.u_scale;
+        let x_u = math::log2_axis(1.0 + u.max(0.0) / U0) * self.u_scale;
         let x_h = (1.0 + sin_h.max(0.0).min(1.0) * self.inv_w) / cos_h.max(COS_H_MIN as f32);
-        let x_s = math::lnf(x_h) * self.s_scale;
+        let x_s = math::log2_axis(x_h) * self.s_scale;
         let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
         let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);
         let mut ln_c = 0.0f32;

@@ -224,7 +224,6 @@ pub fn fresnel(eta: Complex, cos_theta: f32) -> f32 {
 #[derive(Clone, Copy, Debug)]
 struct Direction {
     cos: f64,
-    sin: f64,
     x: f64,
     y: f64,
 }
@@ -239,7 +238,6 @@ impl Direction {
         if !(len > 0.0 && len.is_finite()) {
             return Direction {
                 cos: 1.0,
-                sin: 0.0,
                 x: 0.0,
                 y: 0.0,
             };
@@ -248,19 +246,13 @@ impl Direction {
         if z >= 0.0 {
             return Direction {
                 cos: z.min(1.0),
-                sin: math::hypot(x, y).min(1.0),
                 x,
                 y,
             };
         }
         let t = math::hypot(x, y);
         let (x, y) = if t > 0.0 { (x / t, y / t) } else { (1.0, 0.0) };
-        Direction {
-            cos: 0.0,
-            sin: 1.0,
-            x,
-            y,
-        }
+        Direction { cos: 0.0, x, y }
     }
 }
 
@@ -314,7 +306,7 @@ pub fn q_bar(eta: Complex, i: [f32; 3], o: [f32; 3]) -> f32 {
     let along = -(di.x * dout.x + di.y * dout.y);
     let across = -(di.x * dout.y - di.y * dout.x);
     let (fi, fo) = (q.factors(di.cos), q.factors(dout.cos));
-    (q.combine(&fi, &fo, di.sin * dout.sin, along, across) as f32)
+    (q.combine(&fi, &fo, along, across) as f32)
         .max(0.0)
         .min(f32::MAX)
 }
@@ -359,21 +351,14 @@ impl QConstants {
         [1.0 / sum.norm_sqr(), u.re, u.im, w.re, w.im]
     }
 
-    /// Q̄ from both directions' factors, `sin θi sin θo` and
-    /// `sin θi sin θo (cos φ, sin φ)` (φ is normalised out; φ = 0 when
-    /// either sine is 0).
-    pub(crate) fn combine(
-        &self,
-        fi: &QFactors,
-        fo: &QFactors,
-        sin_sin: f64,
-        along: f64,
-        across: f64,
-    ) -> f64 {
+    /// Q̄ from both directions' factors and `sin θi sin θo (cos φ, sin φ)`
+    /// (its length is `sin θi sin θo`; φ is normalised out, φ = 0 when either
+    /// sine is 0).
+    pub(crate) fn combine(&self, fi: &QFactors, fo: &QFactors, along: f64, across: f64) -> f64 {
         // |along|, |across| ≤ 1: the squares cannot overflow (no hypot needed).
-        let r = math::sqrt(along * along + across * across);
-        let (cos_phi, sin_phi) = if r > 0.0 {
-            (along / r, across / r)
+        let sin_sin = math::sqrt(along * along + across * across);
+        let (cos_phi, sin_phi) = if sin_sin > 0.0 {
+            (along / sin_sin, across / sin_sin)
         } else {
             (1.0, 0.0)
         };

@@ -45,6 +45,8 @@ forward! {
     exp_m1(x) -> f64 = exp_m1 / expm1;
     /// e^x (f32).
     expf(x) -> f32 = exp / expf;
+    /// e^x − 1 (f32), accurate for small |x|.
+    exp_m1f(x) -> f32 = exp_m1 / expm1f;
     /// ln x (f32).
     lnf(x) -> f32 = ln / logf;
     /// √x (f32).
@@ -104,5 +106,79 @@ pub fn sanitised_wavelength(lambda: f32) -> f64 {
         f64::from(lambda).max(0.01).min(100.0)
     } else {
         0.526
+    }
+}
+
+/// A cheap, smooth and increasing stand-in for `log₂ x`, for table axes
+/// that only need some such map (the per-material bakes): `e + p(m)` for
+/// `x = 2^e (1 + m)`, with `p` the cubic through `(0, 0)` and `(1, 1)` whose
+/// slopes there are `log₂`'s (`1/ln 2` and `1/(2 ln 2)`). So it is exact at
+/// powers of two, has a continuous derivative, and is within 0.011 of `log₂ x`.
+/// Defined for normal `x > 0`; every finite input gives a finite output.
+#[inline]
+pub fn log2_axis(x: f32) -> f32 {
+    let bits = x.to_bits();
+    let exponent = ((bits >> 23) & 0xff) as i32 - 127;
+    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
+    exponent as f32 + m * (AXIS_D0 + m * (AXIS_C2 + m * AXIS_C3))
+}
+
+/// The inverse of [`log2_axis`] (f64; for building a table's nodes):
+/// Newton's method on the cubic, which is increasing on [0, 1].
+pub fn exp2_axis(y: f64) -> f64 {
+    let exponent = floor(y);
+    let f = y - exponent;
+    let (d0, c2, c3) = (f64::from(AXIS_D0), f64::from(AXIS_C2), f64::from(AXIS_C3));
+    let mut m = f;
+    for _ in 0..8 {
+        let value = m * (d0 + m * (c2 + m * c3)) - f;
+        let slope = d0 + m * (2.0 * c2 + 3.0 * m * c3);
+        m = (m - value / slope).max(0.0).min(1.0);
+    }
+    powf(2.0, exponent) * (1.0 + m)
+}
+
+/// `p(m) = d₀ m + c₂ m² + c₃ m³` of [`log2_axis`]: `d₀ = 1/ln 2`,
+/// `c₂ = 3 − 2d₀ − d₁`, `c₃ = d₀ + d₁ − 2` with `d₁ = d₀/2` (cubic Hermite).
+const AXIS_D0: f32 = core::f32::consts::LOG2_E;
+const AXIS_C2: f32 = 3.0 - 2.5 * core::f32::consts::LOG2_E;
+const AXIS_C3: f32 = 1.5 * core::f32::consts::LOG2_E - 2.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `log2_axis` is increasing, within 0.011 of log₂, exact at powers of
+    /// two, and `exp2_axis` inverts it.
+    #[test]
+    fn log2_axis_is_a_smooth_increasing_log() {
+        let mut previous = f32::MIN;
+        let mut worst = 0.0f64;
+        for k in 0..=200_000 {
+            let x = 1.0 + k as f32 * 1e-3;
+            let y = log2_axis(x);
+            assert!(y > previous, "not increasing at {x}");
+            previous = y;
+            worst = worst.max((f64::from(y) - f64::from(x).log2()).abs());
+            let back = exp2_axis(f64::from(y));
+            assert!(
+                (back / f64::from(x) - 1.0).abs() < 1e-6,
+                "{x} → {y} → {back}"
+            );
+        }
+        assert!(worst < 0.011, "{worst}");
+        for e in -20..20 {
+            assert_eq!(log2_axis(2f32.powi(e)), e as f32);
+        }
+        for x in [
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            0.0,
+            -1.0,
+            f32::INFINITY,
+            f32::NAN,
+        ] {
+            assert!(log2_axis(x).is_finite() || !x.is_finite(), "{x}");
+        }
     }
 }
