@@ -45,9 +45,9 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
-use crate::bake::{ConvBake, DirectionBake, DirectionValues, MaskingBake};
+use crate::bake::{ConvBake, DirectionBake, DirectionValues, MaskingBake, SlopeQuantileBake};
 use crate::conv::Convolution;
-use crate::epd::Epd;
+use crate::epd::{Epd, normal_at};
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
@@ -273,6 +273,8 @@ pub struct TwoScale<'a> {
     ndf: Epd<'a>,
     /// G1 at the material's (β, p).
     masking: MaskingBake,
+    /// The specular sampler's `tan θm` quantile at the material's (β, p).
+    slope_quantile: SlopeQuantileBake,
     /// F, Q̄'s factors and σrel/σs over `cos θ`.
     direction: DirectionBake,
     /// Q̄'s constants of η (`None` for η = 1: Q̄ = 0).
@@ -363,6 +365,7 @@ impl<'a> TwoScale<'a> {
         };
         let model = TwoScale {
             masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
+            slope_quantile: SlopeQuantileBake::new(ndf.beta(), ndf.p()),
             ndf,
             direction: DirectionBake::new(
                 eta,
@@ -796,7 +799,9 @@ impl<'a> TwoScale<'a> {
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
-                let m = self.ndf.sample([u[0] as f32, u[1] as f32]).map(f64::from);
+                // Epd::sample with the tabulated quantile.
+                let tan = self.slope_quantile.tan_theta(u[0] as f32);
+                let m = normal_at(tan, u[1] as f32).map(f64::from);
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }

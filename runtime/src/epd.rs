@@ -14,7 +14,7 @@
 //! [1e-4, 10]; NaN parameters become the lower bound. Directions are in the
 //! local frame (normal = +z) as unit vectors `[x, y, z]`.
 
-use crate::gamma::inverse_gamma_q;
+use crate::gamma::{inverse_gamma_p, inverse_gamma_q};
 use crate::math::{self, BELOW_ONE};
 use crate::smith::{SmithG1Table, SmithShape};
 
@@ -145,24 +145,36 @@ impl<'a> Epd<'a> {
     /// distributed, which is why its quantile is the inverse regularised
     /// incomplete gamma. `u` is clamped to [0, 1).
     pub fn sample(&self, u: [f32; 2]) -> [f32; 3] {
-        let tan_theta = f64::from(self.sample_tan_theta(u[0]));
-        let cos_theta = 1.0 / math::sqrt(1.0 + tan_theta * tan_theta);
-        let sin_theta = (tan_theta * cos_theta) as f32;
-        let phi = 2.0 * core::f32::consts::PI * u[1].max(0.0).min(BELOW_ONE);
-        [
-            sin_theta * math::cosf(phi),
-            sin_theta * math::sinf(phi),
-            cos_theta as f32,
-        ]
+        normal_at(self.sample_tan_theta(u[0]), u[1])
     }
 
     /// The polar part of [`Epd::sample`]: `tan θm = β · Q⁻¹(1/p, 1 − u₀)^{1/(2p)}`
-    /// (HP17 50), computed in f64 and rounded once.
+    /// (HP17 50), computed in f64 and rounded once (`P⁻¹(1/p, u₀)` below
+    /// `u₀ = ½`, where `1 − u₀` would round away the low tail).
     pub fn sample_tan_theta(&self, u0: f32) -> f32 {
         let u0 = f64::from(u0.max(0.0).min(BELOW_ONE));
-        let y = inverse_gamma_q(self.gamma_shape, 1.0 - u0);
+        let y = if u0 < 0.5 {
+            inverse_gamma_p(self.gamma_shape, u0)
+        } else {
+            inverse_gamma_q(self.gamma_shape, 1.0 - u0)
+        };
         (f64::from(self.beta) * math::powf(y, 0.5 * self.gamma_shape)) as f32
     }
+}
+
+/// The unit normal with polar angle `tan θ` and azimuth `φ = 2π u₁` (`u₁`
+/// clamped to [0, 1)).
+#[inline]
+pub(crate) fn normal_at(tan_theta: f32, u1: f32) -> [f32; 3] {
+    let tan_theta = f64::from(tan_theta);
+    let cos_theta = 1.0 / math::sqrt(1.0 + tan_theta * tan_theta);
+    let sin_theta = (tan_theta * cos_theta) as f32;
+    let phi = 2.0 * core::f32::consts::PI * u1.max(0.0).min(BELOW_ONE);
+    [
+        sin_theta * math::cosf(phi),
+        sin_theta * math::sinf(phi),
+        cos_theta as f32,
+    ]
 }
 
 /// `tan²θ = (x² + y²) / z²` of a direction (∞ when z = 0; callers check z > 0).
