@@ -298,9 +298,9 @@ pub struct TwoScale<'a> {
 }
 
 /// What one pair of directions gives, independent of the wavelength: the
-/// geometry, D and G (shared by the channels of [`Rgb`]).
+/// geometry and D (shared by `pdf` and `eval`, and by the channels of [`Rgb`]).
 #[derive(Clone, Copy, Debug)]
-struct Pair {
+struct Geometry {
     wi: [f64; 3],
     wo: [f64; 3],
     cos_d: f64,
@@ -308,7 +308,13 @@ struct Pair {
     sin_h: f64,
     /// D(h).
     d: f64,
-    /// G(i, o).
+}
+
+/// [`Geometry`] and G(i, o): what `eval` needs of a pair of directions
+/// before the wavelength.
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    geometry: Geometry,
     g: f64,
 }
 
@@ -450,9 +456,8 @@ impl<'a> TwoScale<'a> {
         }
     }
 
-    /// The wavelength-independent part of `eval` at `(i, o)`: geometry, D
-    /// and G; `None` below the horizon.
-    fn pair(&self, i: [f32; 3], o: [f32; 3]) -> Option<Pair> {
+    /// The geometry of `(i, o)` and D(h); `None` below the horizon.
+    fn geometry(&self, i: [f32; 3], o: [f32; 3]) -> Option<Geometry> {
         let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
         // |i + o| ≥ z_i + z_o > 0.
@@ -463,6 +468,25 @@ impl<'a> TwoScale<'a> {
         // sin θh from the tangential components (f64): resolves θh ≪ 1e-3,
         // which an f32 cos θh cannot.
         let sin_h = math::sqrt(h[0] * h[0] + h[1] * h[1]).min(1.0);
+        Some(Geometry {
+            wi,
+            wo,
+            cos_d,
+            cos_h,
+            sin_h,
+            d: f64::from(self.ndf.d(to_f32(h))),
+        })
+    }
+
+    /// The wavelength-independent part of `eval` at `(i, o)`: geometry, D
+    /// and G; `None` below the horizon.
+    fn pair(&self, i: [f32; 3], o: [f32; 3]) -> Option<Pair> {
+        Some(self.with_masking(self.geometry(i, o)?))
+    }
+
+    /// G(i, o) added to `geometry`.
+    fn with_masking(&self, geometry: Geometry) -> Pair {
+        let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrt(w[0] * w[0] + w[1] * w[1]) as f32;
         let (g1_i, g1_o) = (
             self.masking.g1(tangential(wi), wi[2] as f32),
@@ -475,15 +499,7 @@ impl<'a> TwoScale<'a> {
                 1.0 / (1.0 / f64::from(g1_i) + 1.0 / f64::from(g1_o) - 1.0)
             }
         };
-        Some(Pair {
-            wi,
-            wo,
-            cos_d,
-            cos_h,
-            sin_h,
-            d: f64::from(self.ndf.d(to_f32(h))),
-            g,
-        })
+        Pair { geometry, g }
     }
 
     /// ρ(i, o) in sr⁻¹ (HP17 24; module documentation). 0 below the horizon.
@@ -502,12 +518,15 @@ impl<'a> TwoScale<'a> {
     /// The terms of ρ at a pair (HP17 24-33).
     fn lobes(&self, pair: &Pair) -> Lobes {
         let Pair {
-            wi,
-            wo,
-            cos_d,
-            cos_h,
-            sin_h,
-            d,
+            geometry:
+                Geometry {
+                    wi,
+                    wo,
+                    cos_d,
+                    cos_h,
+                    sin_h,
+                    d,
+                },
             g,
         } = *pair;
         let (cos_i, cos_o) = (wi[2], wo[2]);
@@ -684,20 +703,25 @@ impl<'a> TwoScale<'a> {
     /// [`TwoScale::lobe_weights`] and the lobe densities of
     /// [`TwoScale::pdf_lobe`]. 0 below the horizon.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
-            return 0.0;
-        };
-        let w = self.weights(wi[2]);
+        match self.geometry(i, o) {
+            Some(geometry) => finite_or_zero(self.pdf_at(&geometry)),
+            None => 0.0,
+        }
+    }
+
+    /// [`TwoScale::pdf`] at a pair's geometry (the specular density from its D).
+    fn pdf_at(&self, geometry: &Geometry) -> f64 {
+        let w = self.weights(geometry.wi[2]);
         let mut total = 0.0;
         for (k, lobe) in [Lobe::Specular, Lobe::Diffraction, Lobe::Base]
             .into_iter()
             .enumerate()
         {
             if w[k] > 0.0 {
-                total += w[k] * self.pdf_lobe_f64(lobe, wi, wo);
+                total += w[k] * self.lobe_pdf(lobe, geometry);
             }
         }
-        finite_or_zero(total)
+        total
     }
 
     /// The solid-angle density of [`TwoScale::sample_lobe`] for one lobe:
@@ -711,24 +735,26 @@ impl<'a> TwoScale<'a> {
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
     pub fn pdf_lobe(&self, lobe: Lobe, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let (Some(wi), Some(wo)) = (upper_unit(i), upper_unit(o)) else {
-            return 0.0;
-        };
-        finite_or_zero(self.pdf_lobe_f64(lobe, wi, wo))
+        match self.geometry(i, o) {
+            Some(geometry) => finite_or_zero(self.lobe_pdf(lobe, &geometry)),
+            None => 0.0,
+        }
     }
 
-    fn pdf_lobe_f64(&self, lobe: Lobe, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    /// [`TwoScale::pdf_lobe`] at a pair's geometry.
+    fn lobe_pdf(&self, lobe: Lobe, geometry: &Geometry) -> f64 {
+        let Geometry {
+            wi,
+            wo,
+            cos_d,
+            cos_h,
+            d,
+            ..
+        } = *geometry;
         match lobe {
-            Lobe::Specular => {
-                let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-                let len = math::sqrt(dot(sum, sum));
-                let h = sum.map(|x| x / len);
-                let cos_d = dot(wi, h);
-                if !(cos_d > 0.0) {
-                    return 0.0;
-                }
-                f64::from(self.ndf.pdf(to_f32(h))) / (4.0 * cos_d)
-            }
+            // D(h) cos θh / (4 i·h)
+            Lobe::Specular if cos_d > 0.0 => d * cos_h / (4.0 * cos_d),
+            Lobe::Specular => 0.0,
             Lobe::Diffraction => self.diffraction_pdf(wi, wo),
             Lobe::Base => wo[2] / PI,
         }
@@ -745,7 +771,9 @@ impl<'a> TwoScale<'a> {
         let b = self.big_b;
         let half_cm1 = 0.5 * (f64::from(s.c) - 1.0);
         let reach = b * (1.0 + sin_i);
-        let m = -math::exp_m1(-half_cm1 * math::ln_1p(reach * reach)); // (HP17 52)
+        // M = 1 − (1 + reach²)^(−(c−1)/2); the power (cheaper than exp_m1 and
+        // ln_1p) cancels only where M < 1e-9, which has no mass to sample.
+        let m = 1.0 - math::powf(1.0 + reach * reach, -half_cm1); // (HP17 52)
         if !(m > 0.0) {
             return None;
         }
@@ -776,7 +804,7 @@ impl<'a> TwoScale<'a> {
             return 0.0;
         }
         let c = f64::from(self.surface.c);
-        let density = (c - 1.0) * b * b * math::exp(-0.5 * (c + 1.0) * math::ln_1p(b * b * r * r))
+        let density = (c - 1.0) * b * b * math::powf(1.0 + b * b * r * r, -0.5 * (c + 1.0))
             / (2.0 * m * phi_max);
         density * wo[2]
     }
@@ -808,8 +836,9 @@ impl<'a> TwoScale<'a> {
             Lobe::Diffraction => {
                 let (b, sin_i, m) = self.diffraction_setup(wi)?;
                 let c = f64::from(self.surface.c);
-                let t = -2.0 / (c - 1.0) * math::ln_1p(-m * u[0]); // (HP17 51)
-                let r = (math::sqrt(math::exp_m1(t).max(0.0)) / b).min(1.0 + sin_i);
+                let t = -2.0 / (c - 1.0) * f64::from(math::ln_1pf((-m * u[0]) as f32)); // (HP17 51)
+                let r =
+                    (math::sqrt(f64::from(math::exp_m1f(t as f32)).max(0.0)) / b).min(1.0 + sin_i);
                 let psi = (2.0 * u[1] - 1.0) * Self::phi_max(r, sin_i); // (HP17 53-54)
                 let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
                     (wi[0] / sin_i, wi[1] / sin_i)
@@ -849,21 +878,28 @@ impl<'a> TwoScale<'a> {
     /// Returns the direction, [`TwoScale::pdf`] there (> 0) and ρ there;
     /// `None` when nothing can be sampled (see `sample_lobe`).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
-        let wi = upper_unit(i)?;
-        let w = self.weights(wi[2]);
-        let pick = f64::from(u[0].max(0.0).min(BELOW_ONE));
-        let lobe = pick_lobe(pick, w);
-        let o = self.sample_lobe(lobe, i, [u[1], u[2]])?;
-        let pdf = self.pdf(i, o);
+        let (o, lobe) = self.sample_direction(i, u)?;
+        // pdf(i, o) and eval(i, o) from one geometry.
+        let geometry = self.geometry(i, o)?;
+        let pdf = finite_or_zero(self.pdf_at(&geometry));
         if !(pdf > 0.0) {
             return None;
         }
         Some(Sample {
             o,
             pdf,
-            value: self.eval(i, o),
+            value: self.lobes(&self.with_masking(geometry)).total(),
             lobe,
         })
+    }
+
+    /// The direction and lobe of [`TwoScale::sample`].
+    fn sample_direction(&self, i: [f32; 3], u: [f32; 3]) -> Option<([f32; 3], Lobe)> {
+        let wi = upper_unit(i)?;
+        let w = self.weights(wi[2]);
+        let pick = f64::from(u[0].max(0.0).min(BELOW_ONE));
+        let lobe = pick_lobe(pick, w);
+        Some((self.sample_lobe(lobe, i, [u[1], u[2]])?, lobe))
     }
 }
 
@@ -933,8 +969,20 @@ impl<'a> Rgb<'a> {
     /// The density of [`Rgb::sample`]: the mean of the channels' pdfs (one
     /// channel's sampler is picked uniformly).
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
-        let sum: f64 = self.channels.iter().map(|ch| f64::from(ch.pdf(i, o))).sum();
-        finite_or_zero(sum / 3.0)
+        match self.channels[0].geometry(i, o) {
+            Some(geometry) => finite_or_zero(self.pdf_at(&geometry)),
+            None => 0.0,
+        }
+    }
+
+    /// [`Rgb::pdf`] at a pair's geometry.
+    fn pdf_at(&self, geometry: &Geometry) -> f64 {
+        let sum: f64 = self
+            .channels
+            .iter()
+            .map(|ch| f64::from(finite_or_zero(ch.pdf_at(geometry))))
+            .sum();
+        sum / 3.0
     }
 
     /// Picks a channel's sampler with `u[0]` (uniformly; `u[0]` is rescaled
@@ -944,15 +992,18 @@ impl<'a> Rgb<'a> {
         let pick = 3.0 * f64::from(u[0].max(0.0).min(BELOW_ONE));
         let k = (pick as usize).min(2);
         let rest = (pick - k as f64) as f32;
-        let s = self.channels[k].sample(i, [rest, u[1], u[2]])?;
-        let pdf = self.pdf(i, s.o);
+        let (o, _) = self.channels[k].sample_direction(i, [rest, u[1], u[2]])?;
+        // pdf(i, o) and eval(i, o) from one geometry.
+        let geometry = self.channels[0].geometry(i, o)?;
+        let pdf = finite_or_zero(self.pdf_at(&geometry));
         if !(pdf > 0.0) {
             return None;
         }
+        let pair = self.channels[0].with_masking(geometry);
         Some(RgbSample {
-            o: s.o,
+            o,
             pdf,
-            value: self.eval(i, s.o),
+            value: self.channels.each_ref().map(|ch| ch.lobes(&pair).total()),
         })
     }
 }

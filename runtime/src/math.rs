@@ -47,6 +47,8 @@ forward! {
     expf(x) -> f32 = exp / expf;
     /// e^x − 1 (f32), accurate for small |x|.
     exp_m1f(x) -> f32 = exp_m1 / expm1f;
+    /// ln(1 + x) (f32), accurate for small |x|.
+    ln_1pf(x) -> f32 = ln_1p / log1pf;
     /// ln x (f32).
     lnf(x) -> f32 = ln / logf;
     /// √x (f32).
