@@ -139,28 +139,148 @@ impl TableId {
     }
 
     /// Names of the generation parameters stored in [`Header::params`] (unused
-    /// slots are zero and unnamed).
+    /// slots are zero and unnamed): the fields of the table's parameter struct
+    /// ([`SmithG1Params`], [`SigmaRatioParams`], [`DiffuseFresnelParams`],
+    /// [`ConvParams`], [`ShBrdfParams`]).
     pub const fn param_names(self) -> &'static [&'static str] {
         match self {
-            TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
-            TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
-            TableId::DiffuseFresnel => &["quadrature_rel_tol", "quadrature_abs_tol"],
-            TableId::Convolution => &[
-                "angles",
-                "tau_max",
-                "kernel_scale_floor",
-                "ndf_weight",
-                "ndf_exponent_cap",
-                "g_offset",
-                "value_floor",
-                "ndf_softening",
-                "horizon_weight",
-                "edge_weight",
-                "edge_smoothing",
-                "edge_fade_tan",
-            ],
-            TableId::ShBrdf => &crate::sh::PARAM_NAMES,
+            TableId::SmithG1 => SmithG1Params::NAMES,
+            TableId::SigmaRatio => SigmaRatioParams::NAMES,
+            TableId::DiffuseFresnel => DiffuseFresnelParams::NAMES,
+            TableId::Convolution => ConvParams::NAMES,
+            TableId::ShBrdf => ShBrdfParams::NAMES,
         }
+    }
+}
+
+/// Defines a table's generation parameters as a struct of named `f64`
+/// fields, stored in [`Header::params`] in field order: the one definition the
+/// generator writes ([`to_values`](SmithG1Params::to_values)) and the runtime
+/// reads ([`from_header`](SmithG1Params::from_header)).
+macro_rules! header_params {
+    ($(#[$meta:meta])* $name:ident { $($(#[$field_meta:meta])* $field:ident,)+ }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Default)]
+        pub struct $name {
+            $($(#[$field_meta])* pub $field: f64,)+
+        }
+
+        impl $name {
+            /// The field names, in slot order (what `generator inspect` prints).
+            pub const NAMES: &'static [&'static str] = &[$(stringify!($field)),+];
+            /// Number of slots used.
+            pub const COUNT: usize = Self::NAMES.len();
+
+            /// The parameters in slot order (what the writer stores).
+            pub fn to_values(&self) -> [f64; Self::COUNT] {
+                [$(self.$field),+]
+            }
+
+            /// The parameters stored in `header`.
+            pub fn from_header(header: &Header) -> Self {
+                let mut slots = header.params.iter().copied();
+                Self {
+                    $($field: slots.next().unwrap_or(0.0),)+
+                }
+            }
+        }
+
+        const _: () = assert!($name::COUNT <= PARAM_COUNT);
+    };
+}
+
+header_params! {
+    /// T1's generation parameters.
+    SmithG1Params {
+        /// Relative tolerance of the Λ quadrature.
+        quadrature_rel_tol,
+        /// Absolute tolerance of the Λ quadrature.
+        quadrature_abs_tol,
+    }
+}
+
+header_params! {
+    /// T2's generation parameters.
+    SigmaRatioParams {
+        /// Relative tolerance of the σrel quadrature.
+        quadrature_rel_tol,
+        /// `c − 1` at which the node `c = 1` is computed (the limit c → 1).
+        c_minus_1_at_first_node,
+    }
+}
+
+header_params! {
+    /// T5's generation parameters.
+    DiffuseFresnelParams {
+        /// Relative tolerance of the F_dr,int quadrature.
+        quadrature_rel_tol,
+        /// Absolute tolerance of the F_dr,int quadrature.
+        quadrature_abs_tol,
+    }
+}
+
+header_params! {
+    /// T3's generation parameters: its number of normalised angles, the
+    /// normalised angle's constants (`conv::AngleParams`, docs/model.md §3),
+    /// the T3a `g` offset and the value floor.
+    ConvParams {
+        /// Number of normalised angles ξ (the `ln C` channels).
+        angles,
+        /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
+        tau_max,
+        /// `u_floor`: `u_e = √(u² + u_floor²)`.
+        kernel_scale_floor,
+        /// `λ`: weight of the NDF term.
+        ndf_weight,
+        /// `Y`: where the NDF term saturates.
+        ndf_exponent_cap,
+        /// T3a stores `ln(g² + g_offset)`.
+        g_offset,
+        /// `ln C` is stored at least at `ln(value_floor · peak)`.
+        value_floor,
+        /// `κ`: softening of the NDF exponent.
+        ndf_softening,
+        /// `w_h`: weight of the horizon term.
+        horizon_weight,
+        /// `w_e`: weight of the edge term.
+        edge_weight,
+        /// `s_e`: smoothing of the edge term's onset.
+        edge_smoothing,
+        /// `τ_f`: the edge term fades out for edges near the horizon.
+        edge_fade_tan,
+    }
+}
+
+header_params! {
+    /// T4's generation parameters.
+    ShBrdfParams {
+        /// `L`, the largest degree stored.
+        band_limit,
+        /// `l_f` of the half-Gaussian band filter of \[WAT92\] §2.5: every
+        /// coefficient `M_jk` is multiplied by `h(l_j) h(l_k)`,
+        /// `h(l) = exp(−(l − l_f)² / (2 w²))` for `l > l_f`, 1 otherwise.
+        filter_start,
+        /// `w` of the band filter; 0 means no filter.
+        filter_width,
+        /// Wavelength of channel 0, µm (0 for an absent channel).
+        lambda_0,
+        /// Wavelength of channel 1, µm (0 for an absent channel).
+        lambda_1,
+        /// Wavelength of channel 2, µm (0 for an absent channel).
+        lambda_2,
+        /// `‖M − Mᵀ‖ / ‖M‖` before symmetrising, with the norm of (WAT92 27),
+        /// `‖A‖ = Σ|A_jk| / J²`, over the whole matrix; the largest over the
+        /// channels.
+        asymmetry_rel,
+        /// Gauss–Legendre nodes in `cos θ ∈ [0, 1]` of the projection.
+        theta_nodes,
+    }
+}
+
+impl ShBrdfParams {
+    /// The wavelength of each channel, µm (0 for absent channels).
+    pub fn wavelengths(&self) -> [f64; 3] {
+        [self.lambda_0, self.lambda_1, self.lambda_2]
     }
 }
 

@@ -66,7 +66,7 @@ impl Shard {
 fn fingerprint() -> u64 {
     let layout = format!(
         "{GENERATOR_VERSION}|{AXES:?}|{:?}|{CHANNELS}",
-        header_params(ANGLES, &ANGLE)
+        header_params(ANGLES, &ANGLE).to_values()
     );
     fnv1a(FNV_OFFSET, layout.as_bytes())
 }
