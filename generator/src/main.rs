@@ -668,7 +668,8 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
         let id = header.table_id;
         println!("  format version     {}", header.format_version);
         println!(
-            "  table              {} (id {}): {}",
+            "  table              T{} {} (tag {}): {}",
+            id.number(),
             id.name(),
             id.tag(),
             id.description()

@@ -52,7 +52,22 @@ pub const PAYLOAD_ALIGN: usize = 64;
 /// Size of [`Header`] in bytes.
 pub const HEADER_SIZE: usize = size_of::<Header>();
 
-/// Which quantity a table holds. The numeric tags are part of the file format.
+/// Which quantity a table holds.
+///
+/// Tables are known by their **T-number** ([`TableId::number`]: T1 … T5, in
+/// the docs, on the command line and in file names, `t3-convolution.tbl`).
+/// The file stores a different number, the **tag** ([`TableId::tag`]): tags
+/// are part of the file format and never change, and they were given in the
+/// order the tables were added (T5 took tag 3 before T3 existed; tag 5 is
+/// retired). This is the one place the two meet:
+///
+/// | T-number | variant | tag | file |
+/// |---|---|---|---|
+/// | T1 | [`SmithG1`](TableId::SmithG1) | 1 | `t1-smith-g1.tbl` |
+/// | T2 | [`SigmaRatio`](TableId::SigmaRatio) | 2 | `t2-sigma-ratio.tbl` |
+/// | T3 | [`Convolution`](TableId::Convolution) | 4 | `t3-convolution.tbl` |
+/// | T4 | [`ShBrdf`](TableId::ShBrdf) | 6 | `t4-<material>.tbl` |
+/// | T5 | [`DiffuseFresnel`](TableId::DiffuseFresnel) | 3 | `t5-diffuse-fresnel.tbl` |
 #[derive(
     TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq, Hash,
 )]
@@ -85,9 +100,21 @@ impl TableId {
         TableId::ShBrdf,
     ];
 
-    /// The tag stored in the file.
+    /// The tag stored in the file (see the type's documentation).
     pub const fn tag(self) -> u32 {
         self as u32
+    }
+
+    /// The T-number the docs and the command line use (`3` for T3; see the
+    /// type's documentation).
+    pub const fn number(self) -> u32 {
+        match self {
+            TableId::SmithG1 => 1,
+            TableId::SigmaRatio => 2,
+            TableId::Convolution => 3,
+            TableId::ShBrdf => 4,
+            TableId::DiffuseFresnel => 5,
+        }
     }
 
     /// The id with this tag, if any.
@@ -95,7 +122,9 @@ impl TableId {
         Self::ALL.into_iter().find(|id| id.tag() == tag)
     }
 
-    /// Short name, used for file names (`<name>.tbl`) and on the command line.
+    /// Short name, `t<number>-<quantity>`, used for file names (`<name>.tbl`)
+    /// and on the command line (T4's files add the material:
+    /// `t4-sh-brdf` names the kind, `t4-<material>.tbl` the files).
     pub const fn name(self) -> &'static str {
         match self {
             TableId::SmithG1 => "t1-smith-g1",
@@ -1245,5 +1274,29 @@ impl AlignedBuf {
     pub fn bytes_mut(&mut self) -> &mut [u8] {
         let len = self.len;
         &mut self.blocks.as_mut_bytes()[..len]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every table's name starts with its T-number, tags and T-numbers are
+    /// each unique, and a tag round-trips.
+    #[test]
+    fn names_carry_the_t_number() {
+        for id in TableId::ALL {
+            assert!(
+                id.name().starts_with(&format!("t{}-", id.number())),
+                "{id:?}"
+            );
+            assert_eq!(TableId::from_tag(id.tag()), Some(id));
+            for other in TableId::ALL {
+                if other != id {
+                    assert_ne!(other.number(), id.number());
+                    assert_ne!(other.tag(), id.tag());
+                }
+            }
+        }
     }
 }

@@ -57,7 +57,7 @@
 //! P̄_l^m = a_lm (x P̄_{l−1}^m − P̄_{l−2}^m / a_{l−1,m}),   a_lm = √((4l² − 1)/(l² − m²)).
 //! ```
 //!
-//! # File layout (table id 6, `t4-<material>.tbl`)
+//! # File layout (T4, `t4-<material>.tbl`)
 //!
 //! One axis, `coefficient`, of [`coefficient_count`]`(L)` nodes (uniform,
 //! `0 ..= count − 1`; the axis is an index, nothing is interpolated), one
