@@ -751,7 +751,8 @@ fn query(quantity: &str, tables: &Path) -> Result<ExitCode, String> {
         BufReader::new(stdin.lock()),
         &mut out,
         std::io::stderr(),
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     out.flush().map_err(|e| format!("writing output: {e}"))?;
     if summary.bad > 0 {
         eprintln!(
