@@ -150,7 +150,7 @@ pub const VALUE_FLOOR: f64 = 1e-12;
 pub const CHANNELS: usize = FIT_CHANNELS + ANGLES;
 
 mod shard;
-pub use shard::Shard;
+pub use shard::{Shard, ShardError};
 
 /// The T3 builder.
 pub struct Conv;
@@ -306,7 +306,7 @@ pub fn work(shard: Option<Shard>) -> u64 {
 /// The bytes of the shard file of `shard` (see [`Shard`]).
 pub fn build_shard(shard: Shard, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
     let indices: Vec<usize> = shard.indices().collect();
-    shard::encode(shard, &compute_nodes(&indices, progress)?)
+    Ok(shard::encode(shard, &compute_nodes(&indices, progress)?)?)
 }
 
 /// The table from the shard files `files` (name, bytes) of one `N`-way
