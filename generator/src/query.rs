@@ -62,7 +62,7 @@ impl Quantity {
             .ok_or_else(|| QueryError::UnknownQuantity(name.to_string()))
     }
 
-    /// The input columns, in the order [`Self::evaluate`] reads them.
+    /// The input columns, in the order the evaluation reads them.
     pub const fn columns(self) -> &'static [&'static str] {
         match self {
             Quantity::G1 => &["p", "a"],
@@ -76,7 +76,7 @@ impl Quantity {
         }
     }
 
-    /// The output columns, in the order [`Self::evaluate`] returns them.
+    /// The output columns, in the order the evaluation returns them.
     pub const fn outputs(self) -> &'static [&'static str] {
         match self {
             Quantity::Conv => &["fit", "table", "reference"],
@@ -84,7 +84,7 @@ impl Quantity {
         }
     }
 
-    /// Whether [`Self::evaluate`] reads the table files.
+    /// Whether the evaluation reads the table files.
     pub const fn uses_tables(self) -> bool {
         !matches!(self, Quantity::Fresnel)
     }
