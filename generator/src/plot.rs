@@ -301,13 +301,15 @@ fn table_bytes(dir: &Path, id: TableId) -> Result<twoscale::format::AlignedBuf, 
     Ok(aligned_copy(&bytes))
 }
 
+/// The error of table `id`'s file being malformed.
+fn malformed(table: TableId) -> impl FnOnce(FormatError) -> PlotError {
+    move |source| PlotError::Format { table, source }
+}
+
 /// T1's errors at `verify`'s points: `(p, log10 a, |G1 − G1_ref|)`.
 pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
     let buf = table_bytes(dir, TableId::SmithG1)?;
-    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(|source| PlotError::Format {
-        table: TableId::SmithG1,
-        source,
-    })?;
+    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(malformed(TableId::SmithG1))?;
     t1::verification_points(points, seed)
         .par_iter()
         .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), t1::error_at(&table, p, a)?)))
@@ -318,10 +320,7 @@ pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotEr
 /// T2's errors at `verify`'s points: `(θi in degrees, log10 B, relative error)`.
 pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
     let buf = table_bytes(dir, TableId::SigmaRatio)?;
-    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(|source| PlotError::Format {
-        table: TableId::SigmaRatio,
-        source,
-    })?;
+    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(malformed(TableId::SigmaRatio))?;
     t2::verification_points(points, seed)
         .par_iter()
         .map(|&(cos_i, big_b, c)| {
@@ -339,10 +338,7 @@ pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotEr
 /// `([u, c, β, p], e_L2)`.
 pub fn t3_errors(dir: &Path, points: usize, seed: u64) -> Result<Vec<([f64; 4], f64)>, PlotError> {
     let buf = table_bytes(dir, TableId::Convolution)?;
-    let table = ConvTable::from_bytes(buf.bytes()).map_err(|source| PlotError::Format {
-        table: TableId::Convolution,
-        source,
-    })?;
+    let table = ConvTable::from_bytes(buf.bytes()).map_err(malformed(TableId::Convolution))?;
     t3::verification_points(t3::profiles_for(points), seed)
         .par_iter()
         .map(|&pt| Ok((pt, t3::verify_point(&table, pt)?.accurate_e_l2)))
