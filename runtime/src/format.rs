@@ -1112,7 +1112,8 @@ pub mod write {
         pub value_type: ValueType,
         /// Used axes, in storage order.
         pub axes: &'v [AxisHeader],
-        /// Generation parameters, in the order of [`TableId::param_names`].
+        /// Generation parameters, in the order of [`TableId::param_names`]
+        /// (the table's parameter struct's `to_values()`, e.g. [`ConvParams::to_values`]).
         pub params: &'v [f64],
         /// Grid values, row-major, channels innermost.
         pub grid: &'v [f32],
