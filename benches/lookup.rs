@@ -115,28 +115,6 @@ fn sigma_ratio(c: &mut Criterion) {
             sum
         })
     });
-    // One material (B = 9.2, c = 2.6), varying incidence: the per-material
-    // slice (4 taps) against the full lookup on the same inputs.
-    let slice = table.slice(9.2, 2.6);
-    group.bench_function("t2_table_one_material", |b| {
-        b.iter(|| {
-            let mut sum = 0.0f32;
-            for &(cos_theta_i, _, _) in &points {
-                sum +=
-                    table.sigma_ratio_cos(black_box(cos_theta_i), black_box(9.2), black_box(2.6));
-            }
-            sum
-        })
-    });
-    group.bench_function("t2_slice_one_material", |b| {
-        b.iter(|| {
-            let mut sum = 0.0f32;
-            for &(cos_theta_i, _, _) in &points {
-                sum += slice.sigma_ratio_cos(black_box(cos_theta_i));
-            }
-            sum
-        })
-    });
     group.finish();
 
     const REFERENCE_BATCH: usize = 64;

@@ -67,7 +67,8 @@ fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f
                 ndf_softening: 1e-6,
                 ..t3::ANGLE
             },
-        ),
+        )
+        .to_values(),
         grid: &grid,
         aux: &[],
         generator_version: "test",

@@ -5,7 +5,7 @@ use generator::query;
 use generator::reference::epd;
 use generator::rng::SplitMix64;
 
-fn run(input: &str) -> (Result<query::Summary, String>, String, String) {
+fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
     let mut out = Vec::new();
     let mut err = Vec::new();
     let result = query::run(
@@ -53,9 +53,16 @@ fn bad_rows_are_reported_and_the_others_answered() {
 #[test]
 fn header_and_quantity_errors_fail_fast() {
     let (result, _, _) = run("p,b\n1,2\n");
-    assert!(result.unwrap_err().contains("lacks column 'a'"));
+    let e = result.unwrap_err();
+    assert!(
+        matches!(e, query::QueryError::MissingColumn { column: "a", .. }),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("lacks column 'a'"), "{e}");
     let (result, _, _) = run("");
-    assert!(result.unwrap_err().contains("header"));
+    let e = result.unwrap_err();
+    assert!(matches!(e, query::QueryError::EmptyInput), "{e:?}");
+    assert!(e.to_string().contains("header"), "{e}");
     let mut sink = Vec::new();
     let unknown = query::run(
         "nope",
@@ -64,7 +71,12 @@ fn header_and_quantity_errors_fail_fast() {
         &mut sink,
         &mut Vec::new(),
     );
-    assert!(unknown.unwrap_err().contains("unknown quantity"));
+    let e = unknown.unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("unknown quantity 'nope' (known: g1, sigma-ratio, fresnel, conv, brdf)"),
+        "{e}"
+    );
 }
 
 /// Random points: `table` within 2e-5 of the reference, and `reference`

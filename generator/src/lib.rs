@@ -7,12 +7,14 @@
 //! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
 //!   forms of the convolution, table T3);
 //! - [`query`]: the batch CSV queries of docs/model.md §6;
+//! - [`error`]: what a `generator` subcommand can fail with;
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
 //! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod analytic;
 pub mod bspline;
+pub mod error;
 pub mod fit;
 pub mod materials;
 pub mod plot;

@@ -16,6 +16,7 @@ use twoscale::interp::node_value;
 use twoscale::mmap::MappedFile;
 use zerocopy::TryFromBytes;
 
+use generator::error::{Error, FileAction};
 use generator::materials::Materials;
 use generator::report::{self, TableReport};
 use generator::tables::t4::{Projected, ShBrdf};
@@ -246,20 +247,20 @@ fn main() -> ExitCode {
     }
 }
 
-fn set_threads(threads: Option<usize>) -> Result<(), String> {
+fn set_threads(threads: Option<usize>) -> Result<(), Error> {
     if let Some(n) = threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
-            .map_err(|e| format!("cannot set {n} threads: {e}"))?;
+            .map_err(|source| Error::Threads { threads: n, source })?;
     }
     Ok(())
 }
 
 /// The T4 builders of the materials file, projecting the two-scale model
 /// with the tables of `dir` (or the workspace's: `t4::input_dir`).
-fn material_tables(materials: &Path, dir: &Path) -> Result<Vec<ShBrdf>, String> {
-    let materials = Materials::load(materials).map_err(|e| e.to_string())?;
+fn material_tables(materials: &Path, dir: &Path) -> Result<Vec<ShBrdf>, Error> {
+    let materials = Materials::load(materials)?;
     Ok(ShBrdf::all(
         &materials,
         &Projected::TwoScale {
@@ -278,7 +279,7 @@ fn catalogue(t4: &[ShBrdf]) -> Vec<&dyn TableKind> {
 /// The tables named: a name selects the table whose file stem it is, else
 /// the tables whose stems start with it, if they are all of one table id
 /// (so `t4` selects every material's T4).
-fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableKind>, String> {
+fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableKind>, Error> {
     let all = catalogue(t4);
     if names.is_empty() {
         return Ok(all);
@@ -296,20 +297,20 @@ fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableK
         let one_id = matches.windows(2).all(|w| w[0].id() == w[1].id());
         if matches.is_empty() || !one_id {
             let known: Vec<_> = all.iter().map(|t| t.file_stem()).collect();
-            return Err(format!(
+            return Err(Error::Usage(format!(
                 "unknown or ambiguous table '{n}' (known: {})",
                 known.join(", ")
-            ));
+            )));
         }
         chosen.extend(matches.into_iter().copied());
     }
     Ok(chosen)
 }
 
-fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, String> {
+fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, Error> {
     let t4 = material_tables(materials, out)?;
     let kinds = selected(names, &t4)?;
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(Error::file(FileAction::Create, out))?;
     let out = &std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     let total = Instant::now();
     let mut announced = false;
@@ -326,9 +327,9 @@ fn build(names: &[String], out: &Path, materials: &Path) -> Result<ExitCode, Str
         let bytes = with_progress(&stem, kind.work_items(), kind.work_unit(), |progress| {
             kind.build(progress)
         })
-        .map_err(|e| format!("{stem}: {e}"))?;
+        .map_err(Error::table(&stem))?;
         let path = out.join(format!("{stem}.tbl"));
-        write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        write_atomic(&path, &bytes).map_err(Error::file(FileAction::Write, &path))?;
         eprintln!(
             "built {} ({} bytes, {} {}) in {:.1} s -> {}",
             stem,
@@ -375,23 +376,25 @@ fn build_shard(
     out: &Path,
     materials: &Path,
     shard: &str,
-) -> Result<ExitCode, String> {
+) -> Result<ExitCode, Error> {
     let shard = tables::t3::Shard::parse(shard)?;
     let t4 = material_tables(materials, out)?;
     let kinds = selected(names, &t4)?;
     if names.is_empty() || kinds.iter().any(|k| k.id() != TableId::Convolution) {
-        return Err("--shard applies to T3 alone: `build t3 --shard K/N`".into());
+        return Err(Error::Usage(
+            "--shard applies to T3 alone: `build t3 --shard K/N`".into(),
+        ));
     }
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(Error::file(FileAction::Create, out))?;
     let name = shard.file_name();
     let start = Instant::now();
     let work = tables::t3::work(Some(shard));
     let bytes = with_progress(&name, work, tables::t3::Conv.work_unit(), |progress| {
         tables::t3::build_shard(shard, progress)
     })
-    .map_err(|e| format!("{name}: {e}"))?;
+    .map_err(Error::table(&name))?;
     let path = out.join(&name);
-    write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    write_atomic(&path, &bytes).map_err(Error::file(FileAction::Write, &path))?;
     eprintln!(
         "built {name} ({} bytes) in {:.1} s -> {}",
         bytes.len(),
@@ -402,19 +405,22 @@ fn build_shard(
 }
 
 /// `merge`: T3 from its shard files.
-fn merge(shards: &[PathBuf], out: &Path) -> Result<ExitCode, String> {
+fn merge(shards: &[PathBuf], out: &Path) -> Result<ExitCode, Error> {
     let files = shards
         .iter()
         .map(|p| {
             std::fs::read(p)
                 .map(|bytes| (p.display().to_string(), bytes))
-                .map_err(|e| format!("cannot read {}: {e}", p.display()))
+                .map_err(Error::file(FileAction::Read, p))
         })
-        .collect::<Result<Vec<_>, String>>()?;
-    let bytes = tables::t3::merge(&files).map_err(|e| e.to_string())?;
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+        .collect::<Result<Vec<_>, Error>>()?;
+    let bytes = tables::t3::merge(&files).map_err(|e| match e {
+        tables::BuildError::Shard(e) => Error::Shard(e),
+        e => Error::table(TableId::Convolution.name())(e),
+    })?;
+    std::fs::create_dir_all(out).map_err(Error::file(FileAction::Create, out))?;
     let path = out.join(tables::file_name(TableId::Convolution));
-    write_atomic(&path, &bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    write_atomic(&path, &bytes).map_err(Error::file(FileAction::Write, &path))?;
     eprintln!(
         "merged {} shards ({} bytes) -> {}",
         files.len(),
@@ -457,7 +463,7 @@ fn spot_check(
     dir: &Path,
     materials: &Path,
     nodes: usize,
-) -> Result<ExitCode, String> {
+) -> Result<ExitCode, Error> {
     let t4 = material_tables(materials, dir)?;
     let kinds = selected(names, &t4)?;
     let mut failed = false;
@@ -466,8 +472,7 @@ fn spot_check(
         let stem = kind.file_stem();
         let path = dir.join(format!("{stem}.tbl"));
         let start = Instant::now();
-        let file =
-            MappedFile::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let file = MappedFile::open(&path).map_err(Error::file(FileAction::Open, &path))?;
         let Some(outcome) = kind.spot_check(file.bytes(), nodes) else {
             if !names.is_empty() {
                 eprintln!("{stem}: no spot check (rebuild it whole instead)");
@@ -475,7 +480,7 @@ fn spot_check(
             continue;
         };
         any = true;
-        let check = outcome.map_err(|e| format!("{stem}: {e}"))?;
+        let check = outcome.map_err(Error::table(&stem))?;
         if check.mismatched.is_empty() {
             println!(
                 "{stem}: {} nodes recomputed bit-identically in {:.1} s",
@@ -493,7 +498,9 @@ fn spot_check(
         }
     }
     if !any {
-        return Err("none of the selected tables has a spot check".into());
+        return Err(Error::Usage(
+            "none of the selected tables has a spot check".into(),
+        ));
     }
     Ok(if failed {
         ExitCode::FAILURE
@@ -509,7 +516,7 @@ fn verify(
     points: usize,
     seed: u64,
     markdown: Option<&Path>,
-) -> Result<ExitCode, String> {
+) -> Result<ExitCode, Error> {
     let t4 = material_tables(materials, dir)?;
     let mut reports = Vec::new();
     for kind in selected(names, &t4)? {
@@ -517,15 +524,17 @@ fn verify(
         let stem = kind.file_stem();
         let path = dir.join(format!("{stem}.tbl"));
         let outcome = MappedFile::open(&path)
-            .map_err(|e| format!("cannot open {}: {e}", path.display()))
+            .map_err(Error::file(FileAction::Open, &path))
             .and_then(|file| {
                 let size = file.bytes().len() as u64;
-                Table::from_bytes_expecting(file.bytes(), id)
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                Table::from_bytes_expecting(file.bytes(), id).map_err(|source| Error::Format {
+                    path: path.clone(),
+                    source,
+                })?;
                 let start = Instant::now();
                 let accuracy = kind
                     .verify(file.bytes(), points, seed)
-                    .map_err(|e| format!("{stem}: {e}"))?;
+                    .map_err(Error::table(&stem))?;
                 eprintln!(
                     "verified {} at {points} points in {:.1} s",
                     stem,
@@ -553,7 +562,7 @@ fn verify(
             command.push_str(&format!(" --table {n}"));
         }
         write_atomic(file, report::markdown(&command, &reports).as_bytes())
-            .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
+            .map_err(Error::file(FileAction::Write, file))?;
     }
     Ok(if reports.iter().all(TableReport::passed) {
         ExitCode::SUCCESS
@@ -574,20 +583,19 @@ struct PlotArgs {
     font: PathBuf,
 }
 
-fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
+fn plot(args: &PlotArgs) -> Result<ExitCode, Error> {
     use generator::plot;
     plot::load_font(&args.font)?;
-    let materials = Materials::load(&args.materials).map_err(|e| e.to_string())?;
+    let materials = Materials::load(&args.materials)?;
     for name in &args.only {
         if !materials.materials.iter().any(|m| &m.name == name) {
-            return Err(format!(
+            return Err(Error::Usage(format!(
                 "no material {name} in {}",
                 args.materials.display()
-            ));
+            )));
         }
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out).map_err(Error::file(FileAction::Create, &args.out))?;
     let out = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
     // The green channel (as T4's band-limit study).
     let channel = 1;
@@ -646,11 +654,10 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
+fn inspect(files: &[PathBuf]) -> Result<ExitCode, Error> {
     let mut failed = false;
     for path in files {
-        let file =
-            MappedFile::open(path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let file = MappedFile::open(path).map_err(Error::file(FileAction::Open, path))?;
         let bytes = file.bytes();
         println!("{}  ({} bytes)", path.display(), bytes.len());
         let Some(header) = bytes
@@ -668,7 +675,8 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
         let id = header.table_id;
         println!("  format version     {}", header.format_version);
         println!(
-            "  table              {} (id {}): {}",
+            "  table              T{} {} (tag {}): {}",
+            id.number(),
             id.name(),
             id.tag(),
             id.description()
@@ -740,7 +748,7 @@ fn inspect(files: &[PathBuf]) -> Result<ExitCode, String> {
     })
 }
 
-fn query(quantity: &str, tables: &Path) -> Result<ExitCode, String> {
+fn query(quantity: &str, tables: &Path) -> Result<ExitCode, Error> {
     let stdin = std::io::stdin();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
@@ -751,7 +759,8 @@ fn query(quantity: &str, tables: &Path) -> Result<ExitCode, String> {
         &mut out,
         std::io::stderr(),
     )?;
-    out.flush().map_err(|e| format!("writing output: {e}"))?;
+    out.flush()
+        .map_err(|e| Error::Query(generator::query::QueryError::Write(e)))?;
     if summary.bad > 0 {
         eprintln!(
             "{} row(s) answered, {} bad row(s) reported above",

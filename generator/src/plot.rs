@@ -21,9 +21,10 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
 use twoscale::format::aligned_copy;
-use twoscale::{ConvTable, SigmaRatioTable, SmithG1Table, TableId};
+use twoscale::{ConvTable, FormatError, SigmaRatioTable, SmithG1Table, TableId};
 
 /// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
 pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -37,22 +38,93 @@ const SIZE: (u32, u32) = (800, 540);
 /// The font family name the pictures use.
 const FONT: &str = "sans-serif";
 
+/// Why a picture could not be drawn.
+#[derive(Debug)]
+pub enum PlotError {
+    /// The font file could not be read.
+    FontUnreadable {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The font file is not a TrueType font.
+    NotAFont(PathBuf),
+    /// A table file could not be read.
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A table file is malformed.
+    Format {
+        /// Which table.
+        table: TableId,
+        /// What is wrong.
+        source: FormatError,
+    },
+    /// The tables could not be loaded or an error could not be measured.
+    Table(BuildError),
+    /// The material's BRDF is zero everywhere (nothing to draw on a log scale).
+    ZeroBrdf(String),
+    /// plotters failed (its error, as it formats it).
+    Draw(String),
+}
+
+impl fmt::Display for PlotError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlotError::FontUnreadable { path, source } => write!(
+                f,
+                "cannot read the font {} ({source}); install fonts-dejavu-core or pass --font",
+                path.display()
+            ),
+            PlotError::NotAFont(path) => write!(f, "{} is not a TrueType font", path.display()),
+            PlotError::Read { path, source } => {
+                write!(f, "cannot read {}: {source}", path.display())
+            }
+            PlotError::Format { table, source } => write!(f, "{}: {source}", table.name()),
+            PlotError::Table(e) => write!(f, "{e}"),
+            PlotError::ZeroBrdf(material) => write!(f, "{material}: the BRDF is zero everywhere"),
+            PlotError::Draw(e) => write!(f, "drawing failed: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for PlotError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PlotError::FontUnreadable { source, .. } | PlotError::Read { source, .. } => {
+                Some(source)
+            }
+            PlotError::Format { source, .. } => Some(source),
+            PlotError::Table(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<BuildError> for PlotError {
+    fn from(e: BuildError) -> Self {
+        PlotError::Table(e)
+    }
+}
+
 /// Reads the TrueType file at `path` and registers it as the pictures' font.
-pub fn load_font(path: &Path) -> Result<(), String> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        format!(
-            "cannot read the font {} ({e}); install fonts-dejavu-core or pass --font",
-            path.display()
-        )
+pub fn load_font(path: &Path) -> Result<(), PlotError> {
+    let bytes = std::fs::read(path).map_err(|source| PlotError::FontUnreadable {
+        path: path.to_path_buf(),
+        source,
     })?;
     // plotters keeps fonts for the life of the process.
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
     plotters::style::register_font(FONT, FontStyle::Normal, bytes)
-        .map_err(|_| format!("{} is not a TrueType font", path.display()))
+        .map_err(|_| PlotError::NotAFont(path.to_path_buf()))
 }
 
-fn draw_error(e: impl std::fmt::Debug) -> String {
-    format!("drawing failed: {e:?}")
+fn draw_error(e: impl fmt::Debug) -> PlotError {
+    PlotError::Draw(format!("{e:?}"))
 }
 
 /// One term of the BRDF, as drawn.
@@ -105,9 +177,9 @@ pub fn lobes(
     lambda: f64,
     tables_dir: &Path,
     path: &Path,
-) -> Result<(), String> {
-    let inputs = ModelInputs::load(tables_dir).map_err(|e| e.to_string())?;
-    let parsed = inputs.parse().map_err(|e| e.to_string())?;
+) -> Result<(), PlotError> {
+    let inputs = ModelInputs::load(tables_dir)?;
+    let parsed = inputs.parse()?;
     let tables = parsed.brdf_tables();
     let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
     // Per incidence: θo and the terms at each.
@@ -133,7 +205,7 @@ pub fn lobes(
         .flat_map(|(_, _, v)| v.iter().map(|t| t[0]))
         .fold(0.0f64, f64::max);
     if !(peak > 0.0 && peak.is_finite()) {
-        return Err(format!("{}: the BRDF is zero everywhere", material.name));
+        return Err(PlotError::ZeroBrdf(material.name.clone()));
     }
     let hi = 10f64.powf(peak.log10().ceil() + 0.3);
     let lo = hi * 1e-6;
@@ -223,27 +295,32 @@ pub fn lobes(
 pub type Samples = Vec<(f64, f64, f64)>;
 
 /// The file of table `id` in `dir`, aligned.
-fn table_bytes(dir: &Path, id: TableId) -> Result<twoscale::format::AlignedBuf, String> {
+fn table_bytes(dir: &Path, id: TableId) -> Result<twoscale::format::AlignedBuf, PlotError> {
     let path = dir.join(file_name(id));
-    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let bytes = std::fs::read(&path).map_err(|source| PlotError::Read { path, source })?;
     Ok(aligned_copy(&bytes))
 }
 
+/// The error of table `id`'s file being malformed.
+fn malformed(table: TableId) -> impl FnOnce(FormatError) -> PlotError {
+    move |source| PlotError::Format { table, source }
+}
+
 /// T1's errors at `verify`'s points: `(p, log10 a, |G1 − G1_ref|)`.
-pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, String> {
+pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
     let buf = table_bytes(dir, TableId::SmithG1)?;
-    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(malformed(TableId::SmithG1))?;
     t1::verification_points(points, seed)
         .par_iter()
         .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), t1::error_at(&table, p, a)?)))
         .collect::<Result<_, BuildError>>()
-        .map_err(|e| e.to_string())
+        .map_err(PlotError::Table)
 }
 
 /// T2's errors at `verify`'s points: `(θi in degrees, log10 B, relative error)`.
-pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, String> {
+pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
     let buf = table_bytes(dir, TableId::SigmaRatio)?;
-    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(malformed(TableId::SigmaRatio))?;
     t2::verification_points(points, seed)
         .par_iter()
         .map(|&(cos_i, big_b, c)| {
@@ -254,19 +331,19 @@ pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, String
             ))
         })
         .collect::<Result<_, BuildError>>()
-        .map_err(|e| e.to_string())
+        .map_err(PlotError::Table)
 }
 
 /// T3b's e_L2 at `verify`'s profiles (`t3::profiles_for(points)` of them):
 /// `([u, c, β, p], e_L2)`.
-pub fn t3_errors(dir: &Path, points: usize, seed: u64) -> Result<Vec<([f64; 4], f64)>, String> {
+pub fn t3_errors(dir: &Path, points: usize, seed: u64) -> Result<Vec<([f64; 4], f64)>, PlotError> {
     let buf = table_bytes(dir, TableId::Convolution)?;
-    let table = ConvTable::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
+    let table = ConvTable::from_bytes(buf.bytes()).map_err(malformed(TableId::Convolution))?;
     t3::verification_points(t3::profiles_for(points), seed)
         .par_iter()
         .map(|&pt| Ok((pt, t3::verify_point(&table, pt)?.accurate_e_l2)))
         .collect::<Result<_, BuildError>>()
-        .map_err(|e| e.to_string())
+        .map_err(PlotError::Table)
 }
 
 /// A 2-D view of a domain: ranges and axis descriptions.
@@ -314,7 +391,7 @@ fn color_bar(
     area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
     scale: &Scale,
     what: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let mut chart = ChartBuilder::on(area)
         .margin_top(40)
         .margin_bottom(40)
@@ -349,7 +426,7 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// A picture at `path` with `title`: the whole canvas, the plot area and the
 /// colour bar's area.
-fn canvas<'a>(path: &'a Path, title: &str) -> Result<(Area<'a>, Area<'a>, Area<'a>), String> {
+fn canvas<'a>(path: &'a Path, title: &str) -> Result<(Area<'a>, Area<'a>, Area<'a>), PlotError> {
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_error)?;
     let titled = root.titled(title, (FONT, 18)).map_err(draw_error)?;
@@ -364,8 +441,10 @@ fn axes<'a, 'b>(
     x: (f64, f64, &str),
     y: (f64, f64, &str),
     mesh: bool,
-) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
-{
+) -> Result<
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    PlotError,
+> {
     let mut chart = ChartBuilder::on(area)
         .margin(10)
         .x_label_area_size(40)
@@ -395,7 +474,7 @@ pub fn heat_map(
     samples: &Samples,
     bins: (usize, usize),
     what: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let (nx, ny) = bins;
     let (x0, x1, y0, y1) = (view.x.0, view.x.1, view.y.0, view.y.1);
     let index = |v: f64, lo: f64, hi: f64, n: usize| {
@@ -430,7 +509,7 @@ pub fn heat_map(
 
 /// The T3 map: one marker per profile in two views, `(ln u, ln β)` and
 /// `(c, p)`, coloured by T3b's e_L2.
-pub fn t3_map(path: &Path, profiles: &[([f64; 4], f64)], title: &str) -> Result<(), String> {
+pub fn t3_map(path: &Path, profiles: &[([f64; 4], f64)], title: &str) -> Result<(), PlotError> {
     let scale = Scale::of(profiles.iter().map(|p| p.1));
     let (root, main, bar) = canvas(path, title)?;
     let panels = main.split_evenly((1, 2));

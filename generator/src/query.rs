@@ -9,26 +9,288 @@
 //! Rows are evaluated in parallel and written in input order.
 
 use rayon::prelude::*;
+use std::fmt;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use twoscale::{Convolution, TableSet};
+use twoscale::{Convolution, TableSet, TableSetError};
 
 use crate::reference::{brdf, conv, epd, fresnel, kcorr};
 
-/// Quantities that can be queried, with their input columns.
-pub const QUANTITIES: &[(&str, &[&str])] = &[
-    ("g1", &["p", "a"]),
-    ("sigma-ratio", &["theta_i", "B", "c"]),
-    ("fresnel", &["n", "k", "cos_theta"]),
-    ("conv", &["u", "c", "beta", "p", "theta_h"]),
-    (
-        "brdf",
-        &[
-            "beta", "p", "sigma_s", "b", "c", "n", "k", "lambda", "ix", "iy", "iz", "ox", "oy",
-            "oz",
-        ],
-    ),
-];
+/// A quantity `query` answers: each variant's name, input columns, output
+/// columns and evaluation are defined by the methods below, one `match` arm
+/// each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Smith G1 (T1).
+    G1,
+    /// σrel/σs (T2).
+    SigmaRatio,
+    /// Fresnel reflectance (no table: the runtime's f32 Fresnel).
+    Fresnel,
+    /// The convolution C (T3a and T3b).
+    Conv,
+    /// The conductor two-scale BRDF (docs/model.md §6).
+    Brdf,
+}
+
+impl Quantity {
+    /// Every quantity, in the order `--help` and errors list them.
+    pub const ALL: [Quantity; 5] = [
+        Quantity::G1,
+        Quantity::SigmaRatio,
+        Quantity::Fresnel,
+        Quantity::Conv,
+        Quantity::Brdf,
+    ];
+
+    /// The name on the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Quantity::G1 => "g1",
+            Quantity::SigmaRatio => "sigma-ratio",
+            Quantity::Fresnel => "fresnel",
+            Quantity::Conv => "conv",
+            Quantity::Brdf => "brdf",
+        }
+    }
+
+    /// The quantity called `name`.
+    pub fn from_name(name: &str) -> Result<Quantity, QueryError> {
+        Self::ALL
+            .into_iter()
+            .find(|q| q.name() == name)
+            .ok_or_else(|| QueryError::UnknownQuantity(name.to_string()))
+    }
+
+    /// The input columns, in the order the evaluation reads them.
+    pub const fn columns(self) -> &'static [&'static str] {
+        match self {
+            Quantity::G1 => &["p", "a"],
+            Quantity::SigmaRatio => &["theta_i", "B", "c"],
+            Quantity::Fresnel => &["n", "k", "cos_theta"],
+            Quantity::Conv => &["u", "c", "beta", "p", "theta_h"],
+            Quantity::Brdf => &[
+                "beta", "p", "sigma_s", "b", "c", "n", "k", "lambda", "ix", "iy", "iz", "ox", "oy",
+                "oz",
+            ],
+        }
+    }
+
+    /// The output columns, in the order the evaluation returns them.
+    pub const fn outputs(self) -> &'static [&'static str] {
+        match self {
+            Quantity::Conv => &["fit", "table", "reference"],
+            _ => &["table", "reference"],
+        }
+    }
+
+    /// Whether the evaluation reads the table files.
+    pub const fn uses_tables(self) -> bool {
+        !matches!(self, Quantity::Fresnel)
+    }
+
+    /// The output values for inputs `x` (in the order of [`Self::columns`]),
+    /// with the runtime reading `set` (`None` only if not
+    /// [`Self::uses_tables`]), or why there are none.
+    fn evaluate(self, set: Option<&TableSet>, x: &[f64]) -> Result<Vec<String>, RowError> {
+        let set = || set.ok_or(RowError::NoTables);
+        let reference = |e: &dyn fmt::Display| RowError::Reference(e.to_string());
+        Ok(match self {
+            Quantity::G1 => {
+                let (p, a) = (x[0], x[1]);
+                let reference = epd::g1(p, a).map_err(|e| reference(&e))?;
+                let table = set()?.smith.g1(p as f32, a as f32);
+                vec![table.to_string(), reference.to_string()]
+            }
+            Quantity::SigmaRatio => {
+                let (theta_i, big_b, c) = (x[0], x[1], x[2]);
+                let reference = kcorr::sigma_ratio(theta_i, big_b, c).map_err(|e| reference(&e))?;
+                let table = set()?
+                    .sigma_ratio
+                    .sigma_ratio(theta_i as f32, big_b as f32, c as f32);
+                vec![table.to_string(), reference.to_string()]
+            }
+            Quantity::Fresnel => {
+                // `table` is the runtime's f32 Fresnel (computed in f64
+                // inside), `reference` the f64 reference.
+                let (n, k, cos_theta) = (x[0], x[1], x[2]);
+                let reference = fresnel::fresnel(fresnel::Complex64::new(n, k), cos_theta)
+                    .map_err(|e| reference(&e))?;
+                let eta = twoscale::Complex::new(n as f32, k as f32);
+                let table = twoscale::fresnel::fresnel(eta, cos_theta as f32);
+                vec![table.to_string(), reference.to_string()]
+            }
+            Quantity::Conv => {
+                // `fit` = T3a (the paper's s, g form), `table` = T3b, both
+                // from the runtime; `reference` = exact C by direct quadrature.
+                let (u, c, beta, p, theta_h) = (x[0], x[1], x[2], x[3], x[4]);
+                let reference =
+                    conv::convolution(theta_h, u, c, beta, p).map_err(|e| reference(&e))?;
+                let table = &set()?.convolution;
+                let (sin, cos) = (theta_h.sin() as f32, theta_h.cos() as f32);
+                let (u, c, beta, p) = (u as f32, c as f32, beta as f32, p as f32);
+                vec![
+                    table
+                        .fit()
+                        .convolution_sin_cos(sin, cos, u, c, beta, p)
+                        .to_string(),
+                    table
+                        .convolution_sin_cos(sin, cos, u, c, beta, p)
+                        .to_string(),
+                    reference.to_string(),
+                ]
+            }
+            Quantity::Brdf => {
+                // docs/model.md §6: the conductor two-scale model. `table` is
+                // the runtime model (`twoscale::brdf::TwoScale`, f32, baked
+                // from the table set: the path a renderer calls);
+                // `reference` is `reference::brdf::two_scale` (exact Λ,
+                // σrel, C).
+                let params = brdf::Params {
+                    beta: x[0],
+                    p: x[1],
+                    sigma_s: x[2],
+                    b: x[3],
+                    c: x[4],
+                    n: x[5],
+                    k: x[6],
+                    lambda: x[7],
+                };
+                let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
+                let options = twoscale::brdf::Options::default();
+                let reference =
+                    brdf::two_scale(&params, i, o, &options).map_err(|e| reference(&e))?;
+                let f = |v: f64| v as f32;
+                let layer = twoscale::brdf::Layer {
+                    surface: twoscale::brdf::Surface {
+                        beta: f(params.beta),
+                        p: f(params.p),
+                        sigma_s: f(params.sigma_s),
+                        b: f(params.b),
+                        c: f(params.c),
+                    },
+                    base: twoscale::brdf::BaseLayer::Conductor,
+                    lambertian: 0.0,
+                };
+                let model = twoscale::TwoScale::new(
+                    &set()?.brdf_tables(),
+                    layer,
+                    f(params.lambda),
+                    twoscale::Complex::new(f(params.n), f(params.k)),
+                    options,
+                );
+                let table = model.eval(i.map(f), o.map(f));
+                vec![table.to_string(), reference.total().to_string()]
+            }
+        })
+    }
+}
+
+/// Why a query could not run (before any row is answered, or while writing).
+#[derive(Debug)]
+pub enum QueryError {
+    /// No quantity has this name.
+    UnknownQuantity(String),
+    /// The input has no header line.
+    EmptyInput,
+    /// The input could not be read.
+    Read(std::io::Error),
+    /// The header lacks one of the quantity's input columns.
+    MissingColumn {
+        /// The column missing.
+        column: &'static str,
+        /// The quantity's input columns.
+        needs: &'static [&'static str],
+    },
+    /// The table files could not be opened.
+    Tables(TableSetError),
+    /// The output could not be written.
+    Write(std::io::Error),
+}
+
+impl fmt::Display for QueryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            QueryError::UnknownQuantity(name) => {
+                let known: Vec<_> = Quantity::ALL.iter().map(|q| q.name()).collect();
+                write!(f, "unknown quantity '{name}' (known: {})", known.join(", "))
+            }
+            QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
+            QueryError::Read(e) => write!(f, "reading input: {e}"),
+            QueryError::MissingColumn { column, needs } => {
+                write!(
+                    f,
+                    "header lacks column '{column}' (needs {})",
+                    needs.join(",")
+                )
+            }
+            QueryError::Tables(e) => write!(f, "{e} (build the tables with `generator build`)"),
+            QueryError::Write(e) => write!(f, "writing output: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for QueryError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            QueryError::Read(e) | QueryError::Write(e) => Some(e),
+            QueryError::Tables(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// Why one row was not answered (reported on the error stream with its line
+/// number: `line N: …`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum RowError {
+    /// The row has another number of fields than the header.
+    FieldCount {
+        /// Fields in the row.
+        found: usize,
+        /// Fields in the header.
+        expected: usize,
+    },
+    /// An input field is not a number.
+    NotANumber {
+        /// Its column.
+        column: &'static str,
+        /// The field's text.
+        field: String,
+    },
+    /// An input field is NaN or infinite.
+    NotFinite {
+        /// Its column.
+        column: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The reference cannot be computed at this point (outside its domain,
+    /// or a quadrature failed).
+    Reference(String),
+    /// The quantity reads tables that were not opened (a bug of `run`).
+    NoTables,
+}
+
+impl fmt::Display for RowError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RowError::FieldCount { found, expected } => {
+                write!(f, "{found} fields, header has {expected}")
+            }
+            RowError::NotANumber { column, field } => {
+                write!(f, "column '{column}' is not a number: '{field}'")
+            }
+            RowError::NotFinite { column, value } => {
+                write!(f, "column '{column}' is not finite: {value}")
+            }
+            RowError::Reference(e) => write!(f, "reference: {e}"),
+            RowError::NoTables => write!(f, "the table files were not opened"),
+        }
+    }
+}
+
+impl std::error::Error for RowError {}
 
 /// Outcome of a query run.
 #[derive(Debug, Default, PartialEq, Eq)]
@@ -39,10 +301,6 @@ pub struct Summary {
     pub bad: usize,
 }
 
-/// Evaluates one row's inputs (in the order of the quantity's input columns)
-/// to its output values, or says why it cannot.
-type Evaluator<'t> = Box<dyn Fn(&[f64]) -> Result<Vec<String>, String> + Sync + 't>;
-
 /// Runs query `quantity` over CSV `input`, writing CSV to `output` and one line
 /// per bad row to `errors`. Fails (before reading rows) on an unknown quantity,
 /// a missing table file, or a header without the required columns.
@@ -52,23 +310,15 @@ pub fn run(
     input: impl BufRead,
     mut output: impl Write,
     mut errors: impl Write,
-) -> Result<Summary, String> {
-    let (_, columns) = QUANTITIES
-        .iter()
-        .find(|(name, _)| *name == quantity)
-        .ok_or_else(|| {
-            let known: Vec<_> = QUANTITIES.iter().map(|(n, _)| *n).collect();
-            format!(
-                "unknown quantity '{quantity}' (known: {})",
-                known.join(", ")
-            )
-        })?;
+) -> Result<Summary, QueryError> {
+    let quantity = Quantity::from_name(quantity)?;
+    let columns = quantity.columns();
     let mut lines = input.lines().enumerate();
     let header = loop {
         match lines.next() {
-            None => return Err("empty input: expected a CSV header line".into()),
+            None => return Err(QueryError::EmptyInput),
             Some((_, line)) => {
-                let line = line.map_err(|e| format!("reading input: {e}"))?;
+                let line = line.map_err(QueryError::Read)?;
                 if !line.trim().is_empty() {
                     break line;
                 }
@@ -78,184 +328,69 @@ pub fn run(
     let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
     let positions = columns
         .iter()
-        .map(|c| {
+        .map(|&column| {
             names
                 .iter()
-                .position(|n| n == c)
-                .ok_or_else(|| format!("header lacks column '{c}' (needs {})", columns.join(",")))
+                .position(|n| n == column)
+                .ok_or(QueryError::MissingColumn {
+                    column,
+                    needs: columns,
+                })
         })
-        .collect::<Result<Vec<usize>, String>>()?;
+        .collect::<Result<Vec<usize>, QueryError>>()?;
 
     // Load the tables before reading rows, so a missing file fails fast.
     // (`TableSet::open` keeps its maps for the process: one set per run.)
-    let open_set = || {
-        TableSet::open(tables).map_err(|e| format!("{e} (build the tables with `generator build`)"))
-    };
-    let (evaluate, outputs): (Evaluator<'_>, &[&str]) = match quantity {
-        "g1" => {
-            let table = open_set()?.smith;
-            (
-                Box::new(move |x: &[f64]| {
-                    let (p, a) = (x[0], x[1]);
-                    let reference = epd::g1(p, a).map_err(|e| format!("reference: {e}"))?;
-                    Ok(vec![
-                        table.g1(p as f32, a as f32).to_string(),
-                        reference.to_string(),
-                    ])
-                }),
-                &["table", "reference"],
-            )
-        }
-        "sigma-ratio" => {
-            let table = open_set()?.sigma_ratio;
-            (
-                Box::new(move |x: &[f64]| {
-                    let (theta_i, big_b, c) = (x[0], x[1], x[2]);
-                    let reference = kcorr::sigma_ratio(theta_i, big_b, c)
-                        .map_err(|e| format!("reference: {e}"))?;
-                    Ok(vec![
-                        table
-                            .sigma_ratio(theta_i as f32, big_b as f32, c as f32)
-                            .to_string(),
-                        reference.to_string(),
-                    ])
-                }),
-                &["table", "reference"],
-            )
-        }
-        "fresnel" => (
-            // No table: `table` is the runtime's f32 Fresnel (computed in f64
-            // inside), `reference` the f64 reference.
-            Box::new(|x: &[f64]| {
-                let (n, k, cos_theta) = (x[0], x[1], x[2]);
-                let reference = fresnel::fresnel(fresnel::Complex64::new(n, k), cos_theta)
-                    .map_err(|e| format!("reference: {e}"))?;
-                let eta = twoscale::Complex::new(n as f32, k as f32);
-                Ok(vec![
-                    twoscale::fresnel::fresnel(eta, cos_theta as f32).to_string(),
-                    reference.to_string(),
-                ])
-            }),
-            &["table", "reference"],
-        ),
-        "conv" => {
-            let table = open_set()?.convolution;
-            (
-                // `fit` = T3a (the paper's s, g form), `table` = T3b, both
-                // from the runtime; `reference` = exact C by direct quadrature.
-                Box::new(move |x: &[f64]| {
-                    let (u, c, beta, p, theta_h) = (x[0], x[1], x[2], x[3], x[4]);
-                    let reference = conv::convolution(theta_h, u, c, beta, p)
-                        .map_err(|e| format!("reference: {e}"))?;
-                    let (sin, cos) = (theta_h.sin() as f32, theta_h.cos() as f32);
-                    let args = (u as f32, c as f32, beta as f32, p as f32);
-                    Ok(vec![
-                        table
-                            .fit()
-                            .convolution_sin_cos(sin, cos, args.0, args.1, args.2, args.3)
-                            .to_string(),
-                        table
-                            .convolution_sin_cos(sin, cos, args.0, args.1, args.2, args.3)
-                            .to_string(),
-                        reference.to_string(),
-                    ])
-                }),
-                &["fit", "table", "reference"],
-            )
-        }
-        "brdf" => {
-            // docs/model.md §6: the conductor two-scale model. `table` is the runtime
-            // model (`twoscale::brdf::TwoScale`, f32, baked from the table
-            // set: the path a renderer calls); `reference` is
-            // `reference::brdf::two_scale` (exact Λ, σrel, C).
-            let set = open_set()?;
-            (
-                Box::new(move |x: &[f64]| {
-                    let params = brdf::Params {
-                        beta: x[0],
-                        p: x[1],
-                        sigma_s: x[2],
-                        b: x[3],
-                        c: x[4],
-                        n: x[5],
-                        k: x[6],
-                        lambda: x[7],
-                    };
-                    let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
-                    let options = twoscale::brdf::Options::default();
-                    let reference = brdf::two_scale(&params, i, o, &options)
-                        .map_err(|e| format!("reference: {e}"))?;
-                    let f = |v: f64| v as f32;
-                    let layer = twoscale::brdf::Layer {
-                        surface: twoscale::brdf::Surface {
-                            beta: f(params.beta),
-                            p: f(params.p),
-                            sigma_s: f(params.sigma_s),
-                            b: f(params.b),
-                            c: f(params.c),
-                        },
-                        base: twoscale::brdf::BaseLayer::Conductor,
-                        lambertian: 0.0,
-                    };
-                    let model = twoscale::TwoScale::new(
-                        &set.brdf_tables(),
-                        layer,
-                        f(params.lambda),
-                        twoscale::Complex::new(f(params.n), f(params.k)),
-                        options,
-                    );
-                    let table = model.eval(i.map(f), o.map(f));
-                    Ok(vec![table.to_string(), reference.total().to_string()])
-                }),
-                &["table", "reference"],
-            )
-        }
-        _ => unreachable!("quantity list and dispatch agree"),
+    let set = if quantity.uses_tables() {
+        Some(TableSet::open(tables).map_err(QueryError::Tables)?)
+    } else {
+        None
     };
 
     let rows: Vec<(usize, String)> = lines
         .map(|(n, line)| (n + 1, line.unwrap_or_default()))
         .filter(|(_, line)| !line.trim().is_empty())
         .collect();
-    let results: Vec<Result<String, String>> = rows
-        .par_iter()
-        .map(|(n, line)| {
-            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-            if fields.len() != names.len() {
-                return Err(format!(
-                    "line {n}: {} fields, header has {}",
-                    fields.len(),
-                    names.len()
-                ));
-            }
-            let values = positions
-                .iter()
-                .zip(columns.iter())
-                .map(|(&i, c)| {
-                    fields[i].parse::<f64>().map_err(|_| {
-                        format!("line {n}: column '{c}' is not a number: '{}'", fields[i])
-                    })
+    let answer = |line: &str| -> Result<String, RowError> {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != names.len() {
+            return Err(RowError::FieldCount {
+                found: fields.len(),
+                expected: names.len(),
+            });
+        }
+        let values = positions
+            .iter()
+            .zip(columns)
+            .map(|(&i, &column)| {
+                fields[i].parse::<f64>().map_err(|_| RowError::NotANumber {
+                    column,
+                    field: fields[i].to_string(),
                 })
-                .collect::<Result<Vec<f64>, String>>()?;
-            if let Some((c, v)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
-                return Err(format!("line {n}: column '{c}' is not finite: {v}"));
-            }
-            let out = evaluate(&values).map_err(|e| format!("line {n}: {e}"))?;
-            Ok(format!("{},{}", fields.join(","), out.join(",")))
-        })
+            })
+            .collect::<Result<Vec<f64>, RowError>>()?;
+        if let Some((&column, &value)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
+            return Err(RowError::NotFinite { column, value });
+        }
+        let out = quantity.evaluate(set.as_ref(), &values)?;
+        Ok(format!("{},{}", fields.join(","), out.join(",")))
+    };
+    let results: Vec<(usize, Result<String, RowError>)> = rows
+        .par_iter()
+        .map(|(n, line)| (*n, answer(line)))
         .collect();
 
-    let io = |e: std::io::Error| format!("writing output: {e}");
-    writeln!(output, "{},{}", names.join(","), outputs.join(",")).map_err(io)?;
+    let outputs = quantity.outputs();
+    writeln!(output, "{},{}", names.join(","), outputs.join(",")).map_err(QueryError::Write)?;
     let mut summary = Summary::default();
-    for result in results {
+    for (n, result) in results {
         match result {
             Ok(row) => {
-                writeln!(output, "{row}").map_err(io)?;
+                writeln!(output, "{row}").map_err(QueryError::Write)?;
                 summary.answered += 1;
             }
-            Err(message) => {
-                writeln!(errors, "{message}").map_err(io)?;
+            Err(e) => {
+                writeln!(errors, "line {n}: {e}").map_err(QueryError::Write)?;
                 summary.bad += 1;
             }
         }

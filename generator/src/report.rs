@@ -3,18 +3,19 @@
 //! (`verify --markdown`). Both are fixed functions of the measurements (no
 //! timestamps, no paths), so that CI can regenerate the file and compare.
 
+use crate::error::Error;
 use crate::tables::Accuracy;
 use std::fmt::Write;
 
 /// The verification of one table file.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct TableReport {
     /// The file stem, e.g. `t1-smith-g1`.
     pub stem: String,
     /// The file's size in bytes (0 when it could not be read).
     pub bytes: u64,
     /// The measurements, or why there are none.
-    pub outcome: Result<Vec<Accuracy>, String>,
+    pub outcome: Result<Vec<Accuracy>, Error>,
 }
 
 impl TableReport {
@@ -109,7 +110,7 @@ pub fn markdown(command: &str, reports: &[TableReport]) -> String {
                 }
             }
             Err(e) => {
-                let _ = writeln!(out, "Not measured: {}", cell(e));
+                let _ = writeln!(out, "Not measured: {}", cell(&e.to_string()));
             }
         }
     }
@@ -139,7 +140,11 @@ mod tests {
             TableReport {
                 stem: "t5-missing".into(),
                 bytes: 0,
-                outcome: Err("cannot open t5-missing.tbl".into()),
+                outcome: Err(Error::File {
+                    action: crate::error::FileAction::Open,
+                    path: "t5-missing.tbl".into(),
+                    source: std::io::ErrorKind::NotFound.into(),
+                }),
             },
         ];
         let md = markdown("generator verify --points 100 --seed 1", &reports);

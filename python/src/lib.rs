@@ -707,6 +707,7 @@ fn brdf<'py>(
         return evaluate(py, rows_in, true, |x| {
             ref_brdf::two_scale(&params, [x[0], x[1], x[2]], [x[3], x[4], x[5]], &options)
                 .map(|v| v.total())
+                .map_err(|e| e.to_string())
         });
     }
     let f = |v: f64| v as f32;

@@ -93,7 +93,9 @@
 //!   value at `τ_max`; `cos θh ≤ 0` is the horizon.
 //! * Non-finite inputs give 0. The result is never NaN or ∞.
 
-use crate::format::{FormatError, Header, Kernel, Quantised, Table, TableId, ValueType};
+use crate::format::{
+    ConvParams, FormatError, Header, Kernel, Quantised, Table, TableId, ValueType,
+};
 use crate::interp::Axis;
 use crate::math;
 
@@ -146,7 +148,7 @@ pub fn kernel(x: f32, c: f32) -> f32 {
 pub const FIT_CHANNELS: usize = 2;
 
 /// The constants of the normalised angle (see the module documentation),
-/// as stored in the header's `params[1..5]` and `params[7..12]`.
+/// stored in the header as fields of [`ConvParams`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AngleParams {
     /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
@@ -170,6 +172,53 @@ pub struct AngleParams {
     /// `τ_f`: the edge term fades out for edges near the horizon, by
     /// `1 / (1 + (tan θe / τ_f)²)`.
     pub edge_fade_tan: f64,
+}
+
+impl ConvParams {
+    /// T3's header parameters: `angles` normalised angles with constants
+    /// `angle`, the T3a `g` offset and the value floor.
+    pub fn new(angles: usize, angle: &AngleParams, g_offset: f64, value_floor: f64) -> Self {
+        let AngleParams {
+            tau_max,
+            kernel_scale_floor,
+            ndf_weight,
+            ndf_exponent_cap,
+            ndf_softening,
+            horizon_weight,
+            edge_weight,
+            edge_smoothing,
+            edge_fade_tan,
+        } = *angle;
+        ConvParams {
+            angles: angles as f64,
+            tau_max,
+            kernel_scale_floor,
+            ndf_weight,
+            ndf_exponent_cap,
+            g_offset,
+            value_floor,
+            ndf_softening,
+            horizon_weight,
+            edge_weight,
+            edge_smoothing,
+            edge_fade_tan,
+        }
+    }
+
+    /// The normalised angle's constants.
+    pub fn angle(&self) -> AngleParams {
+        AngleParams {
+            tau_max: self.tau_max,
+            kernel_scale_floor: self.kernel_scale_floor,
+            ndf_weight: self.ndf_weight,
+            ndf_exponent_cap: self.ndf_exponent_cap,
+            ndf_softening: self.ndf_softening,
+            horizon_weight: self.horizon_weight,
+            edge_weight: self.edge_weight,
+            edge_smoothing: self.edge_smoothing,
+            edge_fade_tan: self.edge_fade_tan,
+        }
+    }
 }
 
 /// `asinh x` for `x ≥ 0`, accurate for small `x`.
@@ -344,27 +393,18 @@ impl<'a> ConvTable<'a> {
         let header: &Header = table.expecting(TableId::Convolution)?.header();
         let used = header.used_axes();
         let channels = header.channels as usize;
-        let angles = header.params[0] as usize;
+        let params = ConvParams::from_header(header);
+        let angles = params.angles as usize;
         if used.len() != 4 || angles < 4 || channels != FIT_CHANNELS + angles {
             return Err(FormatError::Shape(
                 "T3 needs 4 axes and 2 + angles channels with at least 4 angles",
             ));
         }
-        let angle = AngleParams {
-            tau_max: header.params[1],
-            kernel_scale_floor: header.params[2],
-            ndf_weight: header.params[3],
-            ndf_exponent_cap: header.params[4],
-            ndf_softening: header.params[7],
-            horizon_weight: header.params[8],
-            edge_weight: header.params[9],
-            edge_smoothing: header.params[10],
-            edge_fade_tan: header.params[11],
-        };
+        let angle = params.angle();
         // NaN fails every comparison, so it is rejected too.
         let valid = angle.tau_max > 0.0
             && angle.ndf_exponent_cap > 0.0
-            && header.params[5] > 0.0
+            && params.g_offset > 0.0
             && (0.0..1e6).contains(&angle.ndf_softening)
             && (0.0..1e6).contains(&angle.horizon_weight)
             && (0.0..1e6).contains(&angle.edge_weight)
@@ -413,7 +453,7 @@ impl<'a> ConvTable<'a> {
             values,
             angle,
             angles,
-            g_offset: header.params[5] as f32,
+            g_offset: params.g_offset as f32,
             u_max: domain[0].1,
             domain,
             cubic: DEFAULT_CUBIC_AXES,

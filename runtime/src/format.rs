@@ -52,7 +52,22 @@ pub const PAYLOAD_ALIGN: usize = 64;
 /// Size of [`Header`] in bytes.
 pub const HEADER_SIZE: usize = size_of::<Header>();
 
-/// Which quantity a table holds. The numeric tags are part of the file format.
+/// Which quantity a table holds.
+///
+/// Tables are known by their **T-number** ([`TableId::number`]: T1 … T5, in
+/// the docs, on the command line and in file names, `t3-convolution.tbl`).
+/// The file stores a different number, the **tag** ([`TableId::tag`]): tags
+/// are part of the file format and never change, and they were given in the
+/// order the tables were added (T5 took tag 3 before T3 existed; tag 5 is
+/// retired). This is the one place the two meet:
+///
+/// | T-number | variant | tag | file |
+/// |---|---|---|---|
+/// | T1 | [`SmithG1`](TableId::SmithG1) | 1 | `t1-smith-g1.tbl` |
+/// | T2 | [`SigmaRatio`](TableId::SigmaRatio) | 2 | `t2-sigma-ratio.tbl` |
+/// | T3 | [`Convolution`](TableId::Convolution) | 4 | `t3-convolution.tbl` |
+/// | T4 | [`ShBrdf`](TableId::ShBrdf) | 6 | `t4-<material>.tbl` |
+/// | T5 | [`DiffuseFresnel`](TableId::DiffuseFresnel) | 3 | `t5-diffuse-fresnel.tbl` |
 #[derive(
     TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq, Hash,
 )]
@@ -85,9 +100,21 @@ impl TableId {
         TableId::ShBrdf,
     ];
 
-    /// The tag stored in the file.
+    /// The tag stored in the file (see the type's documentation).
     pub const fn tag(self) -> u32 {
         self as u32
+    }
+
+    /// The T-number the docs and the command line use (`3` for T3; see the
+    /// type's documentation).
+    pub const fn number(self) -> u32 {
+        match self {
+            TableId::SmithG1 => 1,
+            TableId::SigmaRatio => 2,
+            TableId::Convolution => 3,
+            TableId::ShBrdf => 4,
+            TableId::DiffuseFresnel => 5,
+        }
     }
 
     /// The id with this tag, if any.
@@ -95,7 +122,9 @@ impl TableId {
         Self::ALL.into_iter().find(|id| id.tag() == tag)
     }
 
-    /// Short name, used for file names (`<name>.tbl`) and on the command line.
+    /// Short name, `t<number>-<quantity>`, used for file names (`<name>.tbl`)
+    /// and on the command line (T4's files add the material:
+    /// `t4-sh-brdf` names the kind, `t4-<material>.tbl` the files).
     pub const fn name(self) -> &'static str {
         match self {
             TableId::SmithG1 => "t1-smith-g1",
@@ -139,28 +168,148 @@ impl TableId {
     }
 
     /// Names of the generation parameters stored in [`Header::params`] (unused
-    /// slots are zero and unnamed).
+    /// slots are zero and unnamed): the fields of the table's parameter struct
+    /// ([`SmithG1Params`], [`SigmaRatioParams`], [`DiffuseFresnelParams`],
+    /// [`ConvParams`], [`ShBrdfParams`]).
     pub const fn param_names(self) -> &'static [&'static str] {
         match self {
-            TableId::SmithG1 => &["quadrature_rel_tol", "quadrature_abs_tol"],
-            TableId::SigmaRatio => &["quadrature_rel_tol", "c_minus_1_at_first_node"],
-            TableId::DiffuseFresnel => &["quadrature_rel_tol", "quadrature_abs_tol"],
-            TableId::Convolution => &[
-                "angles",
-                "tau_max",
-                "kernel_scale_floor",
-                "ndf_weight",
-                "ndf_exponent_cap",
-                "g_offset",
-                "value_floor",
-                "ndf_softening",
-                "horizon_weight",
-                "edge_weight",
-                "edge_smoothing",
-                "edge_fade_tan",
-            ],
-            TableId::ShBrdf => &crate::sh::PARAM_NAMES,
+            TableId::SmithG1 => SmithG1Params::NAMES,
+            TableId::SigmaRatio => SigmaRatioParams::NAMES,
+            TableId::DiffuseFresnel => DiffuseFresnelParams::NAMES,
+            TableId::Convolution => ConvParams::NAMES,
+            TableId::ShBrdf => ShBrdfParams::NAMES,
         }
+    }
+}
+
+/// Defines a table's generation parameters as a struct of named `f64`
+/// fields, stored in [`Header::params`] in field order: the one definition the
+/// generator writes ([`to_values`](SmithG1Params::to_values)) and the runtime
+/// reads ([`from_header`](SmithG1Params::from_header)).
+macro_rules! header_params {
+    ($(#[$meta:meta])* $name:ident { $($(#[$field_meta:meta])* $field:ident,)+ }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Default)]
+        pub struct $name {
+            $($(#[$field_meta])* pub $field: f64,)+
+        }
+
+        impl $name {
+            /// The field names, in slot order (what `generator inspect` prints).
+            pub const NAMES: &'static [&'static str] = &[$(stringify!($field)),+];
+            /// Number of slots used.
+            pub const COUNT: usize = Self::NAMES.len();
+
+            /// The parameters in slot order (what the writer stores).
+            pub fn to_values(&self) -> [f64; Self::COUNT] {
+                [$(self.$field),+]
+            }
+
+            /// The parameters stored in `header`.
+            pub fn from_header(header: &Header) -> Self {
+                let mut slots = header.params.iter().copied();
+                Self {
+                    $($field: slots.next().unwrap_or(0.0),)+
+                }
+            }
+        }
+
+        const _: () = assert!($name::COUNT <= PARAM_COUNT);
+    };
+}
+
+header_params! {
+    /// T1's generation parameters.
+    SmithG1Params {
+        /// Relative tolerance of the Λ quadrature.
+        quadrature_rel_tol,
+        /// Absolute tolerance of the Λ quadrature.
+        quadrature_abs_tol,
+    }
+}
+
+header_params! {
+    /// T2's generation parameters.
+    SigmaRatioParams {
+        /// Relative tolerance of the σrel quadrature.
+        quadrature_rel_tol,
+        /// `c − 1` at which the node `c = 1` is computed (the limit c → 1).
+        c_minus_1_at_first_node,
+    }
+}
+
+header_params! {
+    /// T5's generation parameters.
+    DiffuseFresnelParams {
+        /// Relative tolerance of the F_dr,int quadrature.
+        quadrature_rel_tol,
+        /// Absolute tolerance of the F_dr,int quadrature.
+        quadrature_abs_tol,
+    }
+}
+
+header_params! {
+    /// T3's generation parameters: its number of normalised angles, the
+    /// normalised angle's constants (`conv::AngleParams`, docs/model.md §3),
+    /// the T3a `g` offset and the value floor.
+    ConvParams {
+        /// Number of normalised angles ξ (the `ln C` channels).
+        angles,
+        /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
+        tau_max,
+        /// `u_floor`: `u_e = √(u² + u_floor²)`.
+        kernel_scale_floor,
+        /// `λ`: weight of the NDF term.
+        ndf_weight,
+        /// `Y`: where the NDF term saturates.
+        ndf_exponent_cap,
+        /// T3a stores `ln(g² + g_offset)`.
+        g_offset,
+        /// `ln C` is stored at least at `ln(value_floor · peak)`.
+        value_floor,
+        /// `κ`: softening of the NDF exponent.
+        ndf_softening,
+        /// `w_h`: weight of the horizon term.
+        horizon_weight,
+        /// `w_e`: weight of the edge term.
+        edge_weight,
+        /// `s_e`: smoothing of the edge term's onset.
+        edge_smoothing,
+        /// `τ_f`: the edge term fades out for edges near the horizon.
+        edge_fade_tan,
+    }
+}
+
+header_params! {
+    /// T4's generation parameters.
+    ShBrdfParams {
+        /// `L`, the largest degree stored.
+        band_limit,
+        /// `l_f` of the half-Gaussian band filter of \[WAT92\] §2.5: every
+        /// coefficient `M_jk` is multiplied by `h(l_j) h(l_k)`,
+        /// `h(l) = exp(−(l − l_f)² / (2 w²))` for `l > l_f`, 1 otherwise.
+        filter_start,
+        /// `w` of the band filter; 0 means no filter.
+        filter_width,
+        /// Wavelength of channel 0, µm (0 for an absent channel).
+        lambda_0,
+        /// Wavelength of channel 1, µm (0 for an absent channel).
+        lambda_1,
+        /// Wavelength of channel 2, µm (0 for an absent channel).
+        lambda_2,
+        /// `‖M − Mᵀ‖ / ‖M‖` before symmetrising, with the norm of (WAT92 27),
+        /// `‖A‖ = Σ|A_jk| / J²`, over the whole matrix; the largest over the
+        /// channels.
+        asymmetry_rel,
+        /// Gauss–Legendre nodes in `cos θ ∈ [0, 1]` of the projection.
+        theta_nodes,
+    }
+}
+
+impl ShBrdfParams {
+    /// The wavelength of each channel, µm (0 for absent channels).
+    pub fn wavelengths(&self) -> [f64; 3] {
+        [self.lambda_0, self.lambda_1, self.lambda_2]
     }
 }
 
@@ -963,7 +1112,8 @@ pub mod write {
         pub value_type: ValueType,
         /// Used axes, in storage order.
         pub axes: &'v [AxisHeader],
-        /// Generation parameters, in the order of [`TableId::param_names`].
+        /// Generation parameters, in the order of [`TableId::param_names`]
+        /// (the table's parameter struct's `to_values()`, e.g. [`ConvParams::to_values`]).
         pub params: &'v [f64],
         /// Grid values, row-major, channels innermost.
         pub grid: &'v [f32],
@@ -1125,5 +1275,29 @@ impl AlignedBuf {
     pub fn bytes_mut(&mut self) -> &mut [u8] {
         let len = self.len;
         &mut self.blocks.as_mut_bytes()[..len]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every table's name starts with its T-number, tags and T-numbers are
+    /// each unique, and a tag round-trips.
+    #[test]
+    fn names_carry_the_t_number() {
+        for id in TableId::ALL {
+            assert!(
+                id.name().starts_with(&format!("t{}-", id.number())),
+                "{id:?}"
+            );
+            assert_eq!(TableId::from_tag(id.tag()), Some(id));
+            for other in TableId::ALL {
+                if other != id {
+                    assert_ne!(other.number(), id.number());
+                    assert_ne!(other.tag(), id.tag());
+                }
+            }
+        }
     }
 }

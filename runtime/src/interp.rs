@@ -296,60 +296,6 @@ impl<'a> Grid<'a> {
         sum
     }
 
-    /// The cubic B-spline restricted to fixed values of every axis but the
-    /// first: the first axis's coefficients blended over the `4^D` corners of
-    /// the trailing axes' cells (`cells[d]` is axis `d + 1`'s), written to
-    /// `out` for `channel`. Returns how many were written (the first axis's
-    /// stored values), or `None` if `out` is too short or the grid is not a
-    /// `(D + 1)`-axis B-spline. [`Grid::eval_first_axis`] then evaluates the
-    /// 1-D spline: the same value as [`Grid::blend_cubic`] up to f32 rounding
-    /// (the tensor-product spline is separable).
-    pub fn blend_cubic_trailing<const D: usize>(
-        &self,
-        cells: [(usize, f32); D],
-        channel: usize,
-        out: &mut [f32],
-    ) -> Option<usize> {
-        if self.kernel != Kernel::CubicBSpline || self.dims != D + 1 {
-            return None;
-        }
-        let count = self.kernel.stored_per_axis(self.axes[0].cells + 1) as usize;
-        let out = out.get_mut(..count)?;
-        let mut weights = [[0.0f32; 4]; D];
-        let mut base = channel;
-        for (d, (&(i, t), w)) in cells.iter().zip(weights.iter_mut()).enumerate() {
-            base += i * self.strides[d + 1];
-            *w = bspline_weights(t);
-        }
-        for (k, slot) in out.iter_mut().enumerate() {
-            let mut sum = 0.0f32;
-            for corner in 0..(1usize << (2 * D)) {
-                let mut weight = 1.0f32;
-                let mut offset = base + k * self.strides[0];
-                for (d, w) in weights.iter().enumerate() {
-                    let j = (corner >> (2 * d)) & 3;
-                    weight *= w[j];
-                    offset += j * self.strides[d + 1];
-                }
-                sum += weight * self.values.get(offset).copied().unwrap_or(0.0);
-            }
-            *slot = sum;
-        }
-        Some(count)
-    }
-
-    /// The 1-D cubic B-spline along the first axis at `x`, on coefficients
-    /// from [`Grid::blend_cubic_trailing`] (0 where they are missing).
-    #[inline]
-    pub fn eval_first_axis(&self, coefficients: &[f32], x: f32) -> f32 {
-        let (i, t) = self.axes[0].locate(x);
-        let w = bspline_weights(t);
-        match coefficients.get(i..i + 4) {
-            Some(c) => w[0] * c[0] + w[1] * c[1] + w[2] * c[2] + w[3] * c[3],
-            None => 0.0,
-        }
-    }
-
     /// n-linear blend of the `2^D` corners of the cell given per axis as
     /// `(index, fraction)` (from [`Axis::locate`]).
     #[inline]

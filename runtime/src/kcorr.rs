@@ -25,9 +25,8 @@
 //!   ~2.6e-5 with 74·70·34 coefficients (688 KiB).
 //!
 //! **One material** (fixed B and c, varying incidence, as in a renderer's
-//! BRDF): [`SigmaRatioTable::slice`] blends the coefficients over B and c
-//! once, leaving a 4-tap 1-D spline per lookup ([`SigmaRatioSlice`]; same
-//! values to 6e-7 relative, measured in `tests/kcorr.rs`). `TwoScale` keeps one.
+//! BRDF): `TwoScale` tabulates σrel/σs over incidence once per material
+//! (the σrel column of the per-material bake, `bake::DirectionBake`).
 //!
 //! **Out of the table's domain** (never NaN, never ∞):
 //! - `c ≤ 1` or NaN: 0 (the spectrum cannot be normalised). `c > 100`: the
@@ -89,30 +88,6 @@ impl<'a> SigmaRatioTable<'a> {
         Ok(SigmaRatioTable {
             grid: Grid::new(header, table.grid())?,
         })
-    }
-
-    /// T2 restricted to the material `(B = b/λ, c)` ([`SigmaRatioSlice`]).
-    pub fn slice(&self, b_over_lambda: f32, c: f32) -> SigmaRatioSlice<'a> {
-        let inside = c > 1.0 && c <= C_MAX && (B_MIN..=B_MAX).contains(&b_over_lambda);
-        let coefficients = if inside {
-            let mut values = [0.0f32; SIGMA_SLICE_CAPACITY];
-            let cells = [
-                self.grid.axis(1).locate(b_over_lambda),
-                self.grid.axis(2).locate(c),
-            ];
-            self.grid
-                .blend_cubic_trailing(cells, 0, &mut values)
-                .map(|count| (values, count))
-        } else {
-            None
-        };
-        SigmaRatioSlice {
-            table: *self,
-            big_b: b_over_lambda,
-            c,
-            r0: normal_incidence_ratio(f64::from(b_over_lambda), f64::from(c)),
-            coefficients,
-        }
     }
 
     /// `q = r / r0` from the table, inputs already inside the domain.
@@ -178,42 +153,6 @@ impl<'a> SigmaRatioTable<'a> {
         let m = (1.0 - r_last * r_last) / tail_last;
         let r_sq = 1.0 - (1.0 - r0 * r0) * m;
         math::sqrt(r_sq.max(0.0)) / r0
-    }
-}
-
-/// Largest number of T2 coefficients along cos θi a [`SigmaRatioSlice`]
-/// holds (the shipped T2 has 72 + 2).
-pub const SIGMA_SLICE_CAPACITY: usize = 128;
-
-/// T2 restricted to one material `(B = b/λ, c)`: the B-spline coefficients
-/// along cos θi blended over B and c once, and `r0(B, c)` computed once, so
-/// that a lookup is a 4-tap 1-D spline instead of the 64-tap tricubic and
-/// its `ln1p`/`expm1`. Same values as [`SigmaRatioTable::sigma_ratio_cos`]
-/// up to f32 rounding (the tensor-product spline is separable); outside the
-/// table's B or c range it defers to the full lookup and its rules.
-#[derive(Clone, Copy, Debug)]
-pub struct SigmaRatioSlice<'a> {
-    table: SigmaRatioTable<'a>,
-    big_b: f32,
-    c: f32,
-    r0: f64,
-    /// The blended coefficients (`count` of them), or `None` to defer.
-    coefficients: Option<([f32; SIGMA_SLICE_CAPACITY], usize)>,
-}
-
-impl<'a> SigmaRatioSlice<'a> {
-    /// σrel/σs at `cos θi` for this slice's material (see
-    /// [`SigmaRatioTable::sigma_ratio_cos`]).
-    #[inline]
-    pub fn sigma_ratio_cos(&self, cos_theta_i: f32) -> f32 {
-        match &self.coefficients {
-            Some((values, count)) => {
-                let cos = cos_theta_i.max(0.0).min(1.0);
-                let q = self.table.grid.eval_first_axis(&values[..*count], cos);
-                (f64::from(q) * self.r0) as f32
-            }
-            None => self.table.sigma_ratio_cos(cos_theta_i, self.big_b, self.c),
-        }
     }
 }
 

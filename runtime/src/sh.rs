@@ -57,7 +57,7 @@
 //! P̄_l^m = a_lm (x P̄_{l−1}^m − P̄_{l−2}^m / a_{l−1,m}),   a_lm = √((4l² − 1)/(l² − m²)).
 //! ```
 //!
-//! # File layout (table id 6, `t4-<material>.tbl`)
+//! # File layout (T4, `t4-<material>.tbl`)
 //!
 //! One axis, `coefficient`, of [`coefficient_count`]`(L)` nodes (uniform,
 //! `0 ..= count − 1`; the axis is an index, nothing is interpolated), one
@@ -66,7 +66,7 @@
 //! (the `l + m` odd ones); its upper triangle `a ≤ b` is stored row by row.
 //! Nothing else is stored: the coefficients that must vanish (`l + m` even,
 //! `m ≠ m'`, cos–sin) are absent by construction.
-//! The header parameters are [`PARAM_NAMES`]; the auxiliary values are
+//! The header parameters are [`ShBrdfParams`]; the auxiliary values are
 //! [`AUX_NAMES`] (what was projected, how, and the material's parameters).
 //!
 //! # Accuracy
@@ -79,7 +79,7 @@
 // Index loops mirror the recurrences and the block formulas of the docs.
 #![allow(clippy::needless_range_loop)]
 
-use crate::format::{FormatError, Kernel, Mapping, Table, TableId};
+use crate::format::{FormatError, Kernel, Mapping, ShBrdfParams, Table, TableId};
 use crate::math;
 
 /// The largest band limit `L` this runtime evaluates (it sizes the stack
@@ -92,29 +92,6 @@ pub const MIN_BAND_LIMIT: usize = 2;
 
 /// The largest number of wavelengths (channels) in a T4 file.
 pub const MAX_CHANNELS: usize = 3;
-
-/// Names of the header parameters of T4 (in [`crate::format::Header::params`]).
-///
-/// - `band_limit`: L, the largest degree stored;
-/// - `filter_start`, `filter_width`: the half-Gaussian band filter of
-///   \[WAT92\] §2.5: every coefficient `M_jk` is multiplied by `h(l_j) h(l_k)`,
-///   `h(l) = exp(−(l − l_f)² / (2 w²))` for `l > l_f`, 1 otherwise; `w = 0`
-///   means no filter;
-/// - `lambda_0..2`: the wavelength of each channel, µm (0 for absent channels);
-/// - `asymmetry_rel`: `‖M − Mᵀ‖ / ‖M‖` before symmetrising, with the norm of
-///   (WAT92 27), `‖A‖ = Σ|A_jk| / J²`, over the whole matrix; the largest over
-///   the channels;
-/// - `theta_nodes`: Gauss–Legendre nodes in `cos θ ∈ [0, 1]` of the projection.
-pub const PARAM_NAMES: [&str; 8] = [
-    "band_limit",
-    "filter_start",
-    "filter_width",
-    "lambda_0",
-    "lambda_1",
-    "lambda_2",
-    "asymmetry_rel",
-    "theta_nodes",
-];
 
 /// Names of the auxiliary values of T4 (after the coefficients).
 ///
@@ -383,7 +360,7 @@ impl ProjectedModel {
 pub struct ShBrdfTable<'a> {
     coefficients: &'a [f32],
     aux: &'a [f32],
-    params: [f64; crate::format::PARAM_COUNT],
+    params: ShBrdfParams,
     band_limit: usize,
     channels: usize,
 }
@@ -397,7 +374,7 @@ impl<'a> ShBrdfTable<'a> {
     /// Checks that a validated table has the shape of T4 (module docs).
     pub fn from_table(table: Table<'a>) -> Result<Self, FormatError> {
         let header = table.expecting(TableId::ShBrdf)?.header();
-        let params = header.params;
+        let params = ShBrdfParams::from_header(header);
         let axes = header.used_axes();
         let channels = header.channels as usize;
         if header.value_type != crate::format::ValueType::F32 {
@@ -408,7 +385,7 @@ impl<'a> ShBrdfTable<'a> {
                 "T4 has one axis (coefficient), 1 to 3 channels and no interpolation",
             ));
         }
-        let l = params[0];
+        let l = params.band_limit;
         if !(l >= MIN_BAND_LIMIT as f64 && l <= MAX_BAND_LIMIT as f64 && l == math::floor(l)) {
             return Err(FormatError::Shape(
                 "T4's band limit must be an integer in [2, 127]",
@@ -426,13 +403,13 @@ impl<'a> ShBrdfTable<'a> {
                 "T4's axis must index the packed coefficients of its band limit",
             ));
         }
-        let (start, width) = (params[1], params[2]);
+        let (start, width) = (params.filter_start, params.filter_width);
         if !(start >= 0.0 && width >= 0.0) {
             return Err(FormatError::Shape(
                 "T4's filter start and width must be non-negative",
             ));
         }
-        for (c, &lambda) in params[3..6].iter().enumerate() {
+        for (c, &lambda) in params.wavelengths().iter().enumerate() {
             if (c < channels) != (lambda > 0.0) || lambda < 0.0 {
                 return Err(FormatError::Shape(
                     "T4 needs a positive wavelength per channel and zero for absent ones",
@@ -466,22 +443,21 @@ impl<'a> ShBrdfTable<'a> {
 
     /// Wavelength of `channel` in µm (0 for a channel that does not exist).
     pub fn wavelength(&self, channel: usize) -> f64 {
-        if channel < self.channels {
-            self.params[3 + channel]
-        } else {
-            0.0
+        match self.params.wavelengths().get(channel) {
+            Some(&lambda) if channel < self.channels => lambda,
+            _ => 0.0,
         }
     }
 
     /// The half-Gaussian band filter applied by the generator, as
-    /// `(l_f, w)`; `w = 0` means none ([`PARAM_NAMES`]).
+    /// `(l_f, w)`; `w = 0` means none ([`ShBrdfParams`]).
     pub fn filter(&self) -> (f64, f64) {
-        (self.params[1], self.params[2])
+        (self.params.filter_start, self.params.filter_width)
     }
 
     /// `‖M − Mᵀ‖/‖M‖` (WAT92 26-27) of the matrix before it was symmetrised.
     pub fn asymmetry(&self) -> f64 {
-        self.params[6]
+        self.params.asymmetry_rel
     }
 
     /// What was projected.

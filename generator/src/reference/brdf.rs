@@ -12,10 +12,56 @@
 //! available (tests, `query brdf`).
 
 use std::f64::consts::PI;
+use std::fmt;
 
 use twoscale::brdf::{ColourTerms, HaloWeight, Masking, Options, SigmaRelMode};
 
+use crate::quad::QuadError;
+use crate::reference::conv::ConvError;
 use crate::reference::{conv, epd, fresnel, kcorr};
+
+/// Why the reference BRDF could not be evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BrdfError {
+    /// Direction `i` or `o` is zero or not finite.
+    Direction(&'static str),
+    /// A parameter is invalid or an integral (Λ, σrel, F, Q̄) failed.
+    Quadrature(QuadError),
+    /// C could not be computed.
+    Convolution(ConvError),
+}
+
+impl fmt::Display for BrdfError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BrdfError::Direction(name) => write!(f, "{name}: not a finite non-zero direction"),
+            BrdfError::Quadrature(e) => write!(f, "{e}"),
+            BrdfError::Convolution(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for BrdfError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            BrdfError::Direction(_) => None,
+            BrdfError::Quadrature(e) => Some(e),
+            BrdfError::Convolution(e) => Some(e),
+        }
+    }
+}
+
+impl From<QuadError> for BrdfError {
+    fn from(e: QuadError) -> Self {
+        BrdfError::Quadrature(e)
+    }
+}
+
+impl From<ConvError> for BrdfError {
+    fn from(e: ConvError) -> Self {
+        BrdfError::Convolution(e)
+    }
+}
 
 /// The parameters of the conductor two-scale model (docs/model.md §6 `query brdf`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,10 +100,10 @@ impl Value {
     }
 }
 
-fn normalise(v: [f64; 3], name: &str) -> Result<[f64; 3], String> {
+fn normalise(v: [f64; 3], name: &'static str) -> Result<[f64; 3], BrdfError> {
     let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if !(len > 0.0 && len.is_finite()) {
-        return Err(format!("{name}: not a finite non-zero direction"));
+        return Err(BrdfError::Direction(name));
     }
     Ok(v.map(|x| x / len))
 }
@@ -75,7 +121,7 @@ pub fn two_scale(
     i: [f64; 3],
     o: [f64; 3],
     options: &Options,
-) -> Result<Value, String> {
+) -> Result<Value, BrdfError> {
     let (wi, wo) = (normalise(i, "i")?, normalise(o, "o")?);
     let zero = Value {
         specular: 0.0,
@@ -84,7 +130,6 @@ pub fn two_scale(
     if !(wi[2] > 0.0 && wo[2] > 0.0) {
         return Ok(zero);
     }
-    let err = |e: &dyn std::fmt::Display| e.to_string();
     let Params {
         beta,
         p,
@@ -102,8 +147,8 @@ pub fn two_scale(
     let theta_h = h[0].hypot(h[1]).atan2(h[2]);
     let (cos_i, cos_o) = (wi[2], wo[2]);
 
-    let lambda_i = epd::lambda(p, beta * tan_theta(wi)).map_err(|e| err(&e))?;
-    let lambda_o = epd::lambda(p, beta * tan_theta(wo)).map_err(|e| err(&e))?;
+    let lambda_i = epd::lambda(p, beta * tan_theta(wi))?;
+    let lambda_o = epd::lambda(p, beta * tan_theta(wo))?;
     let g = match options.masking {
         Masking::Separable => 1.0 / ((1.0 + lambda_i) * (1.0 + lambda_o)),
         Masking::HeightCorrelated => 1.0 / (1.0 + lambda_i + lambda_o),
@@ -113,16 +158,14 @@ pub fn two_scale(
     let f = if white {
         1.0
     } else {
-        fresnel::fresnel(eta, cos_d).map_err(|e| err(&e))?
+        fresnel::fresnel(eta, cos_d)?
     };
-    let d = epd::Epd::new(beta, p).map_err(|e| err(&e))?.d(h[2]);
+    let d = epd::Epd::new(beta, p)?.d(h[2]);
     let rho_ct = f * d * g / (4.0 * cos_i * cos_o);
 
     let big_b = b / lambda;
     let sigma_rel_sq = if sigma_s > 0.0 {
-        let ratio = |cos: f64| {
-            kcorr::sigma_ratio(cos.clamp(0.0, 1.0).acos(), big_b, c).map_err(|e| err(&e))
-        };
+        let ratio = |cos: f64| kcorr::sigma_ratio(cos.clamp(0.0, 1.0).acos(), big_b, c);
         let ratio_sq = match options.sigma_rel {
             SigmaRelMode::Incident => ratio(cos_i)?.powi(2),
             SigmaRelMode::Symmetrised => 0.5 * (ratio(cos_i)?.powi(2) + ratio(cos_o)?.powi(2)),
@@ -139,7 +182,7 @@ pub fn two_scale(
         let q = if white {
             1.0
         } else {
-            fresnel::q_bar(eta, wi, wo).map_err(|e| err(&e))?
+            fresnel::q_bar(eta, wi, wo)?
         };
         // (1 − A)/σrel², → x as σrel → 0; A at θd (printed) or θi.
         let x_halo = match options.halo_weight {
@@ -154,7 +197,7 @@ pub fn two_scale(
         };
         let halo =
             (c - 1.0) * sigma_s * sigma_s * b * b / (2.0 * PI * lambda * lambda) * one_minus_a_over;
-        let c_value = conv::convolution(theta_h, big_b * cos_d, c, beta, p).map_err(|e| err(&e))?;
+        let c_value = conv::convolution(theta_h, big_b * cos_d, c, beta, p)?;
         q * g * halo * c_value
     } else {
         0.0

@@ -215,6 +215,8 @@ pub enum BuildError {
         /// What went wrong.
         message: String,
     },
+    /// T3's shard files could not be written or merged.
+    Shard(t3::ShardError),
     /// An input of the build (a table T4's BRDF reads, a material it cannot
     /// model) is missing or unusable.
     Input {
@@ -233,12 +235,19 @@ impl fmt::Display for BuildError {
             }
             BuildError::Format(e) => write!(f, "{e}"),
             BuildError::Convolution { at, message } => write!(f, "{at}: {message}"),
+            BuildError::Shard(e) => write!(f, "T3 shards: {e}"),
             BuildError::Input { path, message } => write!(f, "{path}: {message}"),
         }
     }
 }
 
 impl std::error::Error for BuildError {}
+
+impl From<t3::ShardError> for BuildError {
+    fn from(e: t3::ShardError) -> Self {
+        BuildError::Shard(e)
+    }
+}
 
 impl From<FormatError> for BuildError {
     fn from(e: FormatError) -> Self {

@@ -11,7 +11,7 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping};
+use twoscale::format::{AxisHeader, Kernel, Mapping, SmithG1Params};
 use twoscale::interp::node_value;
 use twoscale::{SmithG1Table, TableId};
 
@@ -86,7 +86,11 @@ impl TableKind for SmithG1 {
             kernel: Kernel::Multilinear,
             value_type: twoscale::format::ValueType::F32,
             axes: &[P_AXIS, SCALED_AXIS],
-            params: &[epd::LAMBDA_TOL.rel, epd::LAMBDA_TOL.abs],
+            params: &SmithG1Params {
+                quadrature_rel_tol: epd::LAMBDA_TOL.rel,
+                quadrature_abs_tol: epd::LAMBDA_TOL.abs,
+            }
+            .to_values(),
             grid: &grid,
             aux: &slopes,
             generator_version: GENERATOR_VERSION,

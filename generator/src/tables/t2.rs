@@ -6,7 +6,7 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping};
+use twoscale::format::{AxisHeader, Kernel, Mapping, SigmaRatioParams};
 use twoscale::interp::node_value;
 use twoscale::{SigmaRatioTable, TableId};
 
@@ -103,7 +103,11 @@ impl TableKind for SigmaRatio {
             kernel: Kernel::CubicBSpline,
             value_type: twoscale::format::ValueType::F32,
             axes: &[COS_AXIS, B_AXIS, C_AXIS],
-            params: &[kcorr::SIGMA_RATIO_TOL.rel, C_MINUS_1_AT_FIRST_NODE],
+            params: &SigmaRatioParams {
+                quadrature_rel_tol: kcorr::SIGMA_RATIO_TOL.rel,
+                c_minus_1_at_first_node: C_MINUS_1_AT_FIRST_NODE,
+            }
+            .to_values(),
             grid: &coefficients,
             aux: &[],
             generator_version: GENERATOR_VERSION,

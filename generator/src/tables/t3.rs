@@ -53,7 +53,7 @@ use twoscale::conv::{
     AngleParams, ConvTable, Convolution, FIT_CHANNELS, kernel, tan_of_normalised_angle,
 };
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping, quantise_node};
+use twoscale::format::{AxisHeader, ConvParams, Kernel, Mapping, quantise_node};
 use twoscale::interp::node_value;
 use twoscale::{Table, TableId};
 
@@ -150,7 +150,7 @@ pub const VALUE_FLOOR: f64 = 1e-12;
 pub const CHANNELS: usize = FIT_CHANNELS + ANGLES;
 
 mod shard;
-pub use shard::Shard;
+pub use shard::{Shard, ShardError};
 
 /// The T3 builder.
 pub struct Conv;
@@ -240,23 +240,9 @@ pub fn node_values_cached(index: usize, cache: &MomentCache) -> Result<Vec<f32>,
 }
 
 /// The header's generation parameters of a T3 file with `angles` angles and
-/// the angle constants `angle`, in the order of `TableId::param_names`
-/// (`ConvTable::from_table` reads them back).
-pub fn header_params(angles: usize, angle: &AngleParams) -> [f64; 12] {
-    [
-        angles as f64,
-        angle.tau_max,
-        angle.kernel_scale_floor,
-        angle.ndf_weight,
-        angle.ndf_exponent_cap,
-        G_OFFSET,
-        VALUE_FLOOR,
-        angle.ndf_softening,
-        angle.horizon_weight,
-        angle.edge_weight,
-        angle.edge_smoothing,
-        angle.edge_fade_tan,
-    ]
+/// the angle constants `angle` (`ConvTable::from_table` reads them back).
+pub fn header_params(angles: usize, angle: &AngleParams) -> ConvParams {
+    ConvParams::new(angles, angle, G_OFFSET, VALUE_FLOOR)
 }
 
 fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
@@ -266,7 +252,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
         kernel: Kernel::Multilinear,
         value_type: twoscale::format::ValueType::U16,
         axes: &AXES,
-        params: &header_params(ANGLES, &ANGLE),
+        params: &header_params(ANGLES, &ANGLE).to_values(),
         grid,
         aux: &[],
         generator_version: GENERATOR_VERSION,
@@ -320,7 +306,7 @@ pub fn work(shard: Option<Shard>) -> u64 {
 /// The bytes of the shard file of `shard` (see [`Shard`]).
 pub fn build_shard(shard: Shard, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
     let indices: Vec<usize> = shard.indices().collect();
-    shard::encode(shard, &compute_nodes(&indices, progress)?)
+    Ok(shard::encode(shard, &compute_nodes(&indices, progress)?)?)
 }
 
 /// The table from the shard files `files` (name, bytes) of one `N`-way
@@ -591,4 +577,30 @@ pub fn verify(bytes: &[u8], profiles: usize, seed: u64) -> Result<Vec<Accuracy>,
         )
         .report_only(),
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use twoscale::format::{ConvParams, HEADER_SIZE, Header};
+    use zerocopy::TryFromBytes;
+
+    /// The header this generator writes for T3 (encoded here with a zero
+    /// grid: the header does not depend on the values, only the checksum
+    /// does) equals the committed table's, byte for byte up to the checksum,
+    /// and its named parameters read back equal the ones written.
+    #[test]
+    fn header_matches_the_committed_table() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables/t3-convolution.tbl");
+        let committed = std::fs::read(path).expect("the committed T3");
+        let written = encode_table(&vec![0.0; node_count() * CHANNELS]).expect("encodes");
+        let checksum = core::mem::offset_of!(Header, checksum);
+        assert_eq!(written[..checksum], committed[..checksum]);
+        let header = Header::try_read_from_bytes(&committed[..HEADER_SIZE]).expect("header");
+        assert_eq!(
+            ConvParams::from_header(&header),
+            header_params(ANGLES, &ANGLE)
+        );
+        assert_eq!(ConvParams::from_header(&header).angle(), ANGLE);
+    }
 }

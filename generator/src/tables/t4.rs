@@ -37,7 +37,7 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, aligned_copy};
+use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, ShBrdfParams, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
 use twoscale::{Complex, ShBrdfTable, TableBytes, TableId, TableSet, TwoScale};
 
@@ -353,14 +353,17 @@ impl TableKind for ShBrdf {
             }
             Ok(())
         })?;
-        let mut params = vec![
-            l as f64,
-            m.filter.map_or(0.0, |f| f.start),
-            m.filter.map_or(0.0, |f| f.width),
-        ];
-        params.extend((0..3).map(|c| self.wavelengths.get(c).copied().unwrap_or(0.0)));
-        params.push(asymmetry);
-        params.push(quadrature.theta_nodes as f64);
+        let lambda = |c: usize| self.wavelengths.get(c).copied().unwrap_or(0.0);
+        let params = ShBrdfParams {
+            band_limit: l as f64,
+            filter_start: m.filter.map_or(0.0, |f| f.start),
+            filter_width: m.filter.map_or(0.0, |f| f.width),
+            lambda_0: lambda(0),
+            lambda_1: lambda(1),
+            lambda_2: lambda(2),
+            asymmetry_rel: asymmetry,
+            theta_nodes: quadrature.theta_nodes as f64,
+        };
         let axis = AxisHeader {
             nodes: count as u32,
             mapping: Mapping::Uniform,
@@ -375,7 +378,7 @@ impl TableKind for ShBrdf {
             kernel: Kernel::Multilinear,
             value_type: twoscale::format::ValueType::F32,
             axes: &[axis],
-            params: &params,
+            params: &params.to_values(),
             grid: &grid,
             aux: &self.aux(quadrature.phi_nodes()),
             generator_version: GENERATOR_VERSION,

@@ -15,7 +15,7 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping};
+use twoscale::format::{AxisHeader, DiffuseFresnelParams, Kernel, Mapping};
 use twoscale::interp::node_value;
 use twoscale::{DiffuseFresnelTable, TableId};
 
@@ -75,7 +75,11 @@ impl TableKind for DiffuseFresnel {
             kernel: Kernel::CubicBSpline,
             value_type: twoscale::format::ValueType::F32,
             axes: &[ETA_AXIS],
-            params: &[fresnel::DIFFUSE_TOL.rel, fresnel::DIFFUSE_TOL.abs],
+            params: &DiffuseFresnelParams {
+                quadrature_rel_tol: fresnel::DIFFUSE_TOL.rel,
+                quadrature_abs_tol: fresnel::DIFFUSE_TOL.abs,
+            }
+            .to_values(),
             grid: &coefficients,
             aux: &[],
             generator_version: GENERATOR_VERSION,

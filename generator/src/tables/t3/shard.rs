@@ -16,10 +16,11 @@
 //! layout (axes, header parameters, channels): shards of different
 //! generators or grids cannot be merged.
 
+use std::fmt;
 use twoscale::format::{FNV_OFFSET, fnv1a};
 
 use super::{ANGLE, ANGLES, AXES, CHANNELS, header_params, node_count};
-use crate::tables::{BuildError, GENERATOR_VERSION};
+use crate::tables::GENERATOR_VERSION;
 
 const MAGIC: &[u8; 8] = b"T3SHARD1";
 const HEAD: usize = 8 + 8 + 4 * 4;
@@ -35,8 +36,8 @@ pub struct Shard {
 
 impl Shard {
     /// Parses `K/N` with `1 ≤ K ≤ N`.
-    pub fn parse(text: &str) -> Result<Shard, String> {
-        let bad = || format!("invalid shard '{text}': expected K/N with 1 <= K <= N, e.g. 2/8");
+    pub fn parse(text: &str) -> Result<Shard, ShardError> {
+        let bad = || ShardError::Parse(text.to_string());
         let (k, n) = text.split_once('/').ok_or_else(bad)?;
         let k: u32 = k.trim().parse().map_err(|_| bad())?;
         let n: u32 = n.trim().parse().map_err(|_| bad())?;
@@ -66,27 +67,162 @@ impl Shard {
 fn fingerprint() -> u64 {
     let layout = format!(
         "{GENERATOR_VERSION}|{AXES:?}|{:?}|{CHANNELS}",
-        header_params(ANGLES, &ANGLE)
+        header_params(ANGLES, &ANGLE).to_values()
     );
     fnv1a(FNV_OFFSET, layout.as_bytes())
 }
 
-fn shard_error(message: String) -> BuildError {
-    BuildError::Input {
-        path: "T3 shards".into(),
-        message,
+/// Why a shard could not be parsed, written or merged.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShardError {
+    /// `--shard` is not `K/N` with `1 ≤ K ≤ N`.
+    Parse(String),
+    /// A shard's node values are not its nodes' count × [`CHANNELS`].
+    WrongShape {
+        /// The shard.
+        shard: Shard,
+        /// Its node count.
+        expected: usize,
+    },
+    /// A file does not start like a shard file.
+    NotAShard(String),
+    /// A file's checksum does not match (truncated or corrupted).
+    Checksum(String),
+    /// A file was written by another generator version or T3 layout.
+    OtherGenerator(String),
+    /// A file's shard numbers or channel count are invalid.
+    BadHeader {
+        /// The file.
+        name: String,
+        /// Its `K`, `N` and channel count.
+        k: u32,
+        /// See `k`.
+        n: u32,
+        /// See `k`.
+        channels: u32,
+    },
+    /// A file holds another number of nodes than its shard has.
+    NodeCount {
+        /// The file.
+        name: String,
+        /// Its shard.
+        shard: Shard,
+        /// Nodes in the file.
+        count: u32,
+        /// Nodes of the shard.
+        expected: usize,
+    },
+    /// No files were given.
+    NoFiles,
+    /// Two files are of different splits.
+    MixedSplits {
+        /// The file of the other split, and its shard.
+        name: String,
+        /// See `name`.
+        shard: Shard,
+        /// The first file, and its `N`.
+        first: String,
+        /// See `first`.
+        n: u32,
+    },
+    /// Two files are the same shard.
+    Repeated {
+        /// The shard.
+        shard: Shard,
+        /// The two files.
+        first: String,
+        /// See `first`.
+        second: String,
+    },
+    /// Shards of the split are missing (`K`s, ascending).
+    Missing {
+        /// The missing `K`s.
+        k: Vec<u32>,
+        /// The split's `N`.
+        n: u32,
+    },
+}
+
+impl fmt::Display for ShardError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ShardError::Parse(text) => write!(
+                f,
+                "invalid shard '{text}': expected K/N with 1 <= K <= N, e.g. 2/8"
+            ),
+            ShardError::WrongShape { shard, expected } => write!(
+                f,
+                "shard {}/{} must hold {expected} nodes of {CHANNELS} values",
+                shard.k, shard.n
+            ),
+            ShardError::NotAShard(name) => write!(f, "{name}: not a T3 shard file"),
+            ShardError::Checksum(name) => {
+                write!(f, "{name}: checksum mismatch (truncated or corrupted)")
+            }
+            ShardError::OtherGenerator(name) => write!(
+                f,
+                "{name}: built by a different generator version or T3 layout \
+                 (this is generator {GENERATOR_VERSION})"
+            ),
+            ShardError::BadHeader {
+                name,
+                k,
+                n,
+                channels,
+            } => write!(
+                f,
+                "{name}: invalid shard header ({k}/{n}, {channels} channels)"
+            ),
+            ShardError::NodeCount {
+                name,
+                shard,
+                count,
+                expected,
+            } => write!(
+                f,
+                "{name}: shard {}/{} holds {count} nodes, expected {expected}",
+                shard.k, shard.n
+            ),
+            ShardError::NoFiles => write!(f, "no shard files given"),
+            ShardError::MixedSplits {
+                name,
+                shard,
+                first,
+                n,
+            } => write!(
+                f,
+                "{name} is shard {}/{} but {first} is of {n} shards",
+                shard.k, shard.n
+            ),
+            ShardError::Repeated {
+                shard,
+                first,
+                second,
+            } => write!(
+                f,
+                "shard {}/{} given twice: {first} and {second}",
+                shard.k, shard.n
+            ),
+            ShardError::Missing { k, n } => {
+                let shown: Vec<String> = k.iter().take(10).map(|k| format!("{k}/{n}")).collect();
+                write!(f, "missing shards: {}", shown.join(", "))?;
+                if k.len() > shown.len() {
+                    write!(f, " and {} more", k.len() - shown.len())?;
+                }
+                Ok(())
+            }
+        }
     }
 }
 
+impl std::error::Error for ShardError {}
+
 /// The bytes of shard `shard` holding `nodes` (its nodes' values in
 /// ascending index order, [`CHANNELS`] each).
-pub fn encode(shard: Shard, nodes: &[Vec<f32>]) -> Result<Vec<u8>, BuildError> {
+pub fn encode(shard: Shard, nodes: &[Vec<f32>]) -> Result<Vec<u8>, ShardError> {
     let expected = shard.indices().count();
     if nodes.len() != expected || nodes.iter().any(|v| v.len() != CHANNELS) {
-        return Err(shard_error(format!(
-            "shard {}/{} must hold {expected} nodes of {CHANNELS} values",
-            shard.k, shard.n
-        )));
+        return Err(ShardError::WrongShape { shard, expected });
     }
     let mut out = Vec::with_capacity(HEAD + expected * CHANNELS * 4 + 8);
     out.extend_from_slice(MAGIC);
@@ -108,35 +244,36 @@ struct Decoded {
     values: Vec<f32>,
 }
 
-fn decode(name: &str, bytes: &[u8]) -> Result<Decoded, String> {
+fn decode(name: &str, bytes: &[u8]) -> Result<Decoded, ShardError> {
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
     if bytes.len() < HEAD + 8 || &bytes[..8] != MAGIC {
-        return Err(format!("{name}: not a T3 shard file"));
+        return Err(ShardError::NotAShard(name.to_string()));
     }
     let (body, sum) = bytes.split_at(bytes.len() - 8);
     if fnv1a(FNV_OFFSET, body).to_le_bytes() != sum {
-        return Err(format!(
-            "{name}: checksum mismatch (truncated or corrupted)"
-        ));
+        return Err(ShardError::Checksum(name.to_string()));
     }
     if bytes[8..16] != fingerprint().to_le_bytes() {
-        return Err(format!(
-            "{name}: built by a different generator version or T3 layout \
-             (this is generator {GENERATOR_VERSION})"
-        ));
+        return Err(ShardError::OtherGenerator(name.to_string()));
     }
     let (k, n, count, channels) = (u32_at(16), u32_at(20), u32_at(24), u32_at(28));
     if k == 0 || k > n || channels as usize != CHANNELS {
-        return Err(format!(
-            "{name}: invalid shard header ({k}/{n}, {channels} channels)"
-        ));
+        return Err(ShardError::BadHeader {
+            name: name.to_string(),
+            k,
+            n,
+            channels,
+        });
     }
     let shard = Shard { k, n };
     let expected = shard.indices().count();
     if count as usize != expected || body.len() != HEAD + expected * CHANNELS * 4 {
-        return Err(format!(
-            "{name}: shard {k}/{n} holds {count} nodes, expected {expected}"
-        ));
+        return Err(ShardError::NodeCount {
+            name: name.to_string(),
+            shard,
+            count,
+            expected,
+        });
     }
     let values = body[HEAD..]
         .chunks_exact(4)
@@ -148,50 +285,40 @@ fn decode(name: &str, bytes: &[u8]) -> Result<Decoded, String> {
 /// The grid of the whole table (every node's [`CHANNELS`] values, in index
 /// order) from the `N` shard files `files` (name, bytes), in any order.
 /// Errors name the missing, repeated or mismatched shards.
-pub fn merge_grid(files: &[(String, Vec<u8>)]) -> Result<Vec<f32>, BuildError> {
+pub fn merge_grid(files: &[(String, Vec<u8>)]) -> Result<Vec<f32>, ShardError> {
     let decoded = files
         .iter()
         .map(|(name, bytes)| decode(name, bytes))
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(shard_error)?;
+        .collect::<Result<Vec<_>, ShardError>>()?;
     let Some(first) = decoded.first() else {
-        return Err(shard_error("no shard files given".into()));
+        return Err(ShardError::NoFiles);
     };
     let n = first.shard.n;
     if let Some((i, d)) = decoded.iter().enumerate().find(|(_, d)| d.shard.n != n) {
-        return Err(shard_error(format!(
-            "{} is shard {}/{} but {} is of {n} shards",
-            files[i].0, d.shard.k, d.shard.n, files[0].0
-        )));
+        return Err(ShardError::MixedSplits {
+            name: files[i].0.clone(),
+            shard: d.shard,
+            first: files[0].0.clone(),
+            n,
+        });
     }
     let mut owner: Vec<Option<usize>> = vec![None; n as usize];
     for (i, d) in decoded.iter().enumerate() {
         let slot = &mut owner[d.shard.k as usize - 1];
         if let Some(j) = *slot {
-            return Err(shard_error(format!(
-                "shard {}/{n} given twice: {} and {}",
-                d.shard.k, files[j].0, files[i].0
-            )));
+            return Err(ShardError::Repeated {
+                shard: d.shard,
+                first: files[j].0.clone(),
+                second: files[i].0.clone(),
+            });
         }
         *slot = Some(i);
     }
-    let missing: Vec<String> = owner
-        .iter()
-        .enumerate()
-        .filter(|(_, o)| o.is_none())
-        .map(|(k, _)| format!("{}/{n}", k + 1))
+    let missing: Vec<u32> = (1..=n)
+        .filter(|&k| owner[k as usize - 1].is_none())
         .collect();
     if !missing.is_empty() {
-        let shown = missing.len().min(10);
-        let more = if missing.len() > shown {
-            format!(" and {} more", missing.len() - shown)
-        } else {
-            String::new()
-        };
-        return Err(shard_error(format!(
-            "missing shards: {}{more}",
-            missing[..shown].join(", ")
-        )));
+        return Err(ShardError::Missing { k: missing, n });
     }
     let mut grid = vec![0.0f32; node_count() * CHANNELS];
     for d in &decoded {
