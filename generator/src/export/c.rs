@@ -1,0 +1,218 @@
+//! The C header of `generator export --format c`: per table `<stem>.h` with
+//! the arrays as `static const`, the axis constants as macros, one inline
+//! function per axis that maps a physical value to its fractional node
+//! position, and the interpolation weights the tables use (in the style of
+//! Cycles' precomputed tables and Filament's `dfg.inc`). docs/export.md
+//! describes the arrays and the lookups.
+
+use std::fmt::Write as _;
+
+use twoscale::format::Mapping;
+use twoscale::interp::coordinate_f64;
+
+use super::{Encoded, NamedArray, Source, aux_array, interpolation, npy};
+
+/// `t1-smith-g1` → `ts_t1_smith_g1`.
+pub fn prefix(stem: &str) -> String {
+    format!("ts_{}", stem.replace('-', "_"))
+}
+
+/// An f32 as a C literal that reads back to the same value.
+fn c_float(x: f32) -> String {
+    let text = format!("{x:e}");
+    format!("{text}f")
+}
+
+/// Helpers shared by every header (guarded, so that several headers can be
+/// included together).
+const COMMON: &str = r#"#ifndef TS_EXPORT_COMMON
+#define TS_EXPORT_COMMON
+/* Splits a fractional node position u in [0, nodes - 1] into a cell i in
+ * [0, nodes - 2] and a fraction t in [0, 1] (the runtime's Axis::locate). */
+static inline int ts_cell(float u, int nodes, float *t) {
+    int i = (int)floorf(u);
+    if (i > nodes - 2) i = nodes - 2;
+    if (i < 0) i = 0;
+    *t = u - (float)i;
+    return i;
+}
+/* Uniform cubic B-spline weights of coefficients i, i+1, i+2, i+3 at fraction t
+ * of cell i (coefficient j sits at node j - 1). */
+static inline void ts_bspline_weights(float t, float w[4]) {
+    float s = 1.0f - t, t2 = t * t, t3 = t2 * t;
+    w[0] = s * s * s / 6.0f;
+    w[1] = (3.0f * t3 - 6.0f * t2 + 4.0f) / 6.0f;
+    w[2] = (-3.0f * t3 + 3.0f * t2 + 3.0f * t + 1.0f) / 6.0f;
+    w[3] = t3 / 6.0f;
+}
+/* Catmull-Rom weights of nodes i-1, i, i+1, i+2 at fraction t of cell i
+ * (T3's parameter axes; the first and last cell use the quadratic through
+ * their three nodes instead: docs/export.md). */
+static inline void ts_catmull_rom_weights(float t, float w[4]) {
+    float t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5f * (-t3 + 2.0f * t2 - t);
+    w[1] = 0.5f * (3.0f * t3 - 5.0f * t2 + 2.0f);
+    w[2] = 0.5f * (-3.0f * t3 + 4.0f * t2 + t);
+    w[3] = 0.5f * (t3 - t2);
+}
+#endif
+"#;
+
+/// Writes `values` as the body of a C array initialiser, eight per line.
+fn initialiser<T>(out: &mut String, values: &[T], format: impl Fn(&T) -> String) {
+    for chunk in values.chunks(8) {
+        out.push_str("   ");
+        for v in chunk {
+            out.push(' ');
+            out.push_str(&format(v));
+            out.push(',');
+        }
+        out.push('\n');
+    }
+}
+
+/// One array as a `static const` definition with a comment on its shape.
+fn array(out: &mut String, name: &str, named: &NamedArray, comment: &str) {
+    let shape = &named.array.shape;
+    let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+    let _ = writeln!(
+        out,
+        "/* {comment}; shape [{}], C order (last index fastest). */",
+        dims.join("][")
+    );
+    match &named.array.data {
+        npy::Data::F32(v) => {
+            let _ = writeln!(out, "static const float {name}[{}] = {{", v.len());
+            initialiser(out, v, |x| c_float(*x));
+        }
+        npy::Data::U16(v) => {
+            let _ = writeln!(out, "static const uint16_t {name}[{}] = {{", v.len());
+            initialiser(out, v, u16::to_string);
+        }
+    }
+    out.push_str("};\n\n");
+}
+
+/// The C expression of an axis's coordinate `c(x)`.
+fn coordinate_expression(mapping: Mapping, param: f64, param2: f64) -> String {
+    match mapping {
+        Mapping::Uniform => "x".into(),
+        Mapping::Log => "logf(x)".into(),
+        Mapping::LogOffset if param2 != 0.0 => format!(
+            "logf(x + {}) + {} * x",
+            c_float(param as f32),
+            c_float(param2 as f32)
+        ),
+        Mapping::LogOffset => format!("logf(x + {})", c_float(param as f32)),
+        Mapping::Power => format!("powf(x, {})", c_float(param as f32)),
+    }
+}
+
+/// The header of one table with the encoded precisions.
+pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
+    let header = source.table.header();
+    let id = header.table_id;
+    let stem = id.name();
+    let p = prefix(stem);
+    let upper = p.to_uppercase();
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "/* {stem}.h: written by `generator export --format c` from {stem}.tbl; do not edit.\n\
+         * {}\n\
+         * Interpolation: {}\n\
+         * Every array, axis and lookup is described in docs/export.md. */\n\
+         #ifndef {upper}_H\n#define {upper}_H\n#include <math.h>\n#include <stdint.h>\n\n{COMMON}\n",
+        id.description(),
+        interpolation(id)
+    );
+    let _ = writeln!(out, "#define {upper}_CHANNELS {}", header.channels);
+    for (name, value) in id.param_names().iter().zip(header.params) {
+        let _ = writeln!(out, "#define {upper}_{} {value:e}", name.to_uppercase());
+    }
+    out.push('\n');
+    for (d, axis) in header.used_axes().iter().enumerate() {
+        let name = id.axis_names().get(d).copied().unwrap_or("axis");
+        let a = format!("{upper}_{}", name.to_uppercase());
+        let c_lo = coordinate_f64(axis, axis.lo);
+        let c_hi = coordinate_f64(axis, axis.hi);
+        let cells = axis.nodes - 1;
+        let _ = write!(
+            out,
+            "/* Axis {d}, {name}: {} nodes on [{}, {}], evenly spaced in c(x) = {}.\n\
+             * Stored per axis: {} ({}). */\n\
+             #define {a}_NODES {}\n#define {a}_LO {}\n#define {a}_HI {}\n\
+             /* Fractional node position of x in [0, {cells}]: x clamped to [lo, hi] (NaN -> lo),\n\
+             * u = (c(x) - c(lo)) * {cells} / (c(hi) - c(lo)). */\n\
+             static inline float {p}_{name}_position(float x) {{\n\
+             \x20   x = fminf(fmaxf(x, {a}_LO), {a}_HI);\n\
+             \x20   float u = ({} - {}) * {};\n\
+             \x20   return fminf(fmaxf(u, 0.0f), {}.0f);\n}}\n\n",
+            axis.nodes,
+            axis.lo,
+            axis.hi,
+            axis.mapping.describe(axis.param, axis.param2),
+            header.kernel.stored_per_axis(axis.nodes),
+            match header.kernel {
+                twoscale::format::Kernel::Multilinear => "node values",
+                twoscale::format::Kernel::CubicBSpline => "B-spline coefficients, nodes + 2",
+            },
+            axis.nodes,
+            c_float(axis.lo as f32),
+            c_float(axis.hi as f32),
+            coordinate_expression(axis.mapping, axis.param, axis.param2),
+            c_float(c_lo as f32),
+            c_float((f64::from(cells) / (c_hi - c_lo)) as f32),
+            cells
+        );
+    }
+    if let Some(aux) = aux_array(source) {
+        array(
+            &mut out,
+            &format!("{p}_aux"),
+            &aux,
+            "k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) at each p node",
+        );
+    }
+    for e in encoded {
+        if let Some((offset, step)) = e.unorm {
+            let _ = writeln!(
+                out,
+                "/* unorm16: value = {p}_unorm16_offset + code * {p}_unorm16_step (f32). */\n\
+                 static const float {p}_unorm16_offset = {};\nstatic const float {p}_unorm16_step = {};\n",
+                c_float(offset),
+                c_float(step)
+            );
+        }
+        for a in &e.arrays {
+            let comment = match a.suffix.as_str() {
+                "f32" => "values as the runtime reads them".to_string(),
+                "unorm16" if e.unorm.is_none() => {
+                    "u16 codes; value = scales[node][0] + code * scales[node][1]".to_string()
+                }
+                "unorm16" => "u16 codes".to_string(),
+                "unorm16-scales" => "per node (offset, step) of the u16 codes".to_string(),
+                other => other.to_string(),
+            };
+            let name = format!("{p}_{}", a.suffix.replace('-', "_"));
+            array(&mut out, &name, a, &comment);
+        }
+    }
+    let _ = writeln!(out, "#endif /* {upper}_H */");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn float_literals_read_back_exactly() {
+        for x in [0.2f32, 1.0, 1.0527e-5, -3.4e38, 0.0, 65535.0] {
+            let text = c_float(x);
+            assert!(text.ends_with('f'));
+            assert_eq!(text.trim_end_matches('f').parse::<f32>().unwrap(), x);
+        }
+        assert_eq!(prefix("t3-convolution"), "ts_t3_convolution");
+    }
+}
