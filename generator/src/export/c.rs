@@ -119,9 +119,9 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
     let _ = write!(
         out,
         "/* {stem}.h: written by `generator export --format c` from {stem}.tbl; do not edit.\n\
-         * {}\n\
-         * Interpolation: {}\n\
-         * Every array, axis and lookup is described in docs/export.md. */\n\
+         \x20* {}\n\
+         \x20* Interpolation: {}\n\
+         \x20* Every array, axis and lookup is described in docs/export.md. */\n\
          #ifndef {upper}_H\n#define {upper}_H\n#include <math.h>\n#include <stdint.h>\n\n{COMMON}\n",
         id.description(),
         interpolation(id)
@@ -140,13 +140,13 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
         let _ = write!(
             out,
             "/* Axis {d}, {name}: {} nodes on [{}, {}], evenly spaced in c(x) = {}.\n\
-             * Stored per axis: {} ({}). */\n\
+             \x20* Stored per axis: {} ({}). */\n\
              #define {a}_NODES {}\n#define {a}_LO {}\n#define {a}_HI {}\n\
              /* Fractional node position of x in [0, {cells}]: x clamped to [lo, hi] (NaN -> lo),\n\
-             * u = (c(x) - c(lo)) * {cells} / (c(hi) - c(lo)). */\n\
+             \x20* u = (c(x) - c(lo)) * {cells} / (c(hi) - c(lo)). */\n\
              static inline float {p}_{name}_position(float x) {{\n\
              \x20   x = fminf(fmaxf(x, {a}_LO), {a}_HI);\n\
-             \x20   float u = ({} - {}) * {};\n\
+             \x20   float u = ({} - ({})) * {};\n\
              \x20   return fminf(fmaxf(u, 0.0f), {}.0f);\n}}\n\n",
             axis.nodes,
             axis.lo,
