@@ -163,6 +163,27 @@ fn c_headers_compile_and_hold_the_runtime_values() {
             }
         }
     }
+    // T3's normalised angle in C against the runtime's.
+    let t3_file = open(TableId::Convolution);
+    let angle = twoscale::ConvTable::from_bytes(t3_file.bytes())
+        .unwrap()
+        .angle_params();
+    let mut rng = generator::rng::SplitMix64::new(5);
+    for _ in 0..200 {
+        let tau = rng.log_uniform_in(1e-6, 2e4);
+        let u = rng.log_uniform_in(1e-3, 3000.0);
+        let beta = rng.log_uniform_in(0.002, 1.0);
+        let p = rng.uniform_in(0.2, 5.0);
+        body.push_str(&format!(
+            "    printf(\"%a\\n\", ts_t3_convolution_normalised_angle({tau:e}, {u:e}, {beta:e}, {p:e}));\n"
+        ));
+        let xi = twoscale::conv::normalised_angle(tau, u, beta, p, &angle);
+        expected.push((
+            format!("xi(tau = {tau:e}, u = {u:e}, β = {beta:e}, p = {p})"),
+            xi,
+            1e-12,
+        ));
+    }
     program.push_str("int main(void) {\n");
     program.push_str(&body);
     program.push_str("    return 0;\n}\n");

@@ -7,6 +7,7 @@
 
 use std::fmt::Write as _;
 
+use twoscale::TableId;
 use twoscale::format::Mapping;
 use twoscale::interp::coordinate_f64;
 
@@ -108,6 +109,47 @@ fn coordinate_expression(mapping: Mapping, param: f64, param2: f64) -> String {
     }
 }
 
+/// T3's normalised angle in C (double, as the runtime's
+/// `twoscale::conv::normalised_angle`; `P` is the macro prefix of the
+/// header's parameters, `p` the function prefix).
+fn normalised_angle(p: &str, u: &str) -> String {
+    format!(
+        r#"/* The normalised angle xi in [0, 1] of tau = tan(theta_h) for the (clamped) parameters
+ * (u, beta, p): xi = F(min(tau, tau_max)) / F(tau_max), F as in docs/export.md (T3, step 3);
+ * in double, as the runtime's twoscale::conv::normalised_angle. tau < 0 is 0. */
+static inline double {p}_asinh_pos(double x) {{
+    return log1p(x + x * x / (1.0 + sqrt(1.0 + x * x)));
+}}
+static inline double {p}_angle_f(double tau, double u, double beta, double p) {{
+    double ue = sqrt(u * u + {u}_KERNEL_SCALE_FLOOR * {u}_KERNEL_SCALE_FLOOR);
+    double p_eff = p / (1.0 + {u}_NDF_SOFTENING * p / (2.0 * ue * beta));
+    double tau_edge = beta * exp(log({u}_NDF_EXPONENT_CAP) / (2.0 * p_eff));
+    double fade = 1.0 / (1.0 + (tau_edge / {u}_EDGE_FADE_TAN) * (tau_edge / {u}_EDGE_FADE_TAN));
+    double delta = {u}_EDGE_SMOOTHING / (2.0 * ue);
+    double secant = sqrt(1.0 + tau * tau);
+    double kernel = {p}_asinh_pos(2.0 * ue * tau / secant);
+    double horizon = 0.5 * log1p(tau * tau);
+    double y = tau > 0.0 ? exp(2.0 * p_eff * log(tau / beta)) : 0.0;
+    double ndf = log1p({u}_NDF_EXPONENT_CAP * -expm1(-(y / {u}_NDF_EXPONENT_CAP)));
+    double edge = 0.0;
+    if (fade > 0.0) {{
+        double offset = atan((tau - tau_edge) / (1.0 + tau * tau_edge));
+        double beyond = fmin(0.5 * (offset + sqrt(offset * offset + delta * delta)),
+                             1.5707963267948966);
+        edge = fade * {p}_asinh_pos(2.0 * ue * sin(beyond));
+    }}
+    return kernel + {u}_HORIZON_WEIGHT * horizon + {u}_EDGE_WEIGHT * edge + {u}_NDF_WEIGHT * ndf;
+}}
+static inline double {p}_normalised_angle(double tau, double u, double beta, double p) {{
+    double t = fmin(fmax(tau, 0.0), {u}_TAU_MAX);
+    double xi = {p}_angle_f(t, u, beta, p) / {p}_angle_f({u}_TAU_MAX, u, beta, p);
+    return fmin(fmax(xi, 0.0), 1.0);
+}}
+
+"#
+    )
+}
+
 /// The header of one table with the encoded precisions.
 pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
     let header = source.table.header();
@@ -165,6 +207,9 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             c_float((f64::from(cells) / (c_hi - c_lo)) as f32),
             cells
         );
+    }
+    if id == TableId::Convolution {
+        out.push_str(&normalised_angle(&p, &upper));
     }
     if let Some(aux) = aux_array(source) {
         array(
