@@ -150,6 +150,92 @@ static inline double {p}_normalised_angle(double tau, double u, double beta, dou
     )
 }
 
+/// The lookups of T1, T2 and T5 in C over the header's first exported
+/// precision (`value` is the C expression of stored value `k`), as the
+/// runtime does them (docs/export.md); T3's full lookup is left to the
+/// consumer (its normalised angle is in the header).
+fn lookups(id: TableId, p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value.replace("(k)", &format!("({k})"));
+    match id {
+        TableId::SmithG1 => format!(
+            r#"/* G1 bilinear in (p, a_scaled) inside the table (a_scaled <= {u}_A_SCALED_HI). */
+static inline float {p}_bilinear(float p, float a_scaled) {{
+    float tp, ta;
+    int i = ts_cell({p}_p_position(p), {u}_P_NODES, &tp);
+    int j = ts_cell({p}_a_scaled_position(a_scaled), {u}_A_SCALED_NODES, &ta);
+    int n = {u}_A_SCALED_NODES;
+    float v00 = {}, v01 = {};
+    float v10 = {}, v11 = {};
+    float g0 = v00 + ta * (v01 - v00), g1 = v10 + ta * (v11 - v10);
+    return g0 + tp * (g1 - g0);
+}}
+/* Smith G1 of the EPD at shape p and a = beta * tan(theta) (HP17 38), given
+ * k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) (once per material): the table for
+ * a_scaled = k_p * a up to its last node, the asymptote Lambda(last) + (a_scaled - last)
+ * beyond. a <= 0 or NaN gives 1. */
+static inline float {p}_g1(float p, float a, float k_p) {{
+    if (!(a > 0.0f)) return 1.0f;
+    float a_scaled = k_p * a;
+    if (a_scaled <= {u}_A_SCALED_HI) return {p}_bilinear(p, a_scaled);
+    float g_last = {p}_bilinear(p, {u}_A_SCALED_HI);
+    float lambda_last = g_last > 0.0f ? fmaxf(1.0f / g_last - 1.0f, 0.0f) : 3.4028235e38f;
+    return 1.0f / (1.0f + lambda_last + (a_scaled - {u}_A_SCALED_HI));
+}}
+
+"#,
+            v("i * n + j"),
+            v("i * n + j + 1"),
+            v("(i + 1) * n + j"),
+            v("(i + 1) * n + j + 1")
+        ),
+        TableId::DiffuseFresnel => format!(
+            r#"/* F_dr,int(eta): the cubic B-spline at eta clamped to [1, 3], clamped to [0, 1]. */
+static inline float {p}_f_dr(float eta) {{
+    float t, w[4];
+    int i = ts_cell({p}_eta_position(eta), {u}_ETA_NODES, &t);
+    ts_bspline_weights(t, w);
+    float f = w[0] * {} + w[1] * {} + w[2] * {} + w[3] * {};
+    return fminf(fmaxf(f, 0.0f), 1.0f);
+}}
+
+"#,
+            v("i"),
+            v("i + 1"),
+            v("i + 2"),
+            v("i + 3")
+        ),
+        TableId::SigmaRatio => format!(
+            r#"/* sigma_rel / sigma_s inside the table's domain (B in [0.05, 3000], c in (1, 100]):
+ * q = tricubic B-spline at (cos theta_i, B, c), times r0 = sqrt(1 - (1 + B^2)^(-(c-1)/2)).
+ * Outside it the runtime applies the rules of runtime/src/kcorr.rs. */
+static inline float {p}_sigma_ratio(float cos_theta_i, float big_b, float c) {{
+    float t0, t1, t2, w0[4], w1[4], w2[4];
+    int i0 = ts_cell({p}_cos_theta_i_position(cos_theta_i), {u}_COS_THETA_I_NODES, &t0);
+    int i1 = ts_cell({p}_B_position(big_b), {u}_B_NODES, &t1);
+    int i2 = ts_cell({p}_c_position(c), {u}_C_NODES, &t2);
+    int n1 = {u}_B_NODES + 2, n2 = {u}_C_NODES + 2;
+    ts_bspline_weights(t0, w0);
+    ts_bspline_weights(t1, w1);
+    ts_bspline_weights(t2, w2);
+    float q = 0.0f;
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++)
+            for (int d = 0; d < 4; d++) {{
+                int k = ((i0 + a) * n1 + i1 + b) * n2 + i2 + d;
+                q += w0[a] * w1[b] * w2[d] * {};
+            }}
+    double bb = big_b, cc = c;
+    double r0 = sqrt(fmax(-expm1(-(cc - 1.0) / 2.0 * log1p(bb * bb)), 0.0));
+    return (float)(q * r0);
+}}
+
+"#,
+            v("k")
+        ),
+        _ => String::new(),
+    }
+}
+
 /// The header of one table with the encoded precisions.
 pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
     let header = source.table.header();
@@ -241,6 +327,19 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             };
             let name = format!("{p}_{}", a.suffix.replace('-', "_"));
             array(&mut out, &name, a, &comment);
+        }
+    }
+    // The lookups read the first exported precision.
+    if let Some(e) = encoded.first() {
+        let value = match (e.precision, e.unorm) {
+            (super::Precision::F32, _) => Some(format!("{p}_f32[(k)]")),
+            (super::Precision::Unorm16, Some(_)) => Some(format!(
+                "({p}_unorm16_offset + (float){p}_unorm16[(k)] * {p}_unorm16_step)"
+            )),
+            _ => None,
+        };
+        if let Some(value) = value {
+            out.push_str(&lookups(id, &p, &upper, &value));
         }
     }
     let _ = writeln!(out, "#endif /* {upper}_H */");
