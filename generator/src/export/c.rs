@@ -232,6 +232,91 @@ static inline float {p}_sigma_ratio(float cos_theta_i, float big_b, float c) {{
 "#,
             v("k")
         ),
+        TableId::Convolution => format!(
+            r#"/* T3's parameter-axis weights at node position x (docs/export.md, T3 step 2): writes the
+ * weights to w, the first node to *start and returns the node count (4, or 3 in an end cell). */
+static inline int {p}_axis_weights(float x, int nodes, float w[4], int *start) {{
+    float t;
+    int i = ts_cell(x, nodes, &t);
+    if (i >= 1 && i + 2 < nodes) {{
+        ts_catmull_rom_weights(t, w);
+        *start = i - 1;
+        return 4;
+    }}
+    if (i == 0) {{
+        w[0] = 0.5f * (t - 1.0f) * (t - 2.0f); w[1] = -t * (t - 2.0f); w[2] = 0.5f * t * (t - 1.0f);
+        *start = 0;
+    }} else {{
+        w[0] = 0.5f * t * (t - 1.0f); w[1] = (1.0f - t) * (1.0f + t); w[2] = 0.5f * t * (t + 1.0f);
+        *start = i - 1;
+    }}
+    w[3] = 0.0f;
+    return 3;
+}}
+/* C(theta_h; u, c, beta, p) from T3b at tau = tan(theta_h) (docs/export.md, T3 steps 1-5), as the
+ * runtime's ConvTable::at_tan: 0 for non-finite input. */
+static inline float {p}_conv(double tau, float u, float c, float beta, float p) {{
+    if (!(isfinite(u) && isfinite(c) && isfinite(beta) && isfinite(p)) || isnan(tau)) return 0.0f;
+    c = fminf(fmaxf(c, {u}_C_LO), {u}_C_HI);
+    beta = fminf(fmaxf(beta, {u}_BETA_LO), {u}_BETA_HI);
+    p = fminf(fmaxf(p, {u}_P_LO), {u}_P_HI);
+    u = fmaxf(u, {u}_U_LO);
+    float factor = 1.0f;
+    if (u > {u}_U_HI) {{
+        /* I(u) / I(u_max), I(u) = (1 - (1 + 4u^2)^((1-c)/2)) / ((c - 1) u^2) */
+        double cm1 = (double)c - 1.0, uf = u, um = {u}_U_HI;
+        double iu = -expm1(-0.5 * cm1 * log1p(4.0 * uf * uf)) / (cm1 * uf * uf);
+        double im = -expm1(-0.5 * cm1 * log1p(4.0 * um * um)) / (cm1 * um * um);
+        double ratio = iu / im;
+        factor = isfinite(ratio) ? (float)ratio : 0.0f;
+        u = {u}_U_HI;
+    }}
+    float w[4][4];
+    int start[4], count[4];
+    count[0] = {p}_axis_weights({p}_u_position(u), {u}_U_NODES, w[0], &start[0]);
+    count[1] = {p}_axis_weights({p}_c_position(c), {u}_C_NODES, w[1], &start[1]);
+    count[2] = {p}_axis_weights({p}_beta_position(beta), {u}_BETA_NODES, w[2], &start[2]);
+    count[3] = {p}_axis_weights({p}_p_position(p), {u}_P_NODES, w[3], &start[3]);
+    int n = (int){u}_ANGLES;
+    double xi = {p}_normalised_angle(tau, u, beta, p);
+    float position = (float)(fmin(fmax(xi, 0.0), 1.0) * (double)(n - 1));
+    int k = (int)floorf(position);
+    if (k > n - 2) k = n - 2;
+    float t = position - (float)k;
+    int first = k - 1 < 0 ? 0 : (k - 1 > n - 4 ? n - 4 : k - 1);
+    float win[4] = {{0.0f, 0.0f, 0.0f, 0.0f}};
+    for (int a = 0; a < count[0]; a++)
+        for (int b = 0; b < count[1]; b++)
+            for (int e = 0; e < count[2]; e++)
+                for (int f = 0; f < count[3]; f++) {{
+                    int node = (((start[0] + a) * {u}_C_NODES + start[1] + b) * {u}_BETA_NODES
+                                + start[2] + e) * {u}_P_NODES + start[3] + f;
+                    float weight = w[0][a] * w[1][b] * w[2][e] * w[3][f];
+                    for (int j = 0; j < 4; j++) {{
+                        int idx = node * {u}_CHANNELS + 2 + first + j;
+                        win[j] += weight * {};
+                    }}
+                }}
+    float v[4];
+    for (int j = 0; j < 4; j++) {{
+        int m = k - 1 + j;
+        m = m < 0 ? 0 : (m > n - 1 ? n - 1 : m);
+        v[j] = win[m - first > 3 ? 3 : m - first];
+    }}
+    float s_left = k == 0 ? v[2] - v[1] : v[1] - v[0];
+    float s_mid = v[2] - v[1];
+    float s_right = k + 2 >= n ? v[2] - v[1] : v[3] - v[2];
+    float d1 = 0.5f * (s_left + s_mid), d2 = 0.5f * (s_mid + s_right);
+    float t2 = t * t, t3 = t2 * t;
+    float ln_c = (2.0f * t3 - 3.0f * t2 + 1.0f) * v[1] + (t3 - 2.0f * t2 + t) * d1
+               + (-2.0f * t3 + 3.0f * t2) * v[2] + (t3 - t2) * d2;
+    float value = expf(ln_c) * factor;
+    return isfinite(value) ? value : 0.0f;
+}}
+
+"#,
+            v("idx")
+        ),
         _ => String::new(),
     }
 }
@@ -335,6 +420,9 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             (super::Precision::F32, _) => Some(format!("{p}_f32[(k)]")),
             (super::Precision::Unorm16, Some(_)) => Some(format!(
                 "({p}_unorm16_offset + (float){p}_unorm16[(k)] * {p}_unorm16_step)"
+            )),
+            (super::Precision::Unorm16, None) => Some(format!(
+                "({p}_unorm16_scales[2 * ((k) / {upper}_CHANNELS)] + (float){p}_unorm16[(k)] * {p}_unorm16_scales[2 * ((k) / {upper}_CHANNELS) + 1])"
             )),
             _ => None,
         };
