@@ -64,6 +64,9 @@ pub enum Error {
     Query(QueryError),
     /// A picture could not be drawn.
     Plot(PlotError),
+    /// `export` failed (the message names the table or file and says why;
+    /// `generator::export` reports its failures as messages).
+    Export(String),
     /// The worker threads could not be set up.
     Threads {
         /// How many were asked for.
@@ -117,6 +120,7 @@ impl fmt::Display for Error {
             Error::Shard(e) => write!(f, "T3 shards: {e}"),
             Error::Query(e) => write!(f, "{e}"),
             Error::Plot(e) => write!(f, "{e}"),
+            Error::Export(message) => write!(f, "{message}"),
             Error::Threads { threads, source } => {
                 write!(f, "cannot set {threads} threads: {source}")
             }
@@ -135,6 +139,7 @@ impl std::error::Error for Error {
             Error::Shard(e) => Some(e),
             Error::Query(e) => Some(e),
             Error::Plot(e) => Some(e),
+            Error::Export(_) => None,
             Error::Threads { source, .. } => Some(source),
         }
     }

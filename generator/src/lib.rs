@@ -9,12 +9,14 @@
 //! - [`query`]: the batch CSV queries of docs/model.md §6;
 //! - [`error`]: what a `generator` subcommand can fail with;
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
+//! - [`export`]: `generator export`, the tables as `.npy` or C headers;
 //! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod analytic;
 pub mod bspline;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod materials;
 pub mod plot;

@@ -150,6 +150,38 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Export tables for use outside Rust (GPU kernels, NumPy, Mitsuba
+    /// textures): `--format npy` writes one .npy per array, `--format c`
+    /// one C header per table; both write tables.json (axes, node values,
+    /// parameters, decoding). Then measures each exported precision as
+    /// `verify` does: decoded, interpolated as the runtime (and a shader)
+    /// does, against the f64 reference. docs/export.md describes every array.
+    Export {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// npy or c.
+        #[arg(long, default_value = "npy")]
+        format: String,
+        /// Tables to export (names or prefixes: t1, t2, t3, t5); all four if none.
+        #[arg(long = "table")]
+        tables: Vec<String>,
+        /// f32, unorm16 or f16. Default: every precision whose rounding is
+        /// within the table's budget (half its accuracy target). A precision
+        /// a table cannot meet is refused with its rounding error.
+        #[arg(long)]
+        precision: Option<String>,
+        /// Table directory to read.
+        #[arg(long, default_value = DEFAULT_TABLES)]
+        dir: PathBuf,
+        /// Random points of the measurement per table and precision, as for
+        /// verify (0: no measurement).
+        #[arg(long, default_value_t = 20_000)]
+        points: usize,
+        /// Seed of the random points.
+        #[arg(long, default_value_t = 2017)]
+        seed: u64,
+    },
     /// Print the header of table files readably.
     Inspect {
         /// Table files.
@@ -235,6 +267,24 @@ fn main() -> ExitCode {
                 font,
             })
         }),
+        Command::Export {
+            out,
+            format,
+            tables,
+            precision,
+            dir,
+            points,
+            seed,
+        } => export(&ExportArgs {
+            out,
+            format,
+            tables,
+            precision,
+            dir,
+            points,
+            seed,
+        })
+        .map_err(Error::Export),
         Command::Inspect { files } => inspect(&files),
         Command::Query { quantity, tables } => query(&quantity, &tables),
     };
@@ -652,6 +702,172 @@ fn plot(args: &PlotArgs) -> Result<ExitCode, Error> {
         eprintln!("wrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The arguments of `export`.
+struct ExportArgs {
+    out: PathBuf,
+    format: String,
+    tables: Vec<String>,
+    precision: Option<String>,
+    dir: PathBuf,
+    points: usize,
+    seed: u64,
+}
+
+fn export(args: &ExportArgs) -> Result<ExitCode, String> {
+    use generator::export::{self, Format, Precision, Source};
+    let format = Format::parse(&args.format)?;
+    let precision = args
+        .precision
+        .as_deref()
+        .map(Precision::parse)
+        .transpose()?;
+    let kinds = if args.tables.is_empty() {
+        export::EXPORTABLE
+            .iter()
+            .map(|id| export::table_by_name(id.name()))
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        args.tables
+            .iter()
+            .map(|n| export::table_by_name(n))
+            .collect::<Result<Vec<_>, _>>()?
+    };
+    let files = kinds
+        .iter()
+        .map(|kind| {
+            let path = args.dir.join(tables::file_name(kind.id()));
+            MappedFile::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let sources = kinds
+        .iter()
+        .zip(&files)
+        .map(|(kind, file)| {
+            Source::new(file.bytes(), kind.id()).map_err(|e| format!("{}: {e}", kind.id().name()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    // Every requested precision is checked before anything is written.
+    let encoded = sources
+        .iter()
+        .map(|source| match precision {
+            Some(p) => export::export_precision(source, p).map(|e| vec![e]),
+            None => export::allowed_precisions(source)
+                .into_iter()
+                .map(|p| export::export_precision(source, p))
+                .collect(),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let path = args.out.join(name);
+        write_atomic(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        eprintln!("wrote {} ({} bytes)", path.display(), bytes.len());
+        Ok::<(), String>(())
+    };
+    for (source, encoded) in sources.iter().zip(&encoded) {
+        let stem = source.id().name();
+        match format {
+            Format::Npy => {
+                let arrays = encoded.iter().flat_map(|e| &e.arrays);
+                for a in export::aux_array(source).iter().chain(arrays) {
+                    write(
+                        &format!("{stem}.{}.npy", a.suffix),
+                        &export::npy::encode(&a.array)?,
+                    )?;
+                }
+            }
+            Format::C => write(
+                &format!("{stem}.h"),
+                export::c::header(source, encoded).as_bytes(),
+            )?,
+        }
+    }
+    let entries: Vec<_> = sources.iter().zip(encoded.iter().cloned()).collect();
+    write("tables.json", export::json(&entries).as_bytes())?;
+    if args.points == 0 {
+        return Ok(ExitCode::SUCCESS);
+    }
+    // The measurement reads back what was written (npy) or the arrays of
+    // the headers (c: the same arrays), decoded as a shader decodes them.
+    let mut reports = Vec::new();
+    for ((kind, file), (source, encoded)) in
+        kinds.iter().zip(&files).zip(sources.iter().zip(&encoded))
+    {
+        for e in encoded {
+            let mut e = e.clone();
+            if format == Format::Npy {
+                e.decoded = read_back(&args.out, source.id().name(), &e)?;
+            }
+            let start = Instant::now();
+            let outcome = export::measure(*kind, source, &e, file.bytes(), args.points, args.seed);
+            eprintln!(
+                "measured {} {} in {:.1} s",
+                source.id().name(),
+                e.precision.name(),
+                start.elapsed().as_secs_f64()
+            );
+            let bytes: usize = e
+                .arrays
+                .iter()
+                .map(|a| a.array.data.len() * a.array.data.item_size())
+                .sum();
+            reports.push(TableReport {
+                stem: format!("{} {}", source.id().name(), e.precision.name()),
+                bytes: bytes as u64,
+                outcome: outcome.map_err(Error::Export),
+            });
+        }
+    }
+    print!("{}", report::text(&reports));
+    Ok(if reports.iter().all(TableReport::passed) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// The values of an exported precision decoded from the .npy files written.
+fn read_back(
+    dir: &Path,
+    stem: &str,
+    encoded: &generator::export::Encoded,
+) -> Result<Vec<f32>, String> {
+    use generator::export::npy::{self, Data};
+    let read = |suffix: &str| {
+        let path = dir.join(format!("{stem}.{suffix}.npy"));
+        let bytes =
+            std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        npy::decode(&bytes).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    let name = encoded.precision.name();
+    match (read(name)?.data, encoded.unorm) {
+        (Data::F32(values), _) => Ok(values),
+        (Data::U16(bits), _) if name == "f16" => Ok(bits
+            .iter()
+            .map(|&b| half::f16::from_bits(b).to_f32())
+            .collect()),
+        (Data::U16(codes), Some((offset, step))) => Ok(codes
+            .iter()
+            .map(|&q| offset + f32::from(q) * step)
+            .collect()),
+        (Data::U16(codes), None) => {
+            let Data::F32(scales) = read("unorm16-scales")?.data else {
+                return Err(format!("{stem}.unorm16-scales.npy is not f32"));
+            };
+            let channels = codes.len() / (scales.len() / 2).max(1);
+            Ok(codes
+                .iter()
+                .enumerate()
+                .map(|(k, &q)| {
+                    let node = k / channels.max(1);
+                    scales[2 * node] + f32::from(q) * scales[2 * node + 1]
+                })
+                .collect())
+        }
+    }
 }
 
 fn inspect(files: &[PathBuf]) -> Result<ExitCode, Error> {
