@@ -10,6 +10,7 @@
 //! Deterministic (fixed seeds); the reference profiles run on rayon's
 //! threads (`RAYON_NUM_THREADS` limits them).
 
+mod brdf_instructions;
 mod common;
 mod t3_angle;
 mod t3_axes;
@@ -138,6 +139,18 @@ enum Study {
     /// The paper's thresholds for T3a's g (HP17 §4.4) read from the
     /// committed table (docs/design/t3-paper-form.md).
     T3Thresholds,
+    /// Instructions per call of the BRDF's eval, pdf, sample and
+    /// construction against the GGX baseline of benches/brdf.rs, counted by
+    /// callgrind (docs/design/speed.md). Needs valgrind.
+    BrdfInstructions {
+        /// Calls per operation (construction: a thousandth).
+        #[arg(long, default_value_t = 10_000)]
+        calls: usize,
+        /// Run this operation only, without valgrind (what the report runs
+        /// under callgrind).
+        #[arg(long)]
+        operation: Option<String>,
+    },
     /// T4's error against the band limit L
     /// (docs/design/t4-band-limits.md).
     T4BandLimits {
@@ -203,6 +216,10 @@ fn main() -> ExitCode {
             Ok(())
         }
         Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
+        Study::BrdfInstructions { calls, operation } => match operation {
+            Some(op) => brdf_instructions::run_calls(&op, calls),
+            None => brdf_instructions::report(calls),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

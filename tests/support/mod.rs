@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 pub mod brdf;
+pub mod cost;
 
 // The README's code examples run as doctests of this crate.
 #[doc = include_str!("../../README.md")]
