@@ -555,7 +555,7 @@ fn evaluate<'py, const K: usize>(
     Ok(Array1::from_vec(out.map_err(value_error)?).into_pyarray(py))
 }
 
-/// G1 of the EPD at shape `p` and `a = cot θ / β` (HP17 36–37): table T1,
+/// G1 of the EPD at shape `p` and `a = β tan θ` (HP17 36–38): table T1,
 /// or the f64 reference (Λ by quadrature) with `reference=True`.
 #[pyfunction]
 #[pyo3(signature = (p, a, *, reference))]

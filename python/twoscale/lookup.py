@@ -8,8 +8,8 @@ from ._columns import broadcast_call
 
 
 def g1(p, a):
-    """Smith G1 of the EPD from table T1, at shape ``p`` and ``a = cot θ / β``
-    (HP17 36–37)."""
+    """Smith G1 of the EPD from table T1, at shape ``p`` and ``a = β tan θ``
+    (HP17 36–38)."""
     return broadcast_call(_native.g1, p, a, reference=False)
 
 

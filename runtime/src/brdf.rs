@@ -876,7 +876,9 @@ impl<'a> TwoScale<'a> {
     /// `u[0]` picks the lobe with the weights of [`TwoScale::lobe_weights`]
     /// (and is rescaled), `u[1], u[2]` drive [`TwoScale::sample_lobe`].
     /// Returns the direction, [`TwoScale::pdf`] there (> 0) and ρ there;
-    /// `None` when nothing can be sampled (see `sample_lobe`).
+    /// `None` when nothing can be sampled (see `sample_lobe`). The specular
+    /// lobe's polar angle comes from the material's tabulated EPD quantile,
+    /// whose density is `D cos θm` within 3e-5 (docs/model.md §2.1).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
         let (o, lobe) = self.sample_direction(i, u)?;
         // pdf(i, o) and eval(i, o) from one geometry.
