@@ -3,12 +3,11 @@
 //! nothing of C is baked) on 10⁵ random direction pairs, for every preset
 //! and for random materials over the domain.
 //!
-//! The target is a relative error of ρ with p99 ≤ 0.5%. It is not met
-//! everywhere yet: `cargo test --release --test bake -- --include-ignored
-//! --nocapture` prints the figures (docs/design/per-material-bake.md). The
-//! tests that run by default hold the bake to what it achieves on the
-//! presets and to T3b's own pointwise budget on random materials, so that a
-//! change that makes it worse fails.
+//! The target is a relative error of ρ with p99 ≤ 0.5%. The presets meet it;
+//! random materials do not yet (1.2%): `cargo test --release --test bake --
+//! --include-ignored --nocapture` prints the figures
+//! (docs/design/per-material-bake.md). By default the random materials are
+//! held to 2%, so that a change that makes the bake worse fails.
 
 use generator::rng::SplitMix64;
 use suite::brdf::{percentile, random_direction};
@@ -87,10 +86,10 @@ fn random_materials(count: u64) -> Vec<Material> {
         .collect()
 }
 
-/// p99 of every preset and of all random materials together.
-fn measure() -> (Vec<(&'static str, f64)>, f64) {
+/// p99 of every preset.
+fn preset_p99s() -> Vec<(&'static str, f64)> {
     let set = TableSet::embedded();
-    let presets = twoscale::materials::PRESETS
+    twoscale::materials::PRESETS
         .iter()
         .enumerate()
         .map(|(k, (name, material))| {
@@ -99,7 +98,12 @@ fn measure() -> (Vec<(&'static str, f64)>, f64) {
                 report(name, errors(&set, material, 100_000, 100 + k as u64)),
             )
         })
-        .collect();
+        .collect()
+}
+
+/// p99 of 20 random materials together.
+fn random_p99() -> f64 {
+    let set = TableSet::embedded();
     let mut all = Vec::new();
     for (m, material) in random_materials(20).iter().enumerate() {
         let e = errors(&set, material, 5_000, 500 + m as u64);
@@ -114,27 +118,29 @@ fn measure() -> (Vec<(&'static str, f64)>, f64) {
         report(&label, e.clone());
         all.extend(e);
     }
-    (presets, report("all random materials", all))
+    report("all random materials", all)
+}
+
+/// The target for the presets: p99 ≤ 0.5% (worst measured: 0.46%, gold-rough).
+#[test]
+fn presets_are_within_half_a_percent_at_p99() {
+    for (name, p99) in preset_p99s() {
+        assert!(p99 <= 5e-3, "{name}: p99 {p99:.2e} > 0.5%");
+    }
 }
 
 #[test]
-#[ignore = "target not met yet: p99 0.70% (gold-hp17-geometry) and 4.3% (random materials)"]
-fn baked_model_is_within_half_a_percent_at_p99() {
-    let (presets, random) = measure();
-    for (name, p99) in presets {
-        assert!(p99 <= 5e-3, "{name}: p99 {p99:.2e} > 0.5%");
-    }
+#[ignore = "target not met yet: p99 1.2% over random materials"]
+fn random_materials_are_within_half_a_percent_at_p99() {
+    let random = random_p99();
     assert!(random <= 5e-3, "random materials: p99 {random:.2e} > 0.5%");
 }
 
-/// The bake as it is: presets within 1% at p99 (the worst measures 0.70%),
-/// random materials within 5% at p99 — T3b's own pointwise p95 target — so
-/// the bake never dominates the table's error budget.
+/// Random materials as the bake is: p99 within 2% (measured 1.2%), below
+/// T3b's own pointwise p95 target, so the bake never dominates the table's
+/// error budget.
 #[test]
-fn baked_model_stays_within_the_t3b_error_budget() {
-    let (presets, random) = measure();
-    for (name, p99) in presets {
-        assert!(p99 <= 1e-2, "{name}: p99 {p99:.2e} > 1%");
-    }
-    assert!(random <= 5e-2, "random materials: p99 {random:.2e} > 5%");
+fn random_materials_stay_within_two_percent_at_p99() {
+    let random = random_p99();
+    assert!(random <= 2e-2, "random materials: p99 {random:.2e} > 2%");
 }

@@ -8,13 +8,15 @@
 //! * [`MaskingBake`]: Smith G1 (T1 at the material's p) on 1025 nodes even in
 //!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
 //!   horizon (G1 = 0).
-//! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 32 × 160
+//! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 48 × 112
 //!   nodes, `u = B cos θd ∈ [0, B]` even in `ln(1 + u/u₀)` and θh even in
-//!   `x = ln((1 + sin θh / w) / cos θh)` (both logarithms are
+//!   `x = ln((1 + sin θh / w(u)) / cos θh)` per row (both logarithms are
 //!   [`math::log2_axis`], a cheap C¹ stand-in), Catmull–Rom in both (edge cells
-//!   extrapolate linearly: a ghost node on each side). `w` is a quarter of the narrowest core the lobe
-//!   can have, so the core gets nodes and the power-law tail (linear in
-//!   `ln sin θh`) is interpolated almost exactly; the `1/cos θh` term spends
+//!   extrapolate linearly: a ghost node on each side). `w(u)` is about a
+//!   quarter of the lobe's core at `u` ([`ConvBake::inv_width`]): each row's
+//!   core gets nodes, rows are blended at equal `x` (as T3 blends at equal
+//!   ξ), and the power-law tail (linear in `ln sin θh`) is interpolated
+//!   almost exactly; the `1/cos θh` term spends
 //!   nodes on the horizon, where `C ∝ cos²θh` and `ln C` diverges. Beyond
 //!   `cos θh = 10⁻³` the last node is used.
 //!
@@ -33,9 +35,9 @@ const MU_NODES: usize = 257;
 /// Nodes of [`MaskingBake`].
 const MASKING_NODES: usize = 1025;
 /// `u` nodes of [`ConvBake`].
-pub const CONV_U_NODES: usize = 32;
+pub const CONV_U_NODES: usize = 48;
 /// `sin θh` nodes of [`ConvBake`].
-pub const CONV_S_NODES: usize = 160;
+pub const CONV_S_NODES: usize = 112;
 /// [`CONV_U_NODES`] and [`CONV_S_NODES`] with a ghost node at each end.
 const PADDED_U: usize = CONV_U_NODES + 2;
 const PADDED_S: usize = CONV_S_NODES + 2;
@@ -296,12 +298,12 @@ impl SlopeQuantileBake {
 /// documentation).
 #[derive(Clone, Debug)]
 pub(crate) struct ConvBake {
+    /// `B`, the largest `u`.
+    big_b: f32,
     /// `(CONV_U_NODES − 1) / ln(1 + B/u₀)`.
     u_scale: f32,
-    /// `1/w`.
-    inv_w: f32,
-    /// `(CONV_S_NODES − 1) / x_max`, `x_max = ln((1 + 1/w) / cos θh,min)`.
-    s_scale: f32,
+    /// A quarter of the NDF's core width (the floor of [`ConvBake::inv_width`]'s `w`).
+    ndf_quarter_width: f32,
     /// `ln C` row-major `[u][θh]` with one ghost node on each side of both
     /// axes (linear extrapolation), so that every cell has four taps.
     ln_c: [f32; PADDED_U * PADDED_S],
@@ -315,51 +317,40 @@ impl ConvBake {
             return None;
         }
         let u_span = math::log2_axis(1.0 + big_b / U0);
-        // The narrowest core: the kernel at u = B (width ~1/(2B) in sin θh),
-        // or the NDF's, where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
-        let kernel_width = 0.5 / big_b;
+        // The NDF's core: where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
         let ndf_width = beta * math::powff(0.1, 0.5 / p);
-        let w = (0.25 * kernel_width.max(ndf_width)).max(1e-6).min(0.25);
-        let inv_w = 1.0 / w;
-        // The axis exactly as `at` computes it (f32).
-        let angle_x = |theta: f64| {
-            let (sin, cos) = (math::sin(theta) as f32, math::cos(theta) as f32);
-            f64::from(math::log2_axis((1.0 + sin * inv_w) / cos))
+        let mut bake = ConvBake {
+            big_b,
+            u_scale: (CONV_U_NODES - 1) as f32 / u_span,
+            ndf_quarter_width: 0.25 * ndf_width,
+            ln_c: [0.0f32; PADDED_U * PADDED_S],
         };
-        let theta_max = math::acos(COS_H_MIN);
-        let s_span = angle_x(theta_max);
-        // θh of each node, by bisection of the increasing x(θh).
-        let mut tans = [0.0f64; CONV_S_NODES];
-        for (k, tan) in tans.iter_mut().enumerate() {
-            let target = k as f64 / (CONV_S_NODES - 1) as f64 * s_span;
-            let (mut lo, mut hi) = (0.0, theta_max);
-            // 34 halvings of [0, π/2]: 1e-10 rad, far below what f32 resolves.
-            for _ in 0..34 {
-                let mid = 0.5 * (lo + hi);
-                if angle_x(mid) < target {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let theta = 0.5 * (lo + hi);
-            *tan = math::sin(theta) / math::cos(theta);
-        }
-        let s_span = s_span as f32;
-        let mut ln_c = [0.0f32; PADDED_U * PADDED_S];
         let mut top = f32::MIN;
         for j in 0..CONV_U_NODES {
             let x_u = j as f64 / (CONV_U_NODES - 1) as f64 * f64::from(u_span);
             let u = (f64::from(U0) * (math::exp2_axis(x_u) - 1.0)) as f32;
             let u = if j + 1 == CONV_U_NODES { big_b } else { u };
+            // This row's θh nodes: x = (1 + sin θ / w)/cos θ inverted,
+            // tan θ = tan(A − B) with tan A = w x, tan B = w/√(1 + w²(x² − 1)).
+            let inv_w = bake.inv_width(u);
+            let w = 1.0 / f64::from(inv_w);
+            let s_span = f64::from(angle_span(inv_w));
+            let mut tans = [0.0f64; CONV_S_NODES];
+            for (k, tan) in tans.iter_mut().enumerate() {
+                let x = math::exp2_axis(k as f64 / (CONV_S_NODES - 1) as f64 * s_span).max(1.0);
+                let tan_a = w * x;
+                let tan_b = w / math::sqrt(1.0 + w * w * (x * x - 1.0));
+                *tan = (tan_a - tan_b) / (1.0 + tan_a * tan_b);
+            }
             let mut profile = [0.0f32; CONV_S_NODES];
             slice.profile_at_tans(u, &tans, &mut profile);
             for (k, &c) in profile.iter().enumerate() {
                 let v = if c > 0.0 { math::lnf(c) } else { f32::MIN };
                 top = top.max(v);
-                ln_c[(j + 1) * PADDED_S + k + 1] = v;
+                bake.ln_c[(j + 1) * PADDED_S + k + 1] = v;
             }
         }
+        let ln_c = &mut bake.ln_c;
         let floor = if top > f32::MIN {
             top - LN_C_RANGE
         } else {
@@ -379,20 +370,28 @@ impl ConvBake {
             ln_c[at(0)] = 2.0 * ln_c[at(1)] - ln_c[at(2)];
             ln_c[at(PADDED_U - 1)] = 2.0 * ln_c[at(PADDED_U - 2)] - ln_c[at(PADDED_U - 3)];
         }
-        Some(ConvBake {
-            u_scale: (CONV_U_NODES - 1) as f32 / u_span,
-            inv_w,
-            s_scale: (CONV_S_NODES - 1) as f32 / s_span,
-            ln_c,
-        })
+        Some(bake)
+    }
+
+    /// `1/w(u)`: `w` is about a quarter of the lobe's core width at `u`, the
+    /// kernel's `1/(2u)` or the NDF's, whichever is wider, and at most ¼:
+    /// `1/w² = 16 + 1/(k² + n²)` with `k = ⅛/(u + ½)`, `n` the NDF's quarter
+    /// width. Smooth in `u`, so that rows at equal `x` interpolate well.
+    #[inline]
+    fn inv_width(&self, u: f32) -> f32 {
+        let k = 0.125 / (u + 0.5);
+        let n = self.ndf_quarter_width;
+        math::sqrtf(16.0 + 1.0 / (k * k + n * n))
     }
 
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
-        let x_u = math::log2_axis(1.0 + u.max(0.0) / U0) * self.u_scale;
-        let x_h = (1.0 + sin_h.max(0.0).min(1.0) * self.inv_w) / cos_h.max(COS_H_MIN as f32);
-        let x_s = math::log2_axis(x_h) * self.s_scale;
+        let u = u.max(0.0).min(self.big_b);
+        let x_u = math::log2_axis(1.0 + u / U0) * self.u_scale;
+        let inv_w = self.inv_width(u);
+        let x_h = (1.0 + sin_h.max(0.0).min(1.0) * inv_w) / cos_h.max(COS_H_MIN as f32);
+        let x_s = math::log2_axis(x_h) * ((CONV_S_NODES - 1) as f32 / angle_span(inv_w));
         let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
         let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);
         let mut ln_c = 0.0f32;
@@ -409,6 +408,12 @@ impl ConvBake {
         let value = math::expf(ln_c);
         if value.is_finite() { value } else { 0.0 }
     }
+}
+
+/// The θh axis's value at `cos θh = 10⁻³` (its last node) for `1/w`.
+#[inline]
+fn angle_span(inv_w: f32) -> f32 {
+    math::log2_axis((1.0 + inv_w) / COS_H_MIN as f32)
 }
 
 /// The first of the four padded node indices (the cell's index, as the
@@ -457,8 +462,8 @@ mod tests {
                     worst = (e, theta, f64::from(u));
                 }
             }
-            // Measured: 0.75% (HP17 nickel geometry) and 0.25%: the grid's
-            // interpolation error of T3b's own profile (docs/design/per-material-bake.md).
+            // The grid's interpolation error of T3b's own profile
+            // (docs/design/per-material-bake.md).
             assert!(
                 worst.0 < 1e-2,
                 "c {c}, β {beta}, p {p}, B {big_b}: baked C off by {:.2e} at θh {:.3}, u {:.2}",
