@@ -265,9 +265,11 @@ fn one_minus_exp_over(x: f64, s: f64) -> f64 {
 /// The two-scale BRDF at one wavelength (see the module documentation).
 ///
 /// Construction bakes what depends only on the material and wavelength
-/// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, and C over
-/// `(u, θh)` when the source of C is T3b; module `bake`), so that `eval`
-/// reads small tables. About 15 KB; `Clone`, not `Copy`.
+/// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, the sampler's
+/// EPD quantile, and C over `(u, θh)` when the source of C is T3b; module
+/// `bake`), so that `eval` reads small tables. 48 KB (C 23 KB, the
+/// direction bake 12 KB, the quantile 8 KB, G1 4 KB; [`Rgb`] three times
+/// that); `Clone`, not `Copy`.
 #[derive(Clone)]
 pub struct TwoScale<'a> {
     ndf: Epd<'a>,
