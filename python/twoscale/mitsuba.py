@@ -16,8 +16,8 @@ wo)`` has ``wi`` towards the light), and the model is not reciprocal for
   *given the camera direction* (``Material.sample(wi=si.wi, u)``): its lobes
   are those of ρ(si.wi, ·), which differ from ρ(·, si.wi) only through
   σrel(θ), so it remains a good importance sampler;
-- ``pdf(si, wo) = Material.pdf(wi=si.wi, wo=wo)``, the exact density of that
-  sampler, and ``sample``'s weight is ``eval / pdf`` at the sampled direction.
+- ``pdf(si, wo) = Material.pdf(wi=si.wi, wo=wo)``, the density of that
+  sampler (to 3e-5, docs/model.md §2.1), and ``sample``'s weight is ``eval / pdf`` at the sampled direction.
 
 This is radiance transport (``ctx.mode == TransportMode.Radiance``, what
 the path tracers use); particle tracing (importance transport) is not

@@ -1,5 +1,6 @@
 //! The two-scale BRDF of Holzschuch & Pacanowski 2017 (docs/model.md §2.5–§2.7):
-//! evaluation, importance sampling and the exact pdf of the sampler, at one
+//! evaluation, importance sampling and the pdf of the sampler (its density
+//! to 3e-5: the specular lobe's quantile is tabulated, docs/model.md §2.1), at one
 //! wavelength ([`TwoScale`]) and at the three default RGB wavelengths
 //! ([`Rgb`]).
 //!
@@ -658,8 +659,8 @@ impl<'a> TwoScale<'a> {
     /// it by (HP17 48) as printed. When every estimate is 0 (η = 1 and no
     /// base) the split `[A_imp, 1 − A_imp, 0]` is used. The weights are
     /// tabulated with the material (linear in `√cos θi` between 257 nodes):
-    /// `sample` and `pdf` read the same table, so the pdf stays the sampler's
-    /// exact density.
+    /// `sample` and `pdf` read the same table, so the weights add no error to
+    /// the pdf.
     pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
         let Some(wi) = upper_unit(i) else {
             return [0.0; 3];
