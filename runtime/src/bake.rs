@@ -9,7 +9,7 @@
 //!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
 //!   horizon (G1 = 0).
 //! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 36 × 150
-//!   nodes, `u = B cos θd ∈ [0, B]` even in `log₂(1 + u/u₀) + u/u₁` and θh
+//!   nodes, `u = B cos θd ∈ [0, B]` even in `log₂(1 + u/u₀) + a u` and θh
 //!   even in `x = ln((1 + sin θh / w(u)) / cos θh)` per row (the logarithms are
 //!   [`math::log2_axis`], a cheap C¹ stand-in), Catmull–Rom in both (edge cells
 //!   extrapolate linearly: a ghost node on each side). `w(u)` is about a
@@ -45,13 +45,17 @@ const PADDED_S: usize = CONV_S_NODES + 2;
 const U0: f32 = 0.1;
 /// `u₁` of the `u` mapping's linear part.
 const U1: f32 = 1.0;
+/// The linear part spans at most this many times the logarithmic part.
+const LINEAR_SHARE: f32 = 2.0;
 
-/// The `u` axis of [`ConvBake`]: `log₂(1 + u/u₀) + u/u₁` (with
-/// [`math::log2_axis`]): logarithmic at small `u`, where T3's own nodes are
-/// dense, linear at large `u`, where the profile keeps narrowing.
+/// The `u` axis of [`ConvBake`]: `log₂(1 + u/u₀) + a u` (with
+/// [`math::log2_axis`]), `a = min(1/u₁, 2 log₂(1 + B/u₀)/B)`: logarithmic at
+/// small `u`, where T3's own nodes are dense, linear at large `u`, where the
+/// profile keeps narrowing; for large `B` the linear part is capped at twice
+/// the logarithmic one so that small `u` keeps its rows.
 #[inline]
-fn u_axis(u: f32) -> f32 {
-    math::log2_axis(1.0 + u / U0) + u / U1
+fn u_axis(u: f32, linear: f32) -> f32 {
+    math::log2_axis(1.0 + u / U0) + u * linear
 }
 /// Smallest `cos θh` of [`ConvBake`]'s angle axis.
 const COS_H_MIN: f64 = 1e-3;
@@ -310,8 +314,10 @@ impl SlopeQuantileBake {
 pub(crate) struct ConvBake {
     /// `B`, the largest `u`.
     big_b: f32,
-    /// `(CONV_U_NODES − 1) / ln(1 + B/u₀)`.
+    /// `(CONV_U_NODES − 1) / u_axis(B)`.
     u_scale: f32,
+    /// The slope of `u_axis`'s linear part.
+    u_linear: f32,
     /// A quarter of the NDF's core width (the floor of [`ConvBake::inv_width`]'s `w`).
     ndf_quarter_width: f32,
     /// `ln C` row-major `[u][θh]` with one ghost node on each side of both
@@ -326,12 +332,14 @@ impl ConvBake {
         if !(big_b > 0.0 && big_b.is_finite()) {
             return None;
         }
-        let u_span = u_axis(big_b);
+        let linear = (1.0 / U1).min(LINEAR_SHARE * math::log2_axis(1.0 + big_b / U0) / big_b);
+        let u_span = u_axis(big_b, linear);
         // The NDF's core: where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
         let ndf_width = beta * math::powff(0.1, 0.5 / p);
         let mut bake = ConvBake {
             big_b,
             u_scale: (CONV_U_NODES - 1) as f32 / u_span,
+            u_linear: linear,
             ndf_quarter_width: 0.25 * ndf_width,
             ln_c: [0.0f32; PADDED_U * PADDED_S],
         };
@@ -342,7 +350,7 @@ impl ConvBake {
             let (mut lo, mut hi) = (0.0f32, big_b);
             for _ in 0..48 {
                 let mid = 0.5 * (lo + hi);
-                if f64::from(u_axis(mid)) < x_u {
+                if f64::from(u_axis(mid, linear)) < x_u {
                     lo = mid;
                 } else {
                     hi = mid;
@@ -408,7 +416,7 @@ impl ConvBake {
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
         let u = u.max(0.0).min(self.big_b);
-        let x_u = u_axis(u) * self.u_scale;
+        let x_u = u_axis(u, self.u_linear) * self.u_scale;
         let inv_w = self.inv_width(u);
         let x_h = (1.0 + sin_h.max(0.0).min(1.0) * inv_w) / cos_h.max(COS_H_MIN as f32);
         let x_s = math::log2_axis(x_h) * ((CONV_S_NODES - 1) as f32 / angle_span(inv_w));
