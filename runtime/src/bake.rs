@@ -25,7 +25,7 @@
 
 use crate::conv::{ConvSlice, catmull_rom_weights};
 use crate::fresnel::{Complex, QConstants, QFactors, fresnel};
-use crate::gamma::{inverse_gamma_p, inverse_gamma_q};
+use crate::gamma::inverse_gamma_two_tailed;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE};
 use crate::smith::SmithShape;
@@ -248,27 +248,17 @@ pub(crate) struct SlopeQuantileBake {
 impl SlopeQuantileBake {
     /// Tabulates the quantile for `(β, p)` as [`crate::epd::Epd`] clamps them.
     pub fn new(beta: f32, p: f32) -> Self {
-        let (p, a) = (f64::from(p), 1.0 / f64::from(p));
-        let ln_gamma_a = math::ln_gamma(a);
+        let p = f64::from(p);
+        let ln_gamma_a = math::ln_gamma(1.0 / p);
         let h = (LOGIT_RANGE.1 - LOGIT_RANGE.0) / (QUANTILE_NODES - 1) as f64;
         let mut nodes = [[0.0f64; 2]; QUANTILE_NODES];
         for (k, node) in nodes.iter_mut().enumerate() {
-            let v = LOGIT_RANGE.0 + k as f64 * h;
-            // u = 1/(1 + e^−v), 1 − u = 1/(1 + e^v), each without cancellation.
-            let y = if v < 0.0 {
-                inverse_gamma_p(a, 1.0 / (1.0 + math::exp(-v)))
-            } else {
-                inverse_gamma_q(a, 1.0 / (1.0 + math::exp(v)))
-            };
-            let ln_y = math::ln(y);
-            // ln(u(1 − u)) = −|v| − 2 ln(1 + e^−|v|).
-            let ln_u_1mu = -v.abs() - 2.0 * math::ln_1p(math::exp(-v.abs()));
-            let slope = math::exp(ln_u_1mu - (a * ln_y - y - ln_gamma_a)) - p;
-            *node = [ln_y - p * v, h * slope];
+            let (g, slope) = exact_g_and_slope(p, ln_gamma_a, LOGIT_RANGE.0 + k as f64 * h);
+            *node = [g, h * slope];
         }
         SlopeQuantileBake {
             ln_beta: math::ln(f64::from(beta)),
-            half_shape: 0.5 * a,
+            half_shape: 0.5 / p,
             nodes,
         }
     }
@@ -306,6 +296,19 @@ impl SlopeQuantileBake {
             / h;
         (g, slope)
     }
+}
+
+/// `G(v)` and `G'(v)` of [`SlopeQuantileBake`] by solving for the quantile
+/// (`ln_gamma_a = ln Γ(1/p)`).
+fn exact_g_and_slope(p: f64, ln_gamma_a: f64, v: f64) -> (f64, f64) {
+    let a = 1.0 / p;
+    // u = 1/(1 + e^−v), 1 − u = 1/(1 + e^v), each without cancellation.
+    let y = inverse_gamma_two_tailed(a, 1.0 / (1.0 + math::exp(-v)), 1.0 / (1.0 + math::exp(v)));
+    let ln_y = math::ln(y);
+    // ln(u(1 − u)) = −|v| − 2 ln(1 + e^−|v|).
+    let ln_u_1mu = -v.abs() - 2.0 * math::ln_1p(math::exp(-v.abs()));
+    let slope = math::exp(ln_u_1mu - (a * ln_y - y - ln_gamma_a)) - p;
+    (ln_y - p * v, slope)
 }
 
 /// `ln C` for one material and wavelength over `(u, sin θh)` (module
@@ -553,16 +556,10 @@ mod tests {
         let mut worst = (0.0f64, 0.0f64, 0.0f64);
         for p in [0.2f64, 0.35, 0.5, 1.0, 2.0, 5.0] {
             let bake = SlopeQuantileBake::new(0.3, p as f32);
-            let a = 1.0 / p;
+            let ln_gamma_a = math::ln_gamma(1.0 / p);
             for _ in 0..20_000 {
                 let v = LOGIT_RANGE.0 + rng.next() * (LOGIT_RANGE.1 - LOGIT_RANGE.0);
-                let y = if v < 0.0 {
-                    inverse_gamma_p(a, 1.0 / (1.0 + math::exp(-v)))
-                } else {
-                    inverse_gamma_q(a, 1.0 / (1.0 + math::exp(v)))
-                };
-                let ln_u_1mu = -v.abs() - 2.0 * math::ln_1p(math::exp(-v.abs()));
-                let exact = math::exp(ln_u_1mu - (a * math::ln(y) - y - math::ln_gamma(a))) - p;
+                let exact = exact_g_and_slope(p, ln_gamma_a, v).1;
                 let e = (bake.g_and_slope(v).1 - exact).abs() / (p + exact);
                 if e > worst.0 {
                     worst = (e, p, v);

@@ -14,7 +14,7 @@
 //! [1e-4, 10]; NaN parameters become the lower bound. Directions are in the
 //! local frame (normal = +z) as unit vectors `[x, y, z]`.
 
-use crate::gamma::{inverse_gamma_p, inverse_gamma_q};
+use crate::gamma::inverse_gamma_two_tailed;
 use crate::math::{self, BELOW_ONE};
 use crate::smith::{SmithG1Table, SmithShape};
 
@@ -153,11 +153,7 @@ impl<'a> Epd<'a> {
     /// `u₀ = ½`, where `1 − u₀` would round away the low tail).
     pub fn sample_tan_theta(&self, u0: f32) -> f32 {
         let u0 = f64::from(u0.max(0.0).min(BELOW_ONE));
-        let y = if u0 < 0.5 {
-            inverse_gamma_p(self.gamma_shape, u0)
-        } else {
-            inverse_gamma_q(self.gamma_shape, 1.0 - u0)
-        };
+        let y = inverse_gamma_two_tailed(self.gamma_shape, u0, 1.0 - u0);
         (f64::from(self.beta) * math::powf(y, 0.5 * self.gamma_shape)) as f32
     }
 }

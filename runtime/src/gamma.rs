@@ -101,6 +101,18 @@ pub const LARGE_A: f64 = 1.0e4;
 /// halvings reach a relative width of 1e-13, well within 80.
 pub const MAX_INVERSE_ITERATIONS: u32 = 80;
 
+/// The Gamma(a, 1) quantile at probability `p` given with its complement
+/// `q = 1 − p` (each computed without cancellation by the caller):
+/// `P⁻¹(a, p)` below `p = ½`, `Q⁻¹(a, q)` above, so that neither tail is
+/// rounded away.
+pub fn inverse_gamma_two_tailed(a: f64, p: f64, q: f64) -> f64 {
+    if p < 0.5 {
+        inverse_gamma_p(a, p)
+    } else {
+        inverse_gamma_q(a, q)
+    }
+}
+
 /// Regularised lower incomplete gamma function `P(a, x) = γ(a, x)/Γ(a)`.
 ///
 /// `P` is the CDF of the Gamma(a, 1) distribution; see the [module docs](self) for the
