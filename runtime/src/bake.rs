@@ -366,19 +366,25 @@ impl ConvBake {
             let inv_w = bake.inv_width(u);
             let w = 1.0 / f64::from(inv_w);
             let s_span = f64::from(angle_span(inv_w));
-            let mut tans = [0.0f64; CONV_S_NODES];
+            // In f32, as the slice's angle is evaluated (module documentation).
+            let mut tans = [0.0f32; CONV_S_NODES];
             for (k, tan) in tans.iter_mut().enumerate() {
                 let x = math::exp2_axis(k as f64 / (CONV_S_NODES - 1) as f64 * s_span).max(1.0);
                 let tan_a = w * x;
                 let tan_b = w / math::sqrt(1.0 + w * w * (x * x - 1.0));
-                *tan = (tan_a - tan_b) / (1.0 + tan_a * tan_b);
+                *tan = ((tan_a - tan_b) / (1.0 + tan_a * tan_b)) as f32;
             }
-            let mut profile = [0.0f32; CONV_S_NODES];
-            slice.profile_at_tans(u, &tans, &mut profile);
-            for (k, &c) in profile.iter().enumerate() {
-                let v = if c > 0.0 { math::lnf(c) } else { f32::MIN };
-                top = top.max(v);
-                bake.ln_c[(j + 1) * PADDED_S + k + 1] = v;
+            let row = &mut bake.ln_c[(j + 1) * PADDED_S + 1..(j + 1) * PADDED_S + 1 + CONV_S_NODES];
+            // ln C = ln s + the profile (s = 1 inside T3's u range).
+            match slice.ln_profile_at_tans(u, &tans, row) {
+                Some(factor) if factor > 0.0 => {
+                    let ln_factor = math::lnf(factor);
+                    for v in row.iter_mut() {
+                        *v += ln_factor;
+                        top = top.max(*v);
+                    }
+                }
+                _ => row.iter_mut().for_each(|v| *v = f32::MIN),
             }
         }
         let ln_c = &mut bake.ln_c;

@@ -67,9 +67,103 @@ forward! {
     cos(x) -> f64 = cos / cos;
     /// arctan x (f64).
     atan(x) -> f64 = atan / atan;
+    /// arctan x (f32).
+    atanf(x) -> f32 = atan / atanf;
     /// arccos x (f64), NaN outside [−1, 1] (callers clamp).
     acos(x) -> f64 = acos / acos;
 }
+
+/// ln(1 + x) (f32) from `ln`: `ln(u) x/(u − 1)` with `u = 1 + x` rounded,
+/// which cancels the rounding of `u` (Goldberg 1991, Theorem 4; within a few
+/// ulp). glibc's `log1pf` costs about twice its `logf`.
+#[inline(always)]
+pub fn ln_1pf_via_ln(x: f32) -> f32 {
+    let u = 1.0 + x;
+    if u == 1.0 || !(u < f32::INFINITY) {
+        // x below half an ulp of 1 (ln(1 + x) = x in f32), ∞ or NaN.
+        if u == 1.0 { x } else { lnf(u) }
+    } else {
+        lnf(u) * (x / (u - 1.0))
+    }
+}
+
+/// A float type with the elementary functions above, so that one formula
+/// serves in f64 (tables, reference paths) and in f32 (per-material bakes,
+/// where f32's rounding is within the error budget).
+pub trait Real:
+    Copy
+    + PartialOrd
+    + core::ops::Add<Output = Self>
+    + core::ops::Sub<Output = Self>
+    + core::ops::Mul<Output = Self>
+    + core::ops::Div<Output = Self>
+    + core::ops::Neg<Output = Self>
+{
+    /// `x` rounded to this type.
+    fn of(x: f64) -> Self;
+    /// This value as f64.
+    fn wide(self) -> f64;
+    /// √x.
+    fn sqrt(self) -> Self;
+    /// ln x.
+    fn ln(self) -> Self;
+    /// ln(1 + x).
+    fn ln_1p(self) -> Self;
+    /// e^x.
+    fn exp(self) -> Self;
+    /// e^x − 1.
+    fn exp_m1(self) -> Self;
+    /// arctan x.
+    fn atan(self) -> Self;
+    /// sin x.
+    fn sin(self) -> Self;
+}
+
+macro_rules! real {
+    ($ty:ty: $sqrt:ident $ln:ident $ln_1p:ident $exp:ident $exp_m1:ident $atan:ident $sin:ident) => {
+        impl Real for $ty {
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                x as $ty
+            }
+            #[inline(always)]
+            fn wide(self) -> f64 {
+                f64::from(self)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $sqrt(self)
+            }
+            #[inline(always)]
+            fn ln(self) -> Self {
+                $ln(self)
+            }
+            #[inline(always)]
+            fn ln_1p(self) -> Self {
+                $ln_1p(self)
+            }
+            #[inline(always)]
+            fn exp(self) -> Self {
+                $exp(self)
+            }
+            #[inline(always)]
+            fn exp_m1(self) -> Self {
+                $exp_m1(self)
+            }
+            #[inline(always)]
+            fn atan(self) -> Self {
+                $atan(self)
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                $sin(self)
+            }
+        }
+    };
+}
+
+real!(f64: sqrt ln ln_1p exp exp_m1 atan sin);
+real!(f32: sqrtf lnf ln_1pf_via_ln expf exp_m1f atanf sinf);
 
 /// ln Γ(x) for x > 0 (f64, libm's `lgamma` in both builds: `std` has no lgamma).
 #[inline]
@@ -135,9 +229,21 @@ pub fn exp2_axis(y: f64) -> f64 {
     for _ in 0..8 {
         let value = m * (d0 + m * (c2 + m * c3)) - f;
         let slope = d0 + m * (2.0 * c2 + 3.0 * m * c3);
-        m = (m - value / slope).max(0.0).min(1.0);
+        let next = (m - value / slope).max(0.0).min(1.0);
+        // Converged (Newton may then alternate between neighbouring floats).
+        let done = abs(next - m) <= 4.0 * f64::EPSILON;
+        m = next;
+        if done {
+            break;
+        }
     }
-    powf(2.0, exponent) * (1.0 + m)
+    // 2^exponent exactly, from its bits when it is a normal f64.
+    let scale = if (-1022.0..=1023.0).contains(&exponent) {
+        f64::from_bits(((exponent as i64 + 1023) as u64) << 52)
+    } else {
+        powf(2.0, exponent)
+    };
+    scale * (1.0 + m)
 }
 
 /// `p(m) = d₀ m + c₂ m² + c₃ m³` of [`log2_axis`]: `d₀ = 1/ln 2`,
