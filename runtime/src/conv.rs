@@ -507,12 +507,13 @@ impl<'a> ConvTable<'a> {
 
     /// T3b restricted to the material `(c, β, p)` (see [`ConvSlice`]);
     /// `None` for non-finite parameters or a table larger than
-    /// [`SLICE_CAPACITY`]. Costs one full blend per `u` node (80 µs for
-    /// the shipped table: `cargo bench --bench lookup -- convolution_setup`).
+    /// [`SLICE_CAPACITY`] or with more than [`SLICE_ANGLES`] angles. Costs
+    /// one blend of all angles per `u` node (`cargo bench --bench lookup --
+    /// convolution_setup`).
     pub fn slice(&self, c: f32, beta: f32, p: f32) -> Option<ConvSlice<'a>> {
         let k = self.clamp(0.0, c, beta, p)?;
         let (u_nodes, angles) = (self.axes[0].nodes(), self.angles);
-        if u_nodes * angles > SLICE_CAPACITY {
+        if u_nodes * angles > SLICE_CAPACITY || angles > SLICE_ANGLES {
             return None;
         }
         let mut values = [0.0f32; SLICE_CAPACITY];
@@ -719,7 +720,8 @@ impl<'a> ConvTable<'a> {
 pub fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) -> f32 {
     let n = angles;
     let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
-    let k = (math::floorf(position) as usize).min(n - 2);
+    // position ≥ 0: truncation is ⌊position⌋.
+    let k = (position as usize).min(n - 2);
     let t = position - k as f32;
     // The four channels around ξ (clamped to the table).
     let k = k as isize;
@@ -752,6 +754,8 @@ pub fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) 
 /// Largest `u nodes × angles` a [`ConvSlice`] holds (the shipped T3 needs
 /// 28 × 32 = 896).
 pub const SLICE_CAPACITY: usize = 1024;
+/// Largest number of angles `ξ` a [`ConvSlice`] takes (the shipped T3 has 32).
+pub const SLICE_ANGLES: usize = 64;
 
 /// T3b restricted to one material: `ln C` blended over `(c, β, p)` once, at
 /// every `u` node and angle, so that a lookup interpolates only `u` and `ξ`
@@ -798,8 +802,8 @@ impl ConvSlice<'_> {
         let (start, count, weights) = t.axis_weights(0, t.axes[0].locate(k.u));
         let angles = t.angles;
         // The u blend of the slice's rows: ln C at this u's ξ nodes.
-        let mut at_u = [0.0f32; SLICE_CAPACITY];
-        let at_u = &mut at_u[..angles.min(SLICE_CAPACITY)];
+        let mut at_u = [0.0f32; SLICE_ANGLES];
+        let at_u = &mut at_u[..angles.min(SLICE_ANGLES)];
         for (a, w) in weights[..count].iter().enumerate() {
             let row = (start + a) * angles;
             if let Some(v) = self.values.get(row..row + at_u.len()) {
