@@ -335,8 +335,9 @@ pub(crate) struct ConvBake {
 }
 
 impl ConvBake {
-    /// Tabulates `slice` for `u ∈ [0, B]`; `beta`, `p` give the NDF's core
-    /// width. `None` when `B` is not positive and finite.
+    /// Tabulates `slice` for `u ∈ [0, B]` (its normalised angle evaluated in
+    /// f32 at the nodes); `beta`, `p` give the NDF's core width. `None` when
+    /// `B` is not positive and finite.
     pub fn new(slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> Option<Self> {
         if !(big_b > 0.0 && big_b.is_finite()) {
             return None;
