@@ -143,3 +143,43 @@ fn spectrum_and_closed_form() {
         assert!(rel(got, want) < 1e-4, "{got} vs {want}");
     });
 }
+
+/// `sigma_ratio_cos_many` (one (B, c) blend, then a 1-D spline per incidence)
+/// gives `sigma_ratio_cos`'s values up to f32 rounding, inside and outside the
+/// table's domain (small and large B, c > 100, no diffraction).
+#[test]
+fn many_incidences_match_one_at_a_time() {
+    with_t2(|t2| {
+        let cosines: Vec<f32> = (0..=400)
+            .map(|k| (k as f32 / 400.0).powi(2))
+            .chain([-0.5, 1.5, f32::NAN])
+            .collect();
+        let mut worst = (0.0f64, 0.0f32, 0.0f32, 0.0f32);
+        for (big_b, c) in [
+            (9.2f32, 2.0f32),
+            (0.01, 3.0),
+            (0.05, 1.01),
+            (40.0, 8.0),
+            (3000.0, 100.0),
+            (9000.0, 2.5),
+            (5.0, 150.0),
+            (5.0, 1.0),
+            (0.0, 2.0),
+        ] {
+            let mut many = vec![0.0f32; cosines.len()];
+            t2.sigma_ratio_cos_many(&cosines, big_b, c, &mut many);
+            for (&cos, &got) in cosines.iter().zip(&many) {
+                let one = t2.sigma_ratio_cos(cos, big_b, c);
+                let e = if one == 0.0 {
+                    f64::from(got.abs())
+                } else {
+                    rel(f64::from(got), f64::from(one))
+                };
+                if e > worst.0 {
+                    worst = (e, cos, big_b, c);
+                }
+            }
+        }
+        assert!(worst.0 <= 1e-6, "{worst:?}");
+    });
+}

@@ -25,7 +25,7 @@
 
 use crate::conv::{ConvSlice, catmull_rom_weights};
 use crate::fresnel::{Complex, QConstants, QFactors, fresnel};
-use crate::gamma::inverse_gamma_two_tailed;
+use crate::gamma::GammaShape;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE};
 use crate::smith::SmithShape;
@@ -134,15 +134,21 @@ impl DirectionBake {
         c: f32,
     ) -> Self {
         let mut rows = [[0.0f32; ROW]; MU_NODES];
-        for (k, row) in rows.iter_mut().enumerate() {
+        let mut cosines = [0.0f32; MU_NODES];
+        for (k, (row, cos_f32)) in rows.iter_mut().zip(cosines.iter_mut()).enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;
             let cos = x * x;
+            *cos_f32 = cos as f32;
             let factors = q.map(|q| q.factors(cos)).unwrap_or([0.0; 5]);
             row[0] = fresnel(eta, cos as f32);
             for (slot, value) in row[1..6].iter_mut().zip(factors) {
                 *slot = value as f32;
             }
-            row[6] = sigma_ratio.sigma_ratio_cos(cos as f32, big_b, c);
+        }
+        let mut ratios = [0.0f32; MU_NODES];
+        sigma_ratio.sigma_ratio_cos_many(&cosines, big_b, c, &mut ratios);
+        for (row, ratio) in rows.iter_mut().zip(ratios) {
+            row[6] = ratio;
         }
         DirectionBake { rows }
     }
@@ -249,11 +255,11 @@ impl SlopeQuantileBake {
     /// Tabulates the quantile for `(β, p)` as [`crate::epd::Epd`] clamps them.
     pub fn new(beta: f32, p: f32) -> Self {
         let p = f64::from(p);
-        let ln_gamma_a = math::ln_gamma(1.0 / p);
+        let shape = GammaShape::new(1.0 / p);
         let h = (LOGIT_RANGE.1 - LOGIT_RANGE.0) / (QUANTILE_NODES - 1) as f64;
         let mut nodes = [[0.0f64; 2]; QUANTILE_NODES];
         for (k, node) in nodes.iter_mut().enumerate() {
-            let (g, slope) = exact_g_and_slope(p, ln_gamma_a, LOGIT_RANGE.0 + k as f64 * h);
+            let (g, slope) = exact_g_and_slope(p, &shape, LOGIT_RANGE.0 + k as f64 * h);
             *node = [g, h * slope];
         }
         SlopeQuantileBake {
@@ -299,11 +305,11 @@ impl SlopeQuantileBake {
 }
 
 /// `G(v)` and `G'(v)` of [`SlopeQuantileBake`] by solving for the quantile
-/// (`ln_gamma_a = ln Γ(1/p)`).
-fn exact_g_and_slope(p: f64, ln_gamma_a: f64, v: f64) -> (f64, f64) {
-    let a = 1.0 / p;
+/// (`shape` is Gamma(1/p)).
+fn exact_g_and_slope(p: f64, shape: &GammaShape, v: f64) -> (f64, f64) {
+    let (a, ln_gamma_a) = (1.0 / p, shape.ln_gamma());
     // u = 1/(1 + e^−v), 1 − u = 1/(1 + e^v), each without cancellation.
-    let y = inverse_gamma_two_tailed(a, 1.0 / (1.0 + math::exp(-v)), 1.0 / (1.0 + math::exp(v)));
+    let y = shape.inverse_two_tailed(1.0 / (1.0 + math::exp(-v)), 1.0 / (1.0 + math::exp(v)));
     let ln_y = math::ln(y);
     // ln(u(1 − u)) = −|v| − 2 ln(1 + e^−|v|).
     let ln_u_1mu = -v.abs() - 2.0 * math::ln_1p(math::exp(-v.abs()));
@@ -329,8 +335,9 @@ pub(crate) struct ConvBake {
 }
 
 impl ConvBake {
-    /// Tabulates `slice` for `u ∈ [0, B]`; `beta`, `p` give the NDF's core
-    /// width. `None` when `B` is not positive and finite.
+    /// Tabulates `slice` for `u ∈ [0, B]` (its normalised angle evaluated in
+    /// f32 at the nodes); `beta`, `p` give the NDF's core width. `None` when
+    /// `B` is not positive and finite.
     pub fn new(slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> Option<Self> {
         if !(big_b > 0.0 && big_b.is_finite()) {
             return None;
@@ -366,19 +373,25 @@ impl ConvBake {
             let inv_w = bake.inv_width(u);
             let w = 1.0 / f64::from(inv_w);
             let s_span = f64::from(angle_span(inv_w));
-            let mut tans = [0.0f64; CONV_S_NODES];
+            // In f32, as the slice's angle is evaluated (module documentation).
+            let mut tans = [0.0f32; CONV_S_NODES];
             for (k, tan) in tans.iter_mut().enumerate() {
                 let x = math::exp2_axis(k as f64 / (CONV_S_NODES - 1) as f64 * s_span).max(1.0);
                 let tan_a = w * x;
                 let tan_b = w / math::sqrt(1.0 + w * w * (x * x - 1.0));
-                *tan = (tan_a - tan_b) / (1.0 + tan_a * tan_b);
+                *tan = ((tan_a - tan_b) / (1.0 + tan_a * tan_b)) as f32;
             }
-            let mut profile = [0.0f32; CONV_S_NODES];
-            slice.profile_at_tans(u, &tans, &mut profile);
-            for (k, &c) in profile.iter().enumerate() {
-                let v = if c > 0.0 { math::lnf(c) } else { f32::MIN };
-                top = top.max(v);
-                bake.ln_c[(j + 1) * PADDED_S + k + 1] = v;
+            let row = &mut bake.ln_c[(j + 1) * PADDED_S + 1..(j + 1) * PADDED_S + 1 + CONV_S_NODES];
+            // ln C = ln s + the profile (s = 1 inside T3's u range).
+            match slice.ln_profile_at_tans(u, &tans, row) {
+                Some(factor) if factor > 0.0 => {
+                    let ln_factor = math::lnf(factor);
+                    for v in row.iter_mut() {
+                        *v += ln_factor;
+                        top = top.max(*v);
+                    }
+                }
+                _ => row.iter_mut().for_each(|v| *v = f32::MIN),
             }
         }
         let ln_c = &mut bake.ln_c;
@@ -556,10 +569,10 @@ mod tests {
         let mut worst = (0.0f64, 0.0f64, 0.0f64);
         for p in [0.2f64, 0.35, 0.5, 1.0, 2.0, 5.0] {
             let bake = SlopeQuantileBake::new(0.3, p as f32);
-            let ln_gamma_a = math::ln_gamma(1.0 / p);
+            let shape = GammaShape::new(1.0 / p);
             for _ in 0..20_000 {
                 let v = LOGIT_RANGE.0 + rng.next() * (LOGIT_RANGE.1 - LOGIT_RANGE.0);
-                let exact = exact_g_and_slope(p, ln_gamma_a, v).1;
+                let exact = exact_g_and_slope(p, &shape, v).1;
                 let e = (bake.g_and_slope(v).1 - exact).abs() / (p + exact);
                 if e > worst.0 {
                     worst = (e, p, v);

@@ -47,7 +47,7 @@
 //! are not returned, so `∫ pdf ≤ 1`).
 
 use crate::bake::{ConvBake, DirectionBake, DirectionValues, MaskingBake, SlopeQuantileBake};
-use crate::conv::Convolution;
+use crate::conv::{ConvSlice, Convolution};
 use crate::epd::{Epd, normal_at};
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
 use crate::kcorr::SigmaRatioTable;
@@ -300,6 +300,50 @@ pub struct TwoScale<'a> {
     options: Options,
 }
 
+/// What [`TwoScale::new`] bakes from the surface alone, independent of the
+/// wavelength: made once for the three channels of [`Rgb`].
+struct SurfaceBakes<'a> {
+    ndf: Epd<'a>,
+    /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
+    surface: Surface,
+    masking: MaskingBake,
+    slope_quantile: SlopeQuantileBake,
+    /// T3b's material slice when there is diffraction and the source of C
+    /// offers one.
+    slice: Option<ConvSlice<'a>>,
+}
+
+impl<'a> SurfaceBakes<'a> {
+    /// Sanitises `s` (as [`TwoScale::new`] documents) and bakes G1, the
+    /// quantile and C's material slice.
+    fn new(tables: &Tables<'a>, s: Surface) -> Self {
+        let nonneg = |x: f32| if x > 0.0 { x.min(f32::MAX) } else { 0.0 };
+        let c_ok = s.c > 1.0;
+        let ndf = Epd::new(s.beta, s.p, &tables.smith);
+        let surface = Surface {
+            beta: ndf.beta(),
+            p: ndf.p(),
+            sigma_s: if c_ok { nonneg(s.sigma_s) } else { 0.0 },
+            b: nonneg(s.b),
+            c: if c_ok { s.c.min(1e6) } else { 2.0 },
+        };
+        let slice = if surface.sigma_s > 0.0 {
+            tables
+                .convolution
+                .material_slice(surface.c, surface.beta, surface.p)
+        } else {
+            None
+        };
+        SurfaceBakes {
+            masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
+            slope_quantile: SlopeQuantileBake::new(ndf.beta(), ndf.p()),
+            ndf,
+            surface,
+            slice,
+        }
+    }
+}
+
 /// What one pair of directions gives, independent of the wavelength: the
 /// geometry and D (shared by `pdf` and `eval`, and by the channels of [`Rgb`]).
 #[derive(Clone, Copy, Debug)]
@@ -336,17 +380,21 @@ impl<'a> TwoScale<'a> {
         eta: Complex,
         options: Options,
     ) -> Self {
-        let s = layer.surface;
-        let nonneg = |x: f32| if x > 0.0 { x.min(f32::MAX) } else { 0.0 };
-        let c_ok = s.c > 1.0;
-        let ndf = Epd::new(s.beta, s.p, &tables.smith);
-        let surface = Surface {
-            beta: ndf.beta(),
-            p: ndf.p(),
-            sigma_s: if c_ok { nonneg(s.sigma_s) } else { 0.0 },
-            b: nonneg(s.b),
-            c: if c_ok { s.c.min(1e6) } else { 2.0 },
-        };
+        let shared = SurfaceBakes::new(tables, layer.surface);
+        Self::with_surface_bakes(tables, &shared, layer, lambda, eta, options)
+    }
+
+    /// [`TwoScale::new`] with the bakes of `layer.surface` already made
+    /// (`shared` must come from the same tables and surface).
+    fn with_surface_bakes(
+        tables: &Tables<'a>,
+        shared: &SurfaceBakes<'a>,
+        layer: Layer,
+        lambda: f32,
+        eta: Complex,
+        options: Options,
+    ) -> Self {
+        let (ndf, surface) = (shared.ndf, shared.surface);
         let lambda = math::sanitised_wavelength(lambda);
         let unit = |x: f32| f64::from(x.max(0.0).min(1.0));
         let base = match layer.base {
@@ -364,17 +412,13 @@ impl<'a> TwoScale<'a> {
         };
         let big_b = f64::from(surface.b) / lambda;
         let q = QConstants::new(eta);
-        let conv_bake = if surface.sigma_s > 0.0 {
-            tables
-                .convolution
-                .material_slice(surface.c, surface.beta, surface.p)
-                .and_then(|slice| ConvBake::new(&slice, big_b as f32, surface.beta, surface.p))
-        } else {
-            None
-        };
+        let conv_bake = shared
+            .slice
+            .as_ref()
+            .and_then(|slice| ConvBake::new(slice, big_b as f32, surface.beta, surface.p));
         let model = TwoScale {
-            masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
-            slope_quantile: SlopeQuantileBake::new(ndf.beta(), ndf.p()),
+            masking: shared.masking.clone(),
+            slope_quantile: shared.slope_quantile.clone(),
             ndf,
             direction: DirectionBake::new(
                 eta,
@@ -949,9 +993,12 @@ pub struct RgbSample {
 impl<'a> Rgb<'a> {
     /// The three channels of `material` at [`RGB_WAVELENGTHS`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
+        // G1, the quantile and C's slice do not depend on the wavelength.
+        let shared = SurfaceBakes::new(tables, material.layer.surface);
         let channel = |k: usize| {
-            TwoScale::new(
+            TwoScale::with_surface_bakes(
                 tables,
+                &shared,
                 material.layer,
                 RGB_WAVELENGTHS[k],
                 material.eta_rgb[k],

@@ -97,7 +97,7 @@ use crate::format::{
     ConvParams, FormatError, Header, Kernel, Quantised, Table, TableId, ValueType,
 };
 use crate::interp::Axis;
-use crate::math;
+use crate::math::{self, Real};
 
 /// A source of `C(θh; u, c, β, p)` (docs/model.md §2.5).
 ///
@@ -223,31 +223,41 @@ impl ConvParams {
 
 /// `asinh x` for `x ≥ 0`, accurate for small `x`.
 #[inline]
-fn asinh_pos(x: f64) -> f64 {
-    math::ln_1p(x + x * x / (1.0 + math::sqrt(1.0 + x * x)))
+fn asinh_pos<T: Real>(x: T) -> T {
+    let one = T::of(1.0);
+    (x + x * x / (one + (one + x * x).sqrt())).ln_1p()
 }
 
 /// The parts of `F` that depend on `(u, β, p)` only, computed once per
 /// lookup (`F` is evaluated at `τ` and at `τ_max`, and many times by the
-/// inverse).
-struct AngleShape<'a> {
-    a: &'a AngleParams,
-    beta: f64,
+/// inverse), in f64 and rounded to `T`, the type `F` is evaluated in.
+struct AngleShape<T> {
+    beta: T,
     /// `u_e = √(u² + u_floor²)`.
-    ue: f64,
+    ue: T,
     /// The softened exponent `p'`.
-    p_eff: f64,
+    p_eff: T,
     /// `tan θe`, the NDF's edge (∞ for tiny `p'`).
-    tau_edge: f64,
-    /// The edge term's fade `f_e`.
-    fade: f64,
+    tau_edge: T,
+    /// The edge term's fade `f_e` (0 when `tan θe` is not finite in `T`).
+    fade: T,
     /// The edge term's smoothing width `δ = s_e / (2 u_e)`.
-    delta: f64,
+    delta: T,
+    /// `Y`, `w_h`, `w_e`, `λ` of [`AngleParams`].
+    cap: T,
+    /// `ln(40 Y)`: for `ln y` above it, `1 − e^(−y/Y)` rounds to 1 in f64
+    /// (and f32), and the NDF term is `ln(1 + Y)`.
+    ln_saturation: T,
+    /// `ln(1 + Y)`.
+    ndf_saturated: T,
+    horizon_weight: T,
+    edge_weight: T,
+    ndf_weight: T,
 }
 
-impl<'a> AngleShape<'a> {
+impl<T: Real> AngleShape<T> {
     #[inline]
-    fn new(u: f64, beta: f64, p: f64, a: &'a AngleParams) -> Self {
+    fn new(u: f64, beta: f64, p: f64, a: &AngleParams) -> Self {
         let ue = math::sqrt(u * u + a.kernel_scale_floor * a.kernel_scale_floor);
         // The kernel (width ~1/(2u_e)) smooths the NDF's cliff at τ ≈ β over
         // Δln τ ≈ 1/(2 u_e β): soften the exponent to match.
@@ -256,51 +266,71 @@ impl<'a> AngleShape<'a> {
         let tau_edge = beta * math::exp(math::ln(a.ndf_exponent_cap) / (2.0 * p_eff));
         let fade = 1.0 / (1.0 + (tau_edge / a.edge_fade_tan) * (tau_edge / a.edge_fade_tan));
         let delta = a.edge_smoothing / (2.0 * ue);
+        let tau_edge = T::of(tau_edge);
         AngleShape {
-            a,
-            beta,
-            ue,
-            p_eff,
+            beta: T::of(beta),
+            ue: T::of(ue),
+            p_eff: T::of(p_eff),
             tau_edge,
-            fade,
-            delta,
+            fade: if tau_edge.wide() < f64::INFINITY {
+                T::of(fade)
+            } else {
+                T::of(0.0)
+            },
+            delta: T::of(delta),
+            cap: T::of(a.ndf_exponent_cap),
+            ln_saturation: T::of(math::ln(40.0 * a.ndf_exponent_cap)),
+            ndf_saturated: T::of(a.ndf_exponent_cap).ln_1p(),
+            horizon_weight: T::of(a.horizon_weight),
+            edge_weight: T::of(a.edge_weight),
+            ndf_weight: T::of(a.ndf_weight),
         }
     }
 
     /// `F(τ)` of the normalised angle (module documentation), `τ ≥ 0`.
     #[inline]
-    fn f(&self, tau: f64) -> f64 {
-        let (a, ue) = (self.a, self.ue);
+    fn f(&self, tau: T) -> T {
+        let (zero, one, two, half) = (T::of(0.0), T::of(1.0), T::of(2.0), T::of(0.5));
+        let ue = self.ue;
         // sec θh = √(1 + τ²); sin θh = τ / sec θh.
-        let secant = math::sqrt(1.0 + tau * tau);
-        let kernel_term = asinh_pos(2.0 * ue * tau / secant);
-        let horizon_term = 0.5 * math::ln_1p(tau * tau);
-        let y = if tau > 0.0 {
-            math::exp(2.0 * self.p_eff * math::ln(tau / self.beta))
+        let secant = (one + tau * tau).sqrt();
+        let kernel_term = asinh_pos(two * ue * tau / secant);
+        let horizon_term = half * (tau * tau).ln_1p();
+        let ln_y = if tau > zero {
+            two * self.p_eff * (tau / self.beta).ln()
         } else {
-            0.0
+            T::of(f64::NEG_INFINITY)
         };
-        let cap = a.ndf_exponent_cap;
-        // 1 − e^(−y/Y), with y = ∞ giving 1.
-        let saturated = -math::exp_m1(-(y / cap));
-        let ndf_term = math::ln_1p(cap * saturated);
-        let edge_term = if self.fade > 0.0 {
+        let ndf_term = if ln_y > self.ln_saturation {
+            self.ndf_saturated
+        } else {
+            let cap = self.cap;
+            // 1 − e^(−y/Y).
+            let saturated = -(-(ln_y.exp() / cap)).exp_m1();
+            (cap * saturated).ln_1p()
+        };
+        let edge_term = if self.fade > zero {
             // θh − θe = atan((τ − τe) / (1 + τ τe)), in (−π/2, π/2); its
             // positive part smoothed, (x + √(x² + δ²)) / 2, and held ≤ π/2
             // so that the sine (and F) keeps increasing.
             let tau_edge = self.tau_edge;
-            let offset = math::atan((tau - tau_edge) / (1.0 + tau * tau_edge));
+            let offset = ((tau - tau_edge) / (one + tau * tau_edge)).atan();
             let delta = self.delta;
-            let beyond = (0.5 * (offset + math::sqrt(offset * offset + delta * delta)))
-                .min(core::f64::consts::FRAC_PI_2);
-            self.fade * asinh_pos(2.0 * ue * math::sin(beyond))
+            let beyond = half * (offset + (offset * offset + delta * delta).sqrt());
+            let right_angle = T::of(core::f64::consts::FRAC_PI_2);
+            let beyond = if beyond < right_angle {
+                beyond
+            } else {
+                right_angle
+            };
+            self.fade * asinh_pos(two * ue * beyond.sin())
         } else {
-            0.0
+            zero
         };
         kernel_term
-            + a.horizon_weight * horizon_term
-            + a.edge_weight * edge_term
-            + a.ndf_weight * ndf_term
+            + self.horizon_weight * horizon_term
+            + self.edge_weight * edge_term
+            + self.ndf_weight * ndf_term
     }
 }
 
@@ -310,7 +340,7 @@ impl<'a> AngleShape<'a> {
 /// finite with `β, p > 0`, `u ≥ 0`; `τ < 0` is treated as 0.
 pub fn normalised_angle(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
     let tau = tau.max(0.0).min(a.tau_max);
-    let shape = AngleShape::new(u, beta, p, a);
+    let shape = AngleShape::<f64>::new(u, beta, p, a);
     (shape.f(tau) / shape.f(a.tau_max)).max(0.0).min(1.0)
 }
 
@@ -323,7 +353,7 @@ pub fn tan_of_normalised_angle(xi: f64, u: f64, beta: f64, p: f64, a: &AnglePara
     if xi >= 1.0 {
         return a.tau_max;
     }
-    let shape = AngleShape::new(u, beta, p, a);
+    let shape = AngleShape::<f64>::new(u, beta, p, a);
     let target = xi * shape.f(a.tau_max);
     let (mut lo, mut hi) = (0.0f64, math::ln_1p(a.tau_max));
     for _ in 0..200 {
@@ -477,34 +507,25 @@ impl<'a> ConvTable<'a> {
 
     /// T3b restricted to the material `(c, β, p)` (see [`ConvSlice`]);
     /// `None` for non-finite parameters or a table larger than
-    /// [`SLICE_CAPACITY`]. Costs one full blend per `u` node (80 µs for
-    /// the shipped table: `cargo bench --bench lookup -- convolution_setup`).
+    /// [`SLICE_CAPACITY`] or with more than [`SLICE_ANGLES`] angles. Costs
+    /// one blend of all angles per `u` node (`cargo bench --bench lookup --
+    /// convolution_setup`).
     pub fn slice(&self, c: f32, beta: f32, p: f32) -> Option<ConvSlice<'a>> {
         let k = self.clamp(0.0, c, beta, p)?;
         let (u_nodes, angles) = (self.axes[0].nodes(), self.angles);
-        if u_nodes * angles > SLICE_CAPACITY {
+        if u_nodes * angles > SLICE_CAPACITY || angles > SLICE_ANGLES {
             return None;
         }
         let mut values = [0.0f32; SLICE_CAPACITY];
         let mut cells = self.cells(&k);
-        for i in 0..u_nodes {
+        for (i, row) in values.chunks_exact_mut(angles).take(u_nodes).enumerate() {
             // Node i exactly: the start of cell i (the end of the last cell).
             cells[0] = if i + 1 < u_nodes {
                 (i, 0.0)
             } else {
                 (i - 1, 1.0)
             };
-            let mut first = 0;
-            while first < angles {
-                // The last window may overlap the previous one (same values).
-                let at = first.min(angles - 4);
-                let blended = self.blend_params::<4>(cells, FIT_CHANNELS + at);
-                let row = i * angles + at;
-                if let Some(slot) = values.get_mut(row..row + 4) {
-                    slot.copy_from_slice(&blended);
-                }
-                first += 4;
-            }
+            self.blend_into(cells, FIT_CHANNELS, row);
         }
         Some(ConvSlice {
             table: *self,
@@ -516,10 +537,19 @@ impl<'a> ConvTable<'a> {
     }
 
     /// Blend of the `N` consecutive channels from `first` over the parameter
-    /// cell (one pass over the corners), with [`ConvTable::axis_weights`]
-    /// per axis.
+    /// cell ([`ConvTable::blend_into`]).
     fn blend_params<const N: usize>(&self, cells: [(usize, f32); 4], first: usize) -> [f32; N] {
+        let mut sum = [0.0f32; N];
+        self.blend_into(cells, first, &mut sum);
+        sum
+    }
+
+    /// Blend of the `out.len()` consecutive channels from `first` over the
+    /// parameter cell (one pass over the corners, skipping corners of zero
+    /// weight), with [`ConvTable::axis_weights`] per axis.
+    fn blend_into(&self, cells: [(usize, f32); 4], first: usize, out: &mut [f32]) {
         let channels = FIT_CHANNELS + self.angles;
+        let n = out.len();
         let mut start = [0usize; 4];
         let mut count = [2usize; 4];
         let mut weights = [[0.0f32; 4]; 4];
@@ -528,28 +558,45 @@ impl<'a> ConvTable<'a> {
         }
         let Quantised { scales, codes, .. } = self.values;
         let [n1, n2, n3] = [1, 2, 3].map(|d| self.axes[d].nodes());
-        let mut sum = [0.0f32; N];
+        out.iter_mut().for_each(|v| *v = 0.0);
         // Σ w (offset + q step) = Σ w offset + Σ (w step) q.
         let mut offsets = 0.0f32;
-        for (a, wa) in weights[0][..count[0]].iter().enumerate() {
+        let nonzero = |w: &&f32| **w != 0.0;
+        for (a, wa) in weights[0][..count[0]]
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| nonzero(w))
+        {
             let ia = start[0] + a;
-            for (b, wb) in weights[1][..count[1]].iter().enumerate() {
+            for (b, wb) in weights[1][..count[1]]
+                .iter()
+                .enumerate()
+                .filter(|(_, w)| nonzero(w))
+            {
                 let ib = ia * n1 + start[1] + b;
                 let wab = wa * wb;
-                for (c, wc) in weights[2][..count[2]].iter().enumerate() {
+                for (c, wc) in weights[2][..count[2]]
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, w)| nonzero(w))
+                {
                     let ic = ib * n2 + start[2] + c;
                     let wabc = wab * wc;
-                    for (d, wd) in weights[3][..count[3]].iter().enumerate() {
+                    for (d, wd) in weights[3][..count[3]]
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, w)| nonzero(w))
+                    {
                         let node = ic * n3 + start[3] + d;
                         let index = node * channels + first;
                         let w = wabc * wd;
                         if let (Some(q), Some(scale)) = (
-                            codes.get(index..index + N),
+                            codes.get(index..index + n),
                             scales.get(2 * node..2 * node + 2),
                         ) {
                             offsets += w * scale[0];
                             let w_step = w * scale[1];
-                            for (acc, &x) in sum.iter_mut().zip(q) {
+                            for (acc, &x) in out.iter_mut().zip(q) {
                                 *acc += w_step * f32::from(x);
                             }
                         }
@@ -557,7 +604,7 @@ impl<'a> ConvTable<'a> {
                 }
             }
         }
-        sum.map(|x| x + offsets)
+        out.iter_mut().for_each(|v| *v += offsets);
     }
 
     /// The paper's form (T3a) from the same file.
@@ -673,7 +720,8 @@ impl<'a> ConvTable<'a> {
 pub fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) -> f32 {
     let n = angles;
     let position = (xi.max(0.0).min(1.0) * (n - 1) as f64) as f32;
-    let k = (math::floorf(position) as usize).min(n - 2);
+    // position ≥ 0: truncation is ⌊position⌋.
+    let k = (position as usize).min(n - 2);
     let t = position - k as f32;
     // The four channels around ξ (clamped to the table).
     let k = k as isize;
@@ -706,6 +754,8 @@ pub fn along_xi(angles: usize, xi: f64, window: impl FnOnce(usize) -> [f32; 4]) 
 /// Largest `u nodes × angles` a [`ConvSlice`] holds (the shipped T3 needs
 /// 28 × 32 = 896).
 pub const SLICE_CAPACITY: usize = 1024;
+/// Largest number of angles `ξ` a [`ConvSlice`] takes (the shipped T3 has 32).
+pub const SLICE_ANGLES: usize = 64;
 
 /// T3b restricted to one material: `ln C` blended over `(c, β, p)` once, at
 /// every `u` node and angle, so that a lookup interpolates only `u` and `ξ`
@@ -727,48 +777,55 @@ impl ConvSlice<'_> {
     /// `C` at `τ = tan θh` and `u` for the slice's material; the same
     /// out-of-domain rules as [`ConvTable::at_tan`].
     pub fn at_tan(&self, tau: f64, u: f32) -> f32 {
-        let mut out = [0.0f32];
-        self.profile_at_tans(u, &[tau], &mut out);
-        out[0]
+        let mut ln_c = [0.0f32];
+        let Some(factor) = self.ln_profile_at_tans(u, &[tau], &mut ln_c) else {
+            return 0.0;
+        };
+        let value = math::expf(ln_c[0]) * factor;
+        if value.is_finite() { value } else { 0.0 }
     }
 
-    /// [`ConvSlice::at_tan`] at every `τ` of `taus` for one `u` (into the
-    /// same positions of `out`): the angle's `(u, β, p)` parts and `F(τ_max)`
-    /// are computed once, so a profile costs about half as much per point.
-    pub fn profile_at_tans(&self, u: f32, taus: &[f64], out: &mut [f32]) {
+    /// `ln C − ln s` at every `τ` of `taus` for one `u` (into the same
+    /// positions of `out`; `f32::MIN` for a NaN `τ`), and the factor `s` of
+    /// the `u > u_max` rule (1 inside the table; `None`, and `out` untouched,
+    /// for a non-finite `u`): [`ConvSlice::at_tan`] is `s e^out`. The angle's
+    /// `(u, β, p)` parts and `F(τ_max)` are computed once per call, `F` in
+    /// the type of `τ` (f32 for the per-material bake: measured in
+    /// docs/design/per-material-bake.md).
+    pub fn ln_profile_at_tans<T: Real>(&self, u: f32, taus: &[T], out: &mut [f32]) -> Option<f32> {
         let t = &self.table;
-        let Some(k) = t.clamp(u, self.c, self.beta, self.p) else {
-            out.iter_mut().for_each(|v| *v = 0.0);
-            return;
-        };
+        let k = t.clamp(u, self.c, self.beta, self.p)?;
         let a = &t.angle;
-        let shape = AngleShape::new(f64::from(k.u), f64::from(k.beta), f64::from(k.p), a);
-        let f_max = shape.f(a.tau_max);
+        let shape = AngleShape::<T>::new(f64::from(k.u), f64::from(k.beta), f64::from(k.p), a);
+        let (zero, tau_max) = (T::of(0.0), T::of(a.tau_max));
+        let f_max = shape.f(tau_max);
         let (start, count, weights) = t.axis_weights(0, t.axes[0].locate(k.u));
         let angles = t.angles;
+        // The u blend of the slice's rows: ln C at this u's ξ nodes.
+        let mut at_u = [0.0f32; SLICE_ANGLES];
+        let at_u = &mut at_u[..angles.min(SLICE_ANGLES)];
+        for (a, w) in weights[..count].iter().enumerate() {
+            let row = (start + a) * angles;
+            if let Some(v) = self.values.get(row..row + at_u.len()) {
+                for (acc, &x) in at_u.iter_mut().zip(v) {
+                    *acc += w * x;
+                }
+            }
+        }
         for (&tau, slot) in taus.iter().zip(out.iter_mut()) {
-            if tau.is_nan() {
-                *slot = 0.0;
+            if tau.wide().is_nan() {
+                *slot = f32::MIN;
                 continue;
             }
-            let xi = (shape.f(tau.max(0.0).min(a.tau_max)) / f_max)
-                .max(0.0)
-                .min(1.0);
-            let ln_c = along_xi(angles, xi, |first| {
-                let mut sum = [0.0f32; 4];
-                for (a, w) in weights[..count].iter().enumerate() {
-                    let row = (start + a) * angles + first;
-                    if let Some(v) = self.values.get(row..row + 4) {
-                        for (acc, &x) in sum.iter_mut().zip(v) {
-                            *acc += w * x;
-                        }
-                    }
-                }
-                sum
+            let tau = if tau > zero { tau } else { zero };
+            let tau = if tau < tau_max { tau } else { tau_max };
+            let xi = (shape.f(tau) / f_max).wide().max(0.0).min(1.0);
+            *slot = along_xi(angles, xi, |first| match at_u.get(first..first + 4) {
+                Some(&[a, b, c, d]) => [a, b, c, d],
+                _ => [0.0; 4],
             });
-            let value = math::expf(ln_c) * k.factor;
-            *slot = if value.is_finite() { value } else { 0.0 };
         }
+        Some(k.factor)
     }
 
     /// `C` at the half-vector angle given by `sin θh`, `cos θh`, and `u`.

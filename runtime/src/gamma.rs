@@ -106,10 +106,70 @@ pub const MAX_INVERSE_ITERATIONS: u32 = 80;
 /// `P⁻¹(a, p)` below `p = ½`, `Q⁻¹(a, q)` above, so that neither tail is
 /// rounded away.
 pub fn inverse_gamma_two_tailed(a: f64, p: f64, q: f64) -> f64 {
-    if p < 0.5 {
-        inverse_gamma_p(a, p)
-    } else {
-        inverse_gamma_q(a, q)
+    GammaShape::new(a).inverse_two_tailed(p, q)
+}
+
+/// A Gamma(a, 1) shape with `ln Γ(a)` and `ln Γ(a + 1)`, which every inverse
+/// at `a` needs: for callers that invert many probabilities at one `a`.
+#[derive(Clone, Copy, Debug)]
+pub struct GammaShape {
+    a: f64,
+    ln_gamma_a: f64,
+    ln_gamma_a1: f64,
+}
+
+impl GammaShape {
+    /// The shape `a` (any `f64`; the inverses document the out-of-domain values).
+    pub fn new(a: f64) -> Self {
+        GammaShape {
+            a,
+            ln_gamma_a: math::ln_gamma(a),
+            ln_gamma_a1: math::ln_gamma(a + 1.0),
+        }
+    }
+
+    /// `ln Γ(a)`.
+    pub fn ln_gamma(&self) -> f64 {
+        self.ln_gamma_a
+    }
+
+    /// [`inverse_gamma_two_tailed`] at this shape.
+    pub fn inverse_two_tailed(&self, p: f64, q: f64) -> f64 {
+        if p < 0.5 {
+            self.inverse_p(p)
+        } else {
+            self.inverse_q(q)
+        }
+    }
+
+    /// [`inverse_gamma_p`] at this shape.
+    pub fn inverse_p(&self, prob: f64) -> f64 {
+        if prob.is_nan() || prob <= 0.0 {
+            return 0.0;
+        }
+        if prob <= 0.5 {
+            solve(self, Tail::Lower, prob).0
+        } else if prob < 1.0 {
+            // Exact: prob ∈ (1/2, 1).
+            solve(self, Tail::Upper, 1.0 - prob).0
+        } else {
+            solve(self, Tail::Upper, 0.5 * EPS).0
+        }
+    }
+
+    /// [`inverse_gamma_q`] at this shape.
+    pub fn inverse_q(&self, q: f64) -> f64 {
+        if q >= 1.0 || q.is_nan() {
+            return 0.0;
+        }
+        if q > 0.5 {
+            // Exact: q ∈ (1/2, 1).
+            solve(self, Tail::Lower, 1.0 - q).0
+        } else if q > 0.0 {
+            solve(self, Tail::Upper, q).0
+        } else {
+            solve(self, Tail::Upper, f64::from_bits(1)).0
+        }
     }
 }
 
@@ -298,17 +358,7 @@ fn wilson_hilferty_p_and_q(a: f64, x: f64) -> (f64, f64) {
 /// * `a ≤ 0` or NaN → `0` (the limit `a → 0⁺`, where all the mass is at 0);
 /// * `a >` [`LARGE_A`] → the Wilson–Hilferty quantile, clamped to `f64::MAX`.
 pub fn inverse_gamma_p(a: f64, prob: f64) -> f64 {
-    if prob.is_nan() || prob <= 0.0 {
-        return 0.0;
-    }
-    if prob <= 0.5 {
-        solve(a, Tail::Lower, prob).0
-    } else if prob < 1.0 {
-        // Exact: prob ∈ (1/2, 1).
-        solve(a, Tail::Upper, 1.0 - prob).0
-    } else {
-        solve(a, Tail::Upper, 0.5 * EPS).0
-    }
+    GammaShape::new(a).inverse_p(prob)
 }
 
 /// Inverse of [`gamma_q`] in `x`: the `x ≥ 0` with `Q(a, x) = q`.
@@ -359,17 +409,7 @@ pub fn inverse_gamma_p(a: f64, prob: f64) -> f64 {
 /// * `a ≤ 0` or NaN → `0` (the limit `a → 0⁺`);
 /// * `a >` [`LARGE_A`] → the Wilson–Hilferty quantile, clamped to `f64::MAX`.
 pub fn inverse_gamma_q(a: f64, q: f64) -> f64 {
-    if q >= 1.0 || q.is_nan() {
-        return 0.0;
-    }
-    if q > 0.5 {
-        // Exact: q ∈ (1/2, 1).
-        solve(a, Tail::Lower, 1.0 - q).0
-    } else if q > 0.0 {
-        solve(a, Tail::Upper, q).0
-    } else {
-        solve(a, Tail::Upper, f64::from_bits(1)).0
-    }
+    GammaShape::new(a).inverse_q(q)
 }
 
 /// Which tail function an inverse solves for.
@@ -383,7 +423,8 @@ enum Tail {
 
 /// Solves `T(a, x) = t` for `t ∈ (0, 1/2]`, `T` = P or Q; returns the root and the
 /// number of evaluations of `T` used.
-fn solve(a: f64, tail: Tail, t: f64) -> (f64, u32) {
+fn solve(shape: &GammaShape, tail: Tail, t: f64) -> (f64, u32) {
+    let a = shape.a;
     if a.is_nan() || a <= 0.0 {
         return (0.0, 0);
     }
@@ -391,8 +432,7 @@ fn solve(a: f64, tail: Tail, t: f64) -> (f64, u32) {
         return (wilson_hilferty_quantile(a, tail, t), 0);
     }
     let ln_t = math::ln(t);
-    let ln_gamma_a = math::ln_gamma(a);
-    let ln_gamma_a1 = math::ln_gamma(a + 1.0);
+    let (ln_gamma_a, ln_gamma_a1) = (shape.ln_gamma_a, shape.ln_gamma_a1);
 
     // Bracket from the bounds P ≤ x^a/Γ(a+1) and Q ≤ 2^a e^(−x/2) (see the docs),
     // widened by a relative 1e-12 against rounding in their evaluation.
@@ -817,8 +857,10 @@ mod tests {
                 } else {
                     (1.0 - prob, Tail::Lower)
                 };
-                worst.2 = worst.2.max(solve(a, tail, t).1);
-                worst.2 = worst.2.max(solve(a, Tail::Lower, prob.min(0.5)).1);
+                worst.2 = worst.2.max(solve(&GammaShape::new(a), tail, t).1);
+                worst.2 = worst
+                    .2
+                    .max(solve(&GammaShape::new(a), Tail::Lower, prob.min(0.5)).1);
             }
         }
         worst

@@ -104,6 +104,42 @@ impl<'a> SigmaRatioTable<'a> {
     /// σrel/σs (HP17 17-19) for `cos θi`, `B = b/λ` and exponent `c`: the table
     /// inside its domain, the rules of the module documentation outside.
     pub fn sigma_ratio_cos(&self, cos_theta_i: f32, b_over_lambda: f32, c: f32) -> f32 {
+        self.sigma_ratio_with(cos_theta_i, b_over_lambda, c, |cos, big_b, c| {
+            self.ratio_to_normal(cos, big_b, c)
+        })
+    }
+
+    /// [`Self::sigma_ratio_cos`] at every `cos θi` of `cos` for one `(B, c)`
+    /// (into the same positions of `out`): the table is read at one `(B, c)`
+    /// whatever the incidence, so its blend over B and c is done once (the
+    /// same values up to f32 rounding).
+    pub fn sigma_ratio_cos_many(&self, cos: &[f32], b_over_lambda: f32, c: f32, out: &mut [f32]) {
+        let (big_b, c_table) = table_point(b_over_lambda.min(f32::MAX), c.min(f32::MAX));
+        let cells = [
+            (0, 0.0),
+            self.grid.axis(1).locate(big_b.max(B_MIN).min(B_MAX)),
+            self.grid.axis(2).locate(c_table),
+        ];
+        let mut column = [0.0f32; COLUMN_CAPACITY];
+        let count = self.grid.cubic_column(cells, 0, &mut column);
+        let column = &column[..count];
+        for (&cos, slot) in cos.iter().zip(out.iter_mut()) {
+            *slot = self.sigma_ratio_with(cos, b_over_lambda, c, |cos, _, _| {
+                self.grid.interpolate_column(column, cos)
+            });
+        }
+    }
+
+    /// σrel/σs with `q_at(cos θi, B', c')`, T2's `q` at the one point
+    /// `(B', c')` of the table (in its domain) the rules read for `(B, c)`.
+    #[inline]
+    fn sigma_ratio_with(
+        &self,
+        cos_theta_i: f32,
+        b_over_lambda: f32,
+        c: f32,
+        q_at: impl Fn(f32, f32, f32) -> f32,
+    ) -> f32 {
         let cos_theta_i = cos_theta_i.max(0.0).min(1.0);
         if !(c > 1.0 && b_over_lambda > 0.0) {
             return 0.0;
@@ -111,23 +147,25 @@ impl<'a> SigmaRatioTable<'a> {
         let big_b = b_over_lambda.min(f32::MAX);
         let c = c.min(f32::MAX);
         let r0 = normal_incidence_ratio(f64::from(big_b), f64::from(c));
-        // Beyond c = 100: keep B √((c−1)/2) fixed and use the last c node.
-        let (table_b, table_c) = if c > C_MAX {
-            let scale = math::sqrt(f64::from(c - 1.0) / f64::from(C_MAX - 1.0));
-            ((f64::from(big_b) / scale) as f32, C_MAX)
-        } else {
-            (big_b, c)
-        };
-        let q = self.ratio_for_any_b(cos_theta_i, table_b, table_c, r0);
+        let (table_b, table_c) = table_point(big_b, c);
+        let q = self.ratio_for_any_b(cos_theta_i, table_b, table_c, r0, q_at);
         (q * r0) as f32
     }
 
     /// `q = r/r0` for any B > 0 at a c inside the table (`r0` is that of the
-    /// caller's B and c; it only matters beyond the last B node).
-    fn ratio_for_any_b(&self, cos_theta_i: f32, big_b: f32, c: f32, r0: f64) -> f64 {
+    /// caller's B and c; it only matters beyond the last B node), from
+    /// `q_at` (see [`Self::sigma_ratio_with`]).
+    fn ratio_for_any_b(
+        &self,
+        cos_theta_i: f32,
+        big_b: f32,
+        c: f32,
+        r0: f64,
+        q_at: impl Fn(f32, f32, f32) -> f32,
+    ) -> f64 {
         if big_b < B_MIN {
             // q² = 1 − k B²/(1 + μ B²), continuous with the table at B_MIN.
-            let q_lo = f64::from(self.ratio_to_normal(cos_theta_i, B_MIN, c));
+            let q_lo = f64::from(q_at(cos_theta_i, B_MIN, c));
             let deficit = 1.0 - q_lo * q_lo;
             let sin_sq = f64::from((1.0 - cos_theta_i) * (1.0 + cos_theta_i));
             let k = f64::from(c + 1.0) / 2.0 * sin_sq;
@@ -140,10 +178,10 @@ impl<'a> SigmaRatioTable<'a> {
             return math::sqrt((1.0 - k * b_sq / (1.0 + mu * b_sq)).max(0.0));
         }
         if big_b <= B_MAX {
-            return f64::from(self.ratio_to_normal(cos_theta_i, big_b, c));
+            return f64::from(q_at(cos_theta_i, big_b, c));
         }
         // 1 − r² = (1 − r0(B)²)·M, M frozen at the last node.
-        let q_last = f64::from(self.ratio_to_normal(cos_theta_i, B_MAX, c));
+        let q_last = f64::from(q_at(cos_theta_i, B_MAX, c));
         let r0_last = normal_incidence_ratio(f64::from(B_MAX), f64::from(c));
         let r_last = q_last * r0_last;
         let tail_last = 1.0 - r0_last * r0_last;
@@ -153,6 +191,22 @@ impl<'a> SigmaRatioTable<'a> {
         let m = (1.0 - r_last * r_last) / tail_last;
         let r_sq = 1.0 - (1.0 - r0 * r0) * m;
         math::sqrt(r_sq.max(0.0)) / r0
+    }
+}
+
+/// Largest number of T2 coefficients along `cos θi` that
+/// [`SigmaRatioTable::sigma_ratio_cos_many`] blends (the shipped T2 has 74).
+const COLUMN_CAPACITY: usize = 128;
+
+/// The `(B, c)` at which T2 is read for the caller's `(B, c)`: beyond
+/// c = 100, B √((c−1)/2) is kept fixed at the last c node.
+#[inline]
+fn table_point(big_b: f32, c: f32) -> (f32, f32) {
+    if c > C_MAX {
+        let scale = math::sqrt(f64::from(c - 1.0) / f64::from(C_MAX - 1.0));
+        ((f64::from(big_b) / scale) as f32, C_MAX)
+    } else {
+        (big_b, c)
     }
 }
 
