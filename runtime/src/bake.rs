@@ -67,14 +67,21 @@ const LN_C_RANGE: f32 = 70.0;
 /// (clamped; NaN gives 0): the cell and the fraction in it.
 #[inline]
 fn cell(x: f32, n: usize) -> (usize, f32) {
-    let last = (n - 1) as f32;
-    let t = (x * last).max(0.0).min(last);
+    cell_at((x * (n - 1) as f32).max(0.0), n)
+}
+
+/// [`cell`] of a position `t` in nodes (`t ≥ 0`, clamped to `n − 1`).
+#[inline]
+fn cell_at(t: f32, n: usize) -> (usize, f32) {
+    let t = t.min((n - 1) as f32);
     // ⌊t⌋ without a saturating float-to-integer conversion: `t − ½ + 1.5·2²³`
     // rounds to an integer (f32's spacing there is 1), which the low bits
     // hold; a tie rounds to even, which may give the node below `t` with
     // fraction 1 — the same interpolated value.
     let rounded = (t - 0.5) + ROUNDER;
-    let i = (rounded.to_bits().wrapping_sub(ROUNDER.to_bits()) as i32).min(n as i32 - 2);
+    let i = (rounded.to_bits().wrapping_sub(ROUNDER.to_bits()) as i32)
+        .max(0)
+        .min(n as i32 - 2);
     (i as usize, t - i as f32)
 }
 
@@ -463,18 +470,19 @@ impl ConvBake {
         let x_s = math::log2_axis(x_h) * ((CONV_S_NODES - 1) as f32 / angle_span(inv_w));
         let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
         let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);
+        // ju ≤ CONV_U_NODES − 2 and ks ≤ CONV_S_NODES − 2: the 4 × 4 taps
+        // lie in the padded grid.
         let mut ln_c = 0.0f32;
         for (a, wa) in wu.iter().enumerate() {
-            let start = (ju + a) * PADDED_S + ks;
-            let taps = self.ln_c.get(start..start + 4).unwrap_or(&[0.0; 4]);
-            let along: f32 = taps.iter().zip(ws).map(|(v, w)| v * w).sum();
-            ln_c += wa * along;
+            let row = &self.ln_c[(ju + a) * PADDED_S..][..PADDED_S];
+            let taps = &row[ks..ks + 4];
+            ln_c += wa * (taps[0] * ws[0] + taps[1] * ws[1] + taps[2] * ws[2] + taps[3] * ws[3]);
         }
-        // e^x is 0 in f32 below x ≈ −103.3 (and expf is slow near there).
+        // e^x is 0 in f32 below x ≈ −103.3.
         if !(ln_c > -104.0) {
             return 0.0;
         }
-        let value = math::expf(ln_c);
+        let value = math::exp_inline(f64::from(ln_c)) as f32;
         if value.is_finite() { value } else { 0.0 }
     }
 }
@@ -490,7 +498,7 @@ fn angle_span(inv_w: f32) -> f32 {
 /// (in nodes, clamped to `[0, n − 1]`).
 #[inline]
 fn catmull_rom(x: f32, n: usize) -> (usize, [f32; 4]) {
-    let (i, t) = cell(x / (n - 1) as f32, n);
+    let (i, t) = cell_at(x.max(0.0), n);
     (i, catmull_rom_weights(t))
 }
 
