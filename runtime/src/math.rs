@@ -188,33 +188,54 @@ pub fn log2_positive(x: f64) -> f64 {
     f64::from(exponent) + 2.0 * core::f64::consts::LOG2_E * (s + s * series)
 }
 
-/// `(ln 2)ⁿ / n!` for n = 0..12: the Taylor coefficients of `2^r`.
-const EXP2_TAYLOR: [f64; 13] = {
-    let mut c = [1.0f64; 13];
+/// `(ln 2)ⁿ / n!` for n = 0..5: the Taylor coefficients of `2^r`.
+const EXP2_TAYLOR: [f64; 6] = {
+    let mut c = [1.0f64; 6];
     let mut n = 1;
-    while n < 13 {
+    while n < 6 {
         c[n] = c[n - 1] * core::f64::consts::LN_2 / n as f64;
         n += 1;
     }
     c
 };
 
-/// `2^y` (f64), `y` clamped to `[−1022, 1023]` (NaN → 2⁻¹⁰²²): `y = k + r`,
-/// `k` the nearest integer, `|r| ≤ ½`, `2^r` by its Taylor series to `r¹²`
-/// (truncation below 1e-15).
+/// `2^(j/64)` for j = 0..63, by the Taylor series of `e^x` at compile time.
+const EXP2_STEPS: [f64; 64] = {
+    let mut table = [1.0f64; 64];
+    let mut j = 1;
+    while j < 64 {
+        let x = j as f64 / 64.0 * core::f64::consts::LN_2;
+        let (mut term, mut sum, mut n) = (1.0f64, 1.0f64, 1);
+        while n < 30 {
+            term = term * x / n as f64;
+            sum += term;
+            n += 1;
+        }
+        table[j] = sum;
+        j += 1;
+    }
+    table
+};
+
+/// `2^y` (f64), `y` clamped to `[−1022, 1023]` (NaN → 2⁻¹⁰²²): `64 y = n + 64 r`
+/// with `n` the nearest integer, `|r| ≤ 1/128`, `2^y = 2^⌊n/64⌋ 2^((n mod 64)/64) 2^r`,
+/// the middle factor from a table, `2^r` by its Taylor series to `r⁵`
+/// (truncation below 1e-16).
 #[inline]
 pub fn exp2(y: f64) -> f64 {
-    // 1.5·2⁵²: adding it rounds |y| < 2⁵¹ to an integer, held in the low bits.
+    // 1.5·2⁵²: adding it rounds |x| < 2⁵¹ to an integer, held in the low bits.
     const ROUND: f64 = 6_755_399_441_055_744.0;
     let y = y.max(-1022.0).min(1023.0);
-    let shifted = y + ROUND;
-    let k = shifted.to_bits().wrapping_sub(ROUND.to_bits()) as i64;
-    let r = y - (shifted - ROUND);
-    let mut p = EXP2_TAYLOR[12];
-    for c in EXP2_TAYLOR[..12].iter().rev() {
+    let shifted = y * 64.0 + ROUND;
+    let n = shifted.to_bits().wrapping_sub(ROUND.to_bits()) as i64;
+    let r = y - (shifted - ROUND) * (1.0 / 64.0);
+    let mut p = EXP2_TAYLOR[5];
+    for c in EXP2_TAYLOR[..5].iter().rev() {
         p = c + r * p;
     }
-    p * f64::from_bits(((k + 1023) as u64) << 52)
+    // n ≥ −65 408: ⌊n/64⌋ + 1023 ≥ 1, a normal power of two.
+    let scale = f64::from_bits((((n >> 6) + 1023) as u64) << 52);
+    EXP2_STEPS[(n & 63) as usize] * p * scale
 }
 
 #[cfg(test)]
