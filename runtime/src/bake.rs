@@ -63,31 +63,65 @@ const COS_H_MIN: f64 = 1e-3;
 /// `e^−70 C_max` ≈ 4e-31 C_max is stored as that).
 const LN_C_RANGE: f32 = 70.0;
 
-/// Linear-interpolation position on `n` nodes of `x ∈ [0, 1]` (clamped; NaN
-/// gives 0): the cell and the fraction in it.
+/// Linear-interpolation position on `n` nodes (`n ≤ 2²²`) of `x ∈ [0, 1]`
+/// (clamped; NaN gives 0): the cell and the fraction in it.
 #[inline]
 fn cell(x: f32, n: usize) -> (usize, f32) {
-    let last = (n - 1) as f32;
-    let t = (x * last).max(0.0).min(last);
-    let i = (t as usize).min(n - 2);
-    (i, t - i as f32)
+    cell_at((x * (n - 1) as f32).max(0.0), n)
 }
+
+/// [`cell`] of a position `t` in nodes (`t ≥ 0`, clamped to `n − 1`).
+#[inline]
+fn cell_at(t: f32, n: usize) -> (usize, f32) {
+    let t = t.min((n - 1) as f32);
+    // ⌊t⌋ without a saturating float-to-integer conversion: `t − ½ + 1.5·2²³`
+    // rounds to an integer (f32's spacing there is 1), which the low bits
+    // hold; a tie rounds to even, which may give the node below `t` with
+    // fraction 1 — the same interpolated value.
+    let rounded = (t - 0.5) + ROUNDER;
+    let i = (rounded.to_bits().wrapping_sub(ROUNDER.to_bits()) as i32)
+        .max(0)
+        .min(n as i32 - 2);
+    (i as usize, t - i as f32)
+}
+
+/// `1.5·2²³`: adding it to `x ∈ (−2²², 2²²)` rounds `x` to an integer.
+const ROUNDER: f32 = 12_582_912.0;
 
 /// One direction's quantities at one wavelength (module documentation).
 #[derive(Clone, Debug)]
 pub(crate) struct DirectionBake {
-    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0, w_spec, w_diff, w_base, 0]`
-    /// per node.
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 0]` per node: what `eval`
+    /// reads, in one row.
     rows: [[f32; ROW]; MU_NODES],
+    /// `[w_spec, w_diff, w_base, 0]` per node: what the sampler and `pdf` read.
+    weights: [[f32; 4]; MU_NODES],
 }
 
-/// Values per [`DirectionBake`] node.
-const ROW: usize = 12;
+/// Values per [`DirectionBake`] row.
+const ROW: usize = 8;
+
+/// A `cos θ`'s place on [`DirectionBake`]'s axis (the same for every
+/// wavelength, so [`crate::brdf::Rgb`] finds it once for its three channels).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DirectionCell {
+    index: usize,
+    fraction: f32,
+}
+
+impl DirectionCell {
+    /// The cell of `cos θ` (clamped to [0, 1]).
+    #[inline]
+    pub fn new(cos: f32) -> Self {
+        let (index, fraction) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
+        DirectionCell { index, fraction }
+    }
+}
 
 /// Interpolated [`DirectionBake`] row at one `cos θ`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirectionValues {
-    /// `[F, a, Re U, Im U, Re W, Im W, σrel/σs, 0, w_spec, w_diff, w_base, 0]`.
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 0]`.
     pub v: [f32; ROW],
 }
 
@@ -95,31 +129,20 @@ impl DirectionValues {
     /// F(η, cos θ).
     #[inline]
     pub fn fresnel(&self) -> f64 {
-        f64::from(self.v[0])
+        f64::from(self.v[6])
     }
 
     /// The factors of Q̄.
     #[inline]
     pub fn q_factors(&self) -> QFactors {
-        [1, 2, 3, 4, 5].map(|k| f64::from(self.v[k]))
+        let v = &self.v;
+        [v[0], v[1], v[2], v[3], v[4]].map(f64::from)
     }
 
     /// σrel/σs.
     #[inline]
     pub fn sigma_ratio(&self) -> f64 {
-        f64::from(self.v[6])
-    }
-
-    /// The sampler's lobe weights `[specular, diffraction, base]` (sum 1).
-    #[inline]
-    pub fn lobe_weights(&self) -> [f64; 3] {
-        let w = [8, 9, 10].map(|k| f64::from(self.v[k]).max(0.0));
-        let total = w[0] + w[1] + w[2];
-        if total > 0.0 {
-            w.map(|x| x / total)
-        } else {
-            [1.0, 0.0, 0.0]
-        }
+        f64::from(self.v[5])
     }
 }
 
@@ -140,17 +163,20 @@ impl DirectionBake {
             let cos = x * x;
             *cos_f32 = cos as f32;
             let factors = q.map(|q| q.factors(cos)).unwrap_or([0.0; 5]);
-            row[0] = fresnel(eta, cos as f32);
-            for (slot, value) in row[1..6].iter_mut().zip(factors) {
+            for (slot, value) in row[..5].iter_mut().zip(factors) {
                 *slot = value as f32;
             }
+            row[6] = fresnel(eta, cos as f32);
         }
         let mut ratios = [0.0f32; MU_NODES];
         sigma_ratio.sigma_ratio_cos_many(&cosines, big_b, c, &mut ratios);
         for (row, ratio) in rows.iter_mut().zip(ratios) {
-            row[6] = ratio;
+            row[5] = ratio;
         }
-        DirectionBake { rows }
+        DirectionBake {
+            rows,
+            weights: [[0.0f32; 4]; MU_NODES],
+        }
     }
 
     /// Tabulates the lobe weights `weights(cos θ)` (which may read `self`).
@@ -158,31 +184,50 @@ impl DirectionBake {
         for k in 0..MU_NODES {
             let x = k as f64 / (MU_NODES - 1) as f64;
             let w = weights(&self, x * x);
-            for (slot, value) in self.rows[k][8..11].iter_mut().zip(w) {
+            for (slot, value) in self.weights[k].iter_mut().zip(w) {
                 *slot = value as f32;
             }
         }
         self
     }
 
-    /// F alone at `cos θ` (clamped to [0, 1]).
+    /// F alone at a cell.
     #[inline]
-    pub fn fresnel_at(&self, cos: f32) -> f32 {
-        let (i, t) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
-        let (a, b) = (self.rows[i][0], self.rows[i + 1][0]);
-        a + t * (b - a)
+    pub fn fresnel_at(&self, at: DirectionCell) -> f32 {
+        let (a, b) = (self.rows[at.index][6], self.rows[at.index + 1][6]);
+        a + at.fraction * (b - a)
     }
 
     /// The values at `cos θ` (clamped to [0, 1]).
     #[inline]
     pub fn at(&self, cos: f32) -> DirectionValues {
-        let (i, t) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
-        let (a, b) = (&self.rows[i], &self.rows[i + 1]);
+        self.at_cell(DirectionCell::new(cos))
+    }
+
+    /// The values at a cell.
+    #[inline]
+    pub fn at_cell(&self, at: DirectionCell) -> DirectionValues {
+        let (a, b) = (&self.rows[at.index], &self.rows[at.index + 1]);
         let mut v = [0.0f32; ROW];
         for k in 0..ROW {
-            v[k] = a[k] + t * (b[k] - a[k]);
+            v[k] = a[k] + at.fraction * (b[k] - a[k]);
         }
         DirectionValues { v }
+    }
+
+    /// The sampler's lobe weights `[specular, diffraction, base]` (sum 1) at
+    /// `cos θ` (clamped to [0, 1]).
+    #[inline]
+    pub fn lobe_weights(&self, cos: f32) -> [f64; 3] {
+        let at = DirectionCell::new(cos);
+        let (a, b) = (&self.weights[at.index], &self.weights[at.index + 1]);
+        let w = [0, 1, 2].map(|k| f64::from(a[k] + at.fraction * (b[k] - a[k])).max(0.0));
+        let total = w[0] + w[1] + w[2];
+        if total > 0.0 {
+            w.map(|x| x / total)
+        } else {
+            [1.0, 0.0, 0.0]
+        }
     }
 }
 
@@ -438,18 +483,19 @@ impl ConvBake {
         let x_s = math::log2_axis(x_h) * ((CONV_S_NODES - 1) as f32 / angle_span(inv_w));
         let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
         let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);
+        // ju ≤ CONV_U_NODES − 2 and ks ≤ CONV_S_NODES − 2: the 4 × 4 taps
+        // lie in the padded grid.
         let mut ln_c = 0.0f32;
         for (a, wa) in wu.iter().enumerate() {
-            let start = (ju + a) * PADDED_S + ks;
-            let taps = self.ln_c.get(start..start + 4).unwrap_or(&[0.0; 4]);
-            let along: f32 = taps.iter().zip(ws).map(|(v, w)| v * w).sum();
-            ln_c += wa * along;
+            let row = &self.ln_c[(ju + a) * PADDED_S..][..PADDED_S];
+            let taps = &row[ks..ks + 4];
+            ln_c += wa * (taps[0] * ws[0] + taps[1] * ws[1] + taps[2] * ws[2] + taps[3] * ws[3]);
         }
-        // e^x is 0 in f32 below x ≈ −103.3 (and expf is slow near there).
+        // e^x is 0 in f32 below x ≈ −103.3.
         if !(ln_c > -104.0) {
             return 0.0;
         }
-        let value = math::expf(ln_c);
+        let value = math::exp_inline(f64::from(ln_c)) as f32;
         if value.is_finite() { value } else { 0.0 }
     }
 }
@@ -465,7 +511,7 @@ fn angle_span(inv_w: f32) -> f32 {
 /// (in nodes, clamped to `[0, n − 1]`).
 #[inline]
 fn catmull_rom(x: f32, n: usize) -> (usize, [f32; 4]) {
-    let (i, t) = cell(x / (n - 1) as f32, n);
+    let (i, t) = cell_at(x.max(0.0), n);
     (i, catmull_rom_weights(t))
 }
 

@@ -46,7 +46,9 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
-use crate::bake::{ConvBake, DirectionBake, DirectionValues, MaskingBake, SlopeQuantileBake};
+use crate::bake::{
+    ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, SlopeQuantileBake,
+};
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::{Epd, normal_at};
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
@@ -252,14 +254,18 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `(1 − exp(−x s))/s` for `s ≥ 0`, without cancellation, → `x` as `s → 0`.
+/// `(exp(−x s), (1 − exp(−x s))/s)` for `x, s ≥ 0` from one exponential
+/// ([`math::exp_inline`], to 2e-15): `1 − e^−t` loses at most `3e-16/t`
+/// relatively, below 3e-8 for `t ≥ 1e-8`; below that its series; the second
+/// → `x` as `s → 0`.
 #[inline]
-fn one_minus_exp_over(x: f64, s: f64) -> f64 {
+fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
     let t = x * s;
     if t < 1e-8 {
-        x * (1.0 - 0.5 * t)
+        (1.0 - t, x * (1.0 - 0.5 * t))
     } else {
-        -f64::from(math::exp_m1f(-t as f32)) / s
+        let e = math::exp_inline(-t);
+        (e, (1.0 - e) / s)
     }
 }
 
@@ -291,6 +297,12 @@ pub struct TwoScale<'a> {
     lambda: f64,
     /// `B = b / λ`.
     big_b: f64,
+    /// `(4π/λ)²`: A_spec's exponent is `(4π/λ)² cos²θd σrel²`.
+    x_scale: f64,
+    /// `σs²` (µm²).
+    sigma_s_sq: f64,
+    /// `(c−1) σs² b² / (2π λ²)`, the constant of ρ_CTD.
+    halo_scale: f64,
     base: BaseLayer,
     /// `F_dr,int(n)` from T5 (0 for a conductor).
     f_dr_int: f64,
@@ -363,6 +375,11 @@ struct Geometry {
 struct Pair {
     geometry: Geometry,
     g: f64,
+    /// The direction bake's cells of `cos θi`, `cos θo` and `cos θd`.
+    cells: [DirectionCell; 3],
+    /// `sin θi sin θo (cos φ, sin φ)` with φ = φo − φi − π (for Q̄).
+    along: f64,
+    across: f64,
 }
 
 impl<'a> TwoScale<'a> {
@@ -416,7 +433,13 @@ impl<'a> TwoScale<'a> {
             .slice
             .as_ref()
             .and_then(|slice| ConvBake::new(slice, big_b as f32, surface.beta, surface.p));
+        let sigma_s = f64::from(surface.sigma_s);
+        let b = f64::from(surface.b);
         let model = TwoScale {
+            x_scale: (4.0 * PI / lambda) * (4.0 * PI / lambda),
+            sigma_s_sq: sigma_s * sigma_s,
+            halo_scale: (f64::from(surface.c) - 1.0) * sigma_s * sigma_s * b * b
+                / (2.0 * PI * lambda * lambda),
             masking: shared.masking.clone(),
             slope_quantile: shared.slope_quantile.clone(),
             ndf,
@@ -480,12 +503,13 @@ impl<'a> TwoScale<'a> {
         if self.white() { 1.0 } else { values.fresnel() }
     }
 
-    /// F(η, cos θ) from the direction bake, or 1 for white colour terms.
-    fn fresnel_at(&self, cos: f64) -> f64 {
+    /// F(η, cos θ) from the direction bake at `cos θ`'s cell, or 1 for
+    /// white colour terms.
+    fn fresnel_at(&self, at: DirectionCell) -> f64 {
         if self.white() {
             1.0
         } else {
-            f64::from(self.direction.fresnel_at(cos as f32))
+            f64::from(self.direction.fresnel_at(at))
         }
     }
 
@@ -546,7 +570,14 @@ impl<'a> TwoScale<'a> {
                 1.0 / (1.0 / f64::from(g1_i) + 1.0 / f64::from(g1_o) - 1.0)
             }
         };
-        Pair { geometry, g }
+        let cos = |x: f64| DirectionCell::new(x as f32);
+        Pair {
+            geometry,
+            g,
+            cells: [cos(wi[2]), cos(wo[2]), cos(geometry.cos_d)],
+            along: -(wi[0] * wo[0] + wi[1] * wo[1]),
+            across: -(wi[0] * wo[1] - wi[1] * wo[0]),
+        }
     }
 
     /// ρ(i, o) in sr⁻¹ (HP17 24; module documentation). 0 below the horizon.
@@ -575,30 +606,29 @@ impl<'a> TwoScale<'a> {
                     d,
                 },
             g,
+            cells,
+            along,
+            across,
         } = *pair;
         let (cos_i, cos_o) = (wi[2], wo[2]);
         let (at_i, at_o) = (
-            self.direction.at(cos_i as f32),
-            self.direction.at(cos_o as f32),
+            self.direction.at_cell(cells[0]),
+            self.direction.at_cell(cells[1]),
         );
         let s = &self.surface;
-        let sigma_s = f64::from(s.sigma_s);
 
         // A_spec = exp(−x σrel²), x = (4π cos θd / λ)²            (HP17 25)
-        let x = {
-            let t = 4.0 * PI * cos_d / self.lambda;
-            t * t
-        };
+        let x = self.x_scale * cos_d * cos_d;
         let sigma_rel_sq = if s.sigma_s > 0.0 {
-            sigma_s * sigma_s * self.sigma_ratio_sq(&at_i, &at_o)
+            self.sigma_s_sq * self.sigma_ratio_sq(&at_i, &at_o)
         } else {
             0.0
         };
-        // f32 e^x: its 1e-7 relative error is far below the tables'.
-        let a_spec = f64::from(math::expf((-x * sigma_rel_sq) as f32));
+        // (1 − A)/σrel² of the halo below, from the same exponential.
+        let (a_spec, one_minus_a_over) = exp_and_one_minus_over(x, sigma_rel_sq);
 
         // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
-        let rho_ct = self.fresnel_at(cos_d) * d * g / (4.0 * cos_i * cos_o);
+        let rho_ct = self.fresnel_at(cells[2]) * d * g / (4.0 * cos_i * cos_o);
         let specular = a_spec * rho_ct;
 
         // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
@@ -607,27 +637,19 @@ impl<'a> TwoScale<'a> {
                 1.0
             } else {
                 match &self.q {
-                    Some(q) => {
-                        // sin θi sin θo (cos φ, sin φ) with φ = φo − φi − π.
-                        let along = -(wi[0] * wo[0] + wi[1] * wo[1]);
-                        let across = -(wi[0] * wo[1] - wi[1] * wo[0]);
-                        q.combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
-                            .max(0.0)
-                    }
+                    Some(q) => q
+                        .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
+                        .max(0.0),
                     None => 0.0,
                 }
             };
-            let b = f64::from(s.b);
-            let x_halo = match self.options.halo_weight {
-                HaloWeight::Printed => x,
+            let one_minus_a_over = match self.options.halo_weight {
+                HaloWeight::Printed => one_minus_a_over,
                 HaloWeight::Incident => {
-                    let t = 4.0 * PI * cos_i / self.lambda;
-                    t * t
+                    exp_and_one_minus_over(self.x_scale * cos_i * cos_i, sigma_rel_sq).1
                 }
             };
-            let halo = (f64::from(s.c) - 1.0) * sigma_s * sigma_s * b * b
-                / (2.0 * PI * self.lambda * self.lambda)
-                * one_minus_exp_over(x_halo, sigma_rel_sq);
+            let halo = self.halo_scale * one_minus_a_over;
             let u = (self.big_b * cos_d) as f32;
             let c_value = f64::from(match &self.conv_bake {
                 Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
@@ -716,7 +738,7 @@ impl<'a> TwoScale<'a> {
     /// The lobe weights at `cos θi`, from the direction bake's table of
     /// [`TwoScale::weights_at`].
     fn weights(&self, cos_i: f64) -> [f64; 3] {
-        self.direction.at(cos_i as f32).lobe_weights()
+        self.direction.lobe_weights(cos_i as f32)
     }
 
     /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`.
@@ -820,7 +842,7 @@ impl<'a> TwoScale<'a> {
         let reach = b * (1.0 + sin_i);
         // M = 1 − (1 + reach²)^(−(c−1)/2); the power (cheaper than exp_m1 and
         // ln_1p) cancels only where M < 1e-9, which has no mass to sample.
-        let m = 1.0 - math::powf(1.0 + reach * reach, -half_cm1); // (HP17 52)
+        let m = 1.0 - math::pow_positive(1.0 + reach * reach, -half_cm1); // (HP17 52)
         if !(m > 0.0) {
             return None;
         }
@@ -851,7 +873,7 @@ impl<'a> TwoScale<'a> {
             return 0.0;
         }
         let c = f64::from(self.surface.c);
-        let density = (c - 1.0) * b * b * math::powf(1.0 + b * b * r * r, -0.5 * (c + 1.0))
+        let density = (c - 1.0) * b * b * math::pow_positive(1.0 + b * b * r * r, -0.5 * (c + 1.0))
             / (2.0 * m * phi_max);
         density * wo[2]
     }

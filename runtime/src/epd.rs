@@ -81,12 +81,13 @@ impl<'a> Epd<'a> {
         }
         let cos_sq = cos_theta * cos_theta;
         let tan_sq = tan_sq(m);
-        let y = math::powff(tan_sq * self.inv_beta_sq, self.p);
-        // e^−y is 0 in f32 beyond y ≈ 104 (and expf slow near there).
+        // (tan²θ/β²)^p and e^−y inlined, in f64 (math::pow_positive, exp_inline).
+        let y = math::pow_positive(f64::from(tan_sq * self.inv_beta_sq), f64::from(self.p));
+        // e^−y is 0 in f32 beyond y ≈ 104.
         if !(y < 104.0) {
             return 0.0;
         }
-        let falloff = math::expf(-y);
+        let falloff = math::exp_inline(-y) as f32;
         if !(falloff > 0.0) {
             // Also covers z so small that cos⁴θ underflows (tan² = ∞).
             return 0.0;

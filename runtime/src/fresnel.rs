@@ -355,21 +355,23 @@ impl QConstants {
     /// (its length is `sin θi sin θo`; φ is normalised out, φ = 0 when either
     /// sine is 0).
     pub(crate) fn combine(&self, fi: &QFactors, fo: &QFactors, along: f64, across: f64) -> f64 {
-        // |along|, |across| ≤ 1: the squares cannot overflow (no hypot needed).
-        let sin_sin = math::sqrt(along * along + across * across);
-        let (cos_phi, sin_phi) = if sin_sin > 0.0 {
-            (along / sin_sin, across / sin_sin)
+        // With s² = along² + across² = (sin θi sin θo)², the bracket times s²
+        // is a_i a_o along² + (a_i |U_o|² + |U_i|² a_o) across²
+        // + |U_i U_o along − η² s² W_i W_o|²: one division, no square root.
+        // |along|, |across| ≤ 1: the squares cannot overflow.
+        let s_sq = along * along + across * across;
+        let (along, across, inv_s_sq) = if s_sq > 0.0 {
+            (along, across, 1.0 / s_sq)
         } else {
-            (1.0, 0.0)
+            (1.0, 0.0, 1.0)
         };
         let (ui, uo) = (C64::new(fi[1], fi[2]), C64::new(fo[1], fo[2]));
         let (wi, wo) = (C64::new(fi[3], fi[4]), C64::new(fo[3], fo[4]));
-        let (cos2, sin2) = (cos_phi * cos_phi, sin_phi * sin_phi);
-        let pp = ui * uo * cos_phi - self.index.eta_sq * (wi * wo) * sin_sin;
-        let q = fi[0] * fo[0] * cos2
-            + (fi[0] * uo.norm_sqr() + ui.norm_sqr() * fo[0]) * sin2
+        let pp = ui * uo * along - self.index.eta_sq * (wi * wo) * s_sq;
+        let q = fi[0] * fo[0] * (along * along)
+            + (fi[0] * uo.norm_sqr() + ui.norm_sqr() * fo[0]) * (across * across)
             + pp.norm_sqr();
-        0.5 * self.e_norm_sqr * q
+        0.5 * self.e_norm_sqr * q * inv_s_sq
     }
 }
 
