@@ -277,7 +277,8 @@ impl Lobe {
     /// feature, so that on each interval between two consecutive points the
     /// lobe is smooth on the scale of the interval.
     ///
-    /// * Kernel: the peak at 0 with half-width `w = 1/(2u)`: `w·2^k`, `k ≥ −4`.
+    /// * Kernel: the peak at 0 with half-width `w = 1/(2u)`: `w·2^k`, `k ≥ 0`
+    ///   (the kernel is analytic within `w` of its axis).
     /// * NDF: the peak (a cusp for non-integer `p`) at 0, scale
     ///   `θβ = atan β`: `θβ·2^k` for `k ≥ 0` and `θβ·4^(−k)`, `k = 1..8`;
     ///   the angles where `(tan θ/β)^(2p) = 2^k`, `k = −3..6`; and,
@@ -292,7 +293,7 @@ impl Lobe {
             Lobe::Kernel { u, .. } => {
                 if u > 0.0 {
                     let w = 0.5 / u;
-                    let mut x = w / 16.0;
+                    let mut x = w;
                     while x < FRAC_PI_2 {
                         out.push(x);
                         x *= 2.0;
