@@ -225,11 +225,17 @@ impl Params {
 /// The kernel `K(γ) = k(2u sin γ) cos²γ` with `k(x) = (1 + x²)^(−q)`,
 /// `q = (c+1)/2`, cut to zero for `cos γ ≤ 0` (docs/model.md §2.5).
 fn kernel_sc(u: f64, q: f64, sin_gamma: f64, cos_gamma: f64) -> f64 {
+    let x = 2.0 * u * sin_gamma;
+    kernel_x2(q, x * x, cos_gamma)
+}
+
+/// [`kernel_sc`] given `x² = 4u² sin²γ` and `cos γ`: `(1 + x²)^(−q) cos²γ`,
+/// 0 for `cos γ ≤ 0`.
+fn kernel_x2(q: f64, x2: f64, cos_gamma: f64) -> f64 {
     if cos_gamma.is_nan() || cos_gamma <= 0.0 {
         return 0.0;
     }
-    let x = 2.0 * u * sin_gamma;
-    (-q * (x * x).ln_1p()).exp() * cos_gamma * cos_gamma
+    (-q * x2.ln_1p()).exp() * cos_gamma * cos_gamma
 }
 
 /// One of the two rotationally symmetric lobes of the convolution, as a
@@ -268,8 +274,12 @@ impl Lobe {
         if d2.is_nan() || d2 >= 2.0 {
             return 0.0;
         }
-        let sin_t = (d2 * (1.0 - 0.25 * d2)).max(0.0).sqrt();
-        self.value(sin_t, 1.0 - 0.5 * d2)
+        let sin2 = (d2 * (1.0 - 0.25 * d2)).max(0.0);
+        match *self {
+            // The kernel needs sin²θ only.
+            Lobe::Kernel { u, q } => kernel_x2(q, 4.0 * u * u * sin2, 1.0 - 0.5 * d2),
+            Lobe::Ndf { .. } => self.value(sin2.sqrt(), 1.0 - 0.5 * d2),
+        }
     }
 
     /// Polar angles in `(0, π/2)` where the lobe's profile changes scale:
