@@ -26,7 +26,11 @@
 //! (geometric grids around its peak, plus the horizon maximum of small-`p`
 //! NDFs). The inner integral is split at the azimuths where the circle
 //! crosses those angles of `f_B` (`sin²(ψ_j/2) = (sin²(δ_j/2) −
-//! sin²((ρ−θh)/2)) / (sin ρ sin θh)`) and at the cut `ψ_max`. The outer one is
+//! sin²((ρ−θh)/2)) / (sin ρ sin θh)`) and at the cut `ψ_max`; when `f_B` is
+//! the kernel ([`Frame::Normal`]) it is instead integrated in a variable in
+//! which the kernel's leading factor `(1 + 4u² |B − m|²)^(−q)` is smooth
+//! over the whole circle (see `ArcMap::Kernel`), so that a circle costs one
+//! to three pieces however narrow the kernel. The outer one is
 //! split at the angles of `f_A`, at `θh`, and at `θh ± δ_j`, `δ_j − θh`
 //! (where the circle starts or stops meeting the circle `δ = δ_j` around `B`;
 //! with `δ_j = π/2` this is the kink where `R` starts being cut). On every
