@@ -389,7 +389,7 @@ pub const ZH_MAX_BAND: usize = 16384;
 /// `|Δ| / max(|C|, 1e-6 · C(0))` (relative, with an absolute floor of
 /// `1e-12 · C(0)` in the deep tails):
 ///
-/// * the two direct frames ([`Frame`]) agree to `≤ 8e-13`;
+/// * the two direct frames ([`Frame`]) agree to `≤ 1.1e-12`;
 /// * zonal harmonics and direct quadrature agree to `≤ 2.3e-8` (worst at
 ///   `u = 1, c = 10, β = 1, p = 0.2, θh = 0`, the cusp) on the 163 of 180
 ///   points where the series converged within `L = 65536`, typically to
