@@ -14,6 +14,7 @@ mod brdf_instructions;
 mod common;
 mod t3_angle;
 mod t3_axes;
+mod t3_direct_cost;
 mod t3_interp;
 mod t3_node_cost;
 mod t3_thresholds;
@@ -136,6 +137,20 @@ enum Study {
         #[arg(long, default_value_t = 61)]
         stride: usize,
     },
+    /// The T3 build's direct quadrature: lobe evaluations and time of every
+    /// `stride`-th direct node, all angles; saves or compares the values
+    /// (docs/design/t3-build-speed.md).
+    T3DirectCost {
+        /// Every `stride`-th node (the direct ones among them).
+        #[arg(long, default_value_t = 61)]
+        stride: usize,
+        /// Write the values (f64 bits) to this file.
+        #[arg(long)]
+        save: Option<PathBuf>,
+        /// Compare the values with a file written by `--save`.
+        #[arg(long)]
+        compare: Option<PathBuf>,
+    },
     /// The paper's thresholds for T3a's g (HP17 §4.4) read from the
     /// committed table (docs/design/t3-paper-form.md).
     T3Thresholds,
@@ -211,6 +226,11 @@ fn main() -> ExitCode {
             t3_node_cost::run(stride);
             Ok(())
         }
+        Study::T3DirectCost {
+            stride,
+            save,
+            compare,
+        } => t3_direct_cost::run(stride, save.as_deref(), compare.as_deref()),
         Study::T3Thresholds => {
             t3_thresholds::run();
             Ok(())

@@ -279,7 +279,7 @@ pub fn node_cost(index: usize) -> u64 {
 /// [`node_cost`] of a zonal-harmonic node (moments amortised), 0.1 ms units.
 const ZH_NODE_COST: u64 = 20;
 /// [`node_cost`] of a direct-quadrature node at `u = 100`, 0.1 ms units.
-const DIRECT_NODE_COST: f64 = 2000.0;
+const DIRECT_NODE_COST: f64 = 1000.0;
 
 /// Computes the nodes `indices` (in that order), advancing `progress` by
 /// each node's [`node_cost`]; one [`MomentCache`] is shared by all.
