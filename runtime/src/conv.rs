@@ -545,8 +545,9 @@ impl<'a> ConvTable<'a> {
     }
 
     /// Blend of the `out.len()` consecutive channels from `first` over the
-    /// parameter cell (one pass over the corners, skipping corners of zero
-    /// weight), with [`ConvTable::axis_weights`] per axis.
+    /// parameter cell (one pass over the corners, skipping those of zero
+    /// weight along `u`), with [`ConvTable::axis_weights`] per axis.
+    #[inline(always)]
     fn blend_into(&self, cells: [(usize, f32); 4], first: usize, out: &mut [f32]) {
         let channels = FIT_CHANNELS + self.angles;
         let n = out.len();
@@ -561,32 +562,22 @@ impl<'a> ConvTable<'a> {
         out.iter_mut().for_each(|v| *v = 0.0);
         // Σ w (offset + q step) = Σ w offset + Σ (w step) q.
         let mut offsets = 0.0f32;
-        let nonzero = |w: &&f32| **w != 0.0;
+        // Corners of zero weight along the first axis (u; a slice's rows at
+        // nodes) are skipped: most of a slice's blends; a test per inner
+        // corner costs more than it saves (callgrind).
         for (a, wa) in weights[0][..count[0]]
             .iter()
             .enumerate()
-            .filter(|(_, w)| nonzero(w))
+            .filter(|(_, w)| **w != 0.0)
         {
             let ia = start[0] + a;
-            for (b, wb) in weights[1][..count[1]]
-                .iter()
-                .enumerate()
-                .filter(|(_, w)| nonzero(w))
-            {
+            for (b, wb) in weights[1][..count[1]].iter().enumerate() {
                 let ib = ia * n1 + start[1] + b;
                 let wab = wa * wb;
-                for (c, wc) in weights[2][..count[2]]
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, w)| nonzero(w))
-                {
+                for (c, wc) in weights[2][..count[2]].iter().enumerate() {
                     let ic = ib * n2 + start[2] + c;
                     let wabc = wab * wc;
-                    for (d, wd) in weights[3][..count[3]]
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, w)| nonzero(w))
-                    {
+                    for (d, wd) in weights[3][..count[3]].iter().enumerate() {
                         let node = ic * n3 + start[3] + d;
                         let index = node * channels + first;
                         let w = wabc * wd;

@@ -18,11 +18,12 @@ use twoscale::brdf::{Options, Rgb, TwoScale};
 use twoscale::materials::{HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
-pub const OPERATIONS: [&str; 9] = [
+pub const OPERATIONS: [&str; 10] = [
     "ggx-eval",
     "ggx-eval-rgb",
     "ggx-sample-eval",
     "eval",
+    "eval-t3a",
     "eval-rgb",
     "pdf",
     "sample",
@@ -35,6 +36,8 @@ pub const OPERATIONS: [&str; 9] = [
 pub fn run_calls(operation: &str, calls: usize) -> Result<(), String> {
     let set = TableSet::embedded();
     let model = cost::nickel(&set, &set.convolution);
+    let fit = set.convolution.fit();
+    let model_fit = cost::nickel(&set, &fit);
     let ggx = cost::ggx();
     let (rgb, rgb_eta) = cost::rgb_preset(&set);
     let inputs = Inputs::new();
@@ -50,6 +53,7 @@ pub fn run_calls(operation: &str, calls: usize) -> Result<(), String> {
                 .sample_eval(black_box(iu), [u[1], u[2]])
                 .map_or(0.0, |(_, pdf, value)| value / pdf),
             "eval" => model.eval(black_box(i), black_box(o)),
+            "eval-t3a" => model_fit.eval(black_box(i), black_box(o)),
             "eval-rgb" => rgb.eval(black_box(i), black_box(o))[1],
             "pdf" => model.pdf(black_box(i), black_box(o)),
             "sample" => model
