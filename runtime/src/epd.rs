@@ -81,13 +81,14 @@ impl<'a> Epd<'a> {
         }
         let cos_sq = cos_theta * cos_theta;
         let tan_sq = tan_sq(m);
-        // (tan²θ/β²)^p and e^−y inlined, in f64 (math::pow_positive, exp_inline).
-        let y = math::pow_positive(f64::from(tan_sq * self.inv_beta_sq), f64::from(self.p));
+        // libm's f32 powf and expf: the inlined f64 forms (math::pow_positive,
+        // exp_inline) count fewer instructions but ran slower (speed.md).
+        let y = math::powff(tan_sq * self.inv_beta_sq, self.p);
         // e^−y is 0 in f32 beyond y ≈ 104.
         if !(y < 104.0) {
             return 0.0;
         }
-        let falloff = math::exp_inline(-y) as f32;
+        let falloff = math::expf(-y);
         if !(falloff > 0.0) {
             // Also covers z so small that cos⁴θ underflows (tan² = ∞).
             return 0.0;
