@@ -31,57 +31,154 @@ pub const OPERATIONS: [&str; 10] = [
     "construct-rgb",
 ];
 
-/// Runs `calls` calls of `operation` (one of [`OPERATIONS`]), cycling over
-/// the inputs; the set-up is the same for every operation and count.
+/// The models and inputs every operation runs on (the same set-up for every
+/// operation and count).
+pub struct Workload<'a> {
+    set: &'a TableSet<'static>,
+    model: TwoScale<'a>,
+    model_fit: TwoScale<'a>,
+    ggx: cost::Ggx,
+    rgb: Rgb<'a>,
+    rgb_eta: [twoscale::Complex; 3],
+    inputs: Inputs,
+}
+
+impl<'a> Workload<'a> {
+    /// The models of `suite::cost` on `set` (and T3a's fit, kept in `fit`).
+    pub fn new(set: &'a TableSet<'static>, fit: &'a twoscale::conv::ConvFitTable<'static>) -> Self {
+        let (rgb, rgb_eta) = cost::rgb_preset(set);
+        Workload {
+            set,
+            model: cost::nickel(set, &set.convolution),
+            model_fit: cost::nickel(set, fit),
+            ggx: cost::ggx(),
+            rgb,
+            rgb_eta,
+            inputs: Inputs::new(),
+        }
+    }
+
+    /// Runs `calls` calls of `operation` (one of [`OPERATIONS`]), cycling
+    /// over the inputs from input `start`.
+    pub fn run(&self, operation: &str, start: usize, calls: usize) -> Result<f32, String> {
+        let inputs = &self.inputs;
+        let n = inputs.pairs.len();
+        let (set, model, model_fit, ggx, rgb) =
+            (self.set, &self.model, &self.model_fit, &self.ggx, &self.rgb);
+        let mut sum = 0.0f32;
+        for k in start..start + calls {
+            let (i, o) = inputs.pairs[k % n];
+            let (iu, u) = inputs.uniforms[k % n];
+            sum += match operation {
+                "ggx-eval" => ggx.eval(black_box(i), black_box(o)),
+                "ggx-eval-rgb" => ggx.eval_rgb(&self.rgb_eta, black_box(i), black_box(o))[1],
+                "ggx-sample-eval" => ggx
+                    .sample_eval(black_box(iu), [u[1], u[2]])
+                    .map_or(0.0, |(_, pdf, value)| value / pdf),
+                "eval" => model.eval(black_box(i), black_box(o)),
+                "eval-t3a" => model_fit.eval(black_box(i), black_box(o)),
+                "eval-rgb" => rgb.eval(black_box(i), black_box(o))[1],
+                "pdf" => model.pdf(black_box(i), black_box(o)),
+                "sample" => model
+                    .sample(black_box(iu), black_box(u))
+                    .map_or(0.0, |s| s.value / s.pdf),
+                // One wavelength's model per call (as criterion's `two_scale_new`).
+                "construct" => TwoScale::conductor(
+                    &set.brdf_tables(),
+                    black_box(HP17_NICKEL_SURFACE),
+                    cost::LAMBDA,
+                    cost::NICKEL_LIKE,
+                )
+                .eval(i, o),
+                "construct-rgb" => Rgb::new(
+                    &set.brdf_tables(),
+                    black_box(&PRESETS[0].1),
+                    Options::default(),
+                )
+                .eval(i, o)[1],
+                other => {
+                    return Err(format!(
+                        "unknown operation {other}; one of {}",
+                        OPERATIONS.join(", ")
+                    ));
+                }
+            };
+        }
+        Ok(black_box(sum))
+    }
+}
+
+/// The baseline an operation's ratio is taken against (empty: none):
+/// eval-rgb against the RGB GGX eval, sample against GGX's visible-normal
+/// sample + eval, the other BRDF operations against the GGX eval.
+fn baseline(operation: &str) -> &'static str {
+    match operation {
+        "eval-rgb" => "ggx-eval-rgb",
+        "sample" => "ggx-sample-eval",
+        _ if operation.starts_with("ggx") || operation.starts_with("construct") => "",
+        _ => "ggx-eval",
+    }
+}
+
+/// Calls per timed batch or counted run: construction is ~10⁴× an eval.
+fn calls_of(operation: &str, calls: usize) -> usize {
+    if operation.starts_with("construct") {
+        (calls / 1000).max(3)
+    } else {
+        calls
+    }
+}
+
+/// Runs `calls` calls of `operation` (what the report runs under callgrind).
 pub fn run_calls(operation: &str, calls: usize) -> Result<(), String> {
     let set = TableSet::embedded();
-    let model = cost::nickel(&set, &set.convolution);
     let fit = set.convolution.fit();
-    let model_fit = cost::nickel(&set, &fit);
-    let ggx = cost::ggx();
-    let (rgb, rgb_eta) = cost::rgb_preset(&set);
-    let inputs = Inputs::new();
-    let n = inputs.pairs.len();
-    let mut sum = 0.0f32;
-    for k in 0..calls {
-        let (i, o) = inputs.pairs[k % n];
-        let (iu, u) = inputs.uniforms[k % n];
-        sum += match operation {
-            "ggx-eval" => ggx.eval(black_box(i), black_box(o)),
-            "ggx-eval-rgb" => ggx.eval_rgb(&rgb_eta, black_box(i), black_box(o))[1],
-            "ggx-sample-eval" => ggx
-                .sample_eval(black_box(iu), [u[1], u[2]])
-                .map_or(0.0, |(_, pdf, value)| value / pdf),
-            "eval" => model.eval(black_box(i), black_box(o)),
-            "eval-t3a" => model_fit.eval(black_box(i), black_box(o)),
-            "eval-rgb" => rgb.eval(black_box(i), black_box(o))[1],
-            "pdf" => model.pdf(black_box(i), black_box(o)),
-            "sample" => model
-                .sample(black_box(iu), black_box(u))
-                .map_or(0.0, |s| s.value / s.pdf),
-            // One wavelength's model per call (as criterion's `two_scale_new`).
-            "construct" => TwoScale::conductor(
-                &set.brdf_tables(),
-                black_box(HP17_NICKEL_SURFACE),
-                cost::LAMBDA,
-                cost::NICKEL_LIKE,
-            )
-            .eval(i, o),
-            "construct-rgb" => Rgb::new(
-                &set.brdf_tables(),
-                black_box(&PRESETS[0].1),
-                Options::default(),
-            )
-            .eval(i, o)[1],
-            other => {
-                return Err(format!(
-                    "unknown operation {other}; one of {}",
-                    OPERATIONS.join(", ")
-                ));
-            }
-        };
+    Workload::new(&set, &fit).run(operation, 0, calls).map(drop)
+}
+
+/// Wall time per call of every operation, interleaved: each of `rounds`
+/// rounds times one batch of `batch` calls of every operation in turn, so a
+/// change of the machine's load hits all operations alike. Prints the
+/// minimum and median over the rounds (ns per call) and the ratios of the
+/// minima to the baselines: the minimum is the run least disturbed by other
+/// processes, which on a shared machine only ever add time.
+pub fn timing(rounds: usize, batch: usize) -> Result<(), String> {
+    let set = TableSet::embedded();
+    let fit = set.convolution.fit();
+    let work = Workload::new(&set, &fit);
+    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); OPERATIONS.len()];
+    for round in 0..rounds {
+        for (k, op) in OPERATIONS.iter().enumerate() {
+            let n = calls_of(op, batch);
+            let start = std::time::Instant::now();
+            work.run(op, round * n, n)?;
+            times[k].push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+        }
     }
-    black_box(sum);
+    let stats: Vec<(f64, f64)> = times
+        .iter_mut()
+        .map(|t| {
+            t.sort_by(f64::total_cmp);
+            (t[0], t[t.len() / 2])
+        })
+        .collect();
+    let min_of = |name: &str| {
+        OPERATIONS
+            .iter()
+            .position(|op| *op == name)
+            .map_or(f64::NAN, |k| stats[k].0)
+    };
+    println!("| operation | min ns per call | median | min ratio | against |");
+    println!("|---|---|---|---|---|");
+    for (op, &(min, median)) in OPERATIONS.iter().zip(&stats) {
+        let against = baseline(op);
+        let ratio = if against.is_empty() {
+            String::new()
+        } else {
+            format!("{:.2}×", min / min_of(against))
+        };
+        println!("| {op} | {min:.1} | {median:.1} | {ratio} | {against} |");
+    }
     Ok(())
 }
 
@@ -112,12 +209,7 @@ fn instructions(operation: &str, calls: usize) -> Result<u64, String> {
 pub fn report(calls: usize) -> Result<(), String> {
     let mut per_call = Vec::new();
     for op in OPERATIONS {
-        // Construction is ~10⁴× an eval: fewer calls.
-        let n = if op.starts_with("construct") {
-            (calls / 1000).max(3)
-        } else {
-            calls
-        };
+        let n = calls_of(op, calls);
         let (low, high) = (instructions(op, n)?, instructions(op, 3 * n)?);
         let count = high.saturating_sub(low) as f64 / (2 * n) as f64;
         eprintln!("{op}: {count:.0} instructions per call");
@@ -132,12 +224,7 @@ pub fn report(calls: usize) -> Result<(), String> {
     println!("| operation | instructions per call | ratio | against |");
     println!("|---|---|---|---|");
     for &(op, count) in &per_call {
-        let baseline = match op {
-            "eval-rgb" => "ggx-eval-rgb",
-            "sample" => "ggx-sample-eval",
-            _ if op.starts_with("ggx") || op.starts_with("construct") => "",
-            _ => "ggx-eval",
-        };
+        let baseline = baseline(op);
         if baseline.is_empty() {
             println!("| {op} | {count:.0} | | |");
         } else {

@@ -166,6 +166,16 @@ enum Study {
         #[arg(long)]
         operation: Option<String>,
     },
+    /// Wall time per call of the BRDF's operations and the GGX baselines,
+    /// interleaved batches, minimum over rounds (docs/design/speed.md).
+    BrdfTiming {
+        /// Rounds (each times one batch of every operation).
+        #[arg(long, default_value_t = 200)]
+        rounds: usize,
+        /// Calls per batch (construction: a thousandth).
+        #[arg(long, default_value_t = 4096)]
+        batch: usize,
+    },
     /// T4's error against the band limit L
     /// (docs/design/t4-band-limits.md).
     T4BandLimits {
@@ -236,6 +246,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
+        Study::BrdfTiming { rounds, batch } => brdf_instructions::timing(rounds, batch),
         Study::BrdfInstructions { calls, operation } => match operation {
             Some(op) => brdf_instructions::run_calls(&op, calls),
             None => brdf_instructions::report(calls),
