@@ -5,6 +5,8 @@
 //!   wavelength — F(η, cos θ), the factors of Q̄ ([`QConstants::factors`]) and
 //!   σrel/σs (T2), and the sampler's lobe weights — on 257 nodes even in `√cos θ` (dense at grazing, where σrel
 //!   and F move fastest), linear between nodes.
+//! * [`RadialNormBake`]: `1/M(sin θi)`, the normalisation of the diffraction
+//!   sampler's radial law, on 513 nodes even in `sin θi`, linear between.
 //! * [`MaskingBake`]: Smith G1 (T1 at the material's p) on 1025 nodes even in
 //!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
 //!   horizon (G1 = 0).
@@ -228,6 +230,47 @@ impl DirectionBake {
         } else {
             [1.0, 0.0, 0.0]
         }
+    }
+}
+
+/// `1/M(sin θi)` of the diffraction sampler's radial law at one wavelength,
+/// `M = 1 − (1 + B²(1 + sin θi)²)^(−(c−1)/2)` (HP17 52), on [`RADIAL_NODES`]
+/// nodes even in `sin θi` (where `M` is analytic), linear between; 0 where
+/// `M` is not positive (no mass to sample). `sample` and `pdf` read the same
+/// values.
+#[derive(Clone, Debug)]
+pub(crate) struct RadialNormBake {
+    inv_m: [f32; RADIAL_NODES],
+}
+
+/// Nodes of [`RadialNormBake`].
+const RADIAL_NODES: usize = 513;
+
+impl RadialNormBake {
+    /// Tabulates `1/M` for `B = b/λ` and the spectrum's `c`.
+    pub fn new(big_b: f64, c: f64) -> Self {
+        let mut inv_m = [0.0f32; RADIAL_NODES];
+        for (k, slot) in inv_m.iter_mut().enumerate() {
+            let sin_i = k as f64 / (RADIAL_NODES - 1) as f64;
+            let reach = big_b * (1.0 + sin_i);
+            // −expm1(−(c−1)/2 · ln(1 + reach²)): no cancellation for small reach.
+            let m = -math::exp_m1(-0.5 * (c - 1.0) * math::ln_1p(reach * reach));
+            let value = (1.0 / m) as f32;
+            *slot = if m > 0.0 && value.is_finite() {
+                value
+            } else {
+                0.0
+            };
+        }
+        RadialNormBake { inv_m }
+    }
+
+    /// `1/M` at `sin θi` (clamped to [0, 1]).
+    #[inline]
+    pub fn inv_m(&self, sin_i: f64) -> f64 {
+        let (i, t) = cell(sin_i as f32, RADIAL_NODES);
+        let (a, b) = (self.inv_m[i], self.inv_m[i + 1]);
+        f64::from(a + t * (b - a))
     }
 }
 
@@ -468,9 +511,10 @@ impl ConvBake {
     /// width. Smooth in `u`, so that rows at equal `x` interpolate well.
     #[inline]
     fn inv_width(&self, u: f32) -> f32 {
-        let k = 0.125 / (u + 0.5);
-        let n = self.ndf_quarter_width;
-        math::sqrtf(16.0 + 1.0 / (k * k + n * n))
+        // 1/(k² + n²) = v²/(1/64 + n² v²) with v = u + ½: one division.
+        let v = u + 0.5;
+        let nv = self.ndf_quarter_width * v;
+        math::sqrtf(16.0 + v * v / (1.0 / 64.0 + nv * nv))
     }
 
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
@@ -495,7 +539,7 @@ impl ConvBake {
         if !(ln_c > -104.0) {
             return 0.0;
         }
-        let value = math::exp_inline(f64::from(ln_c)) as f32;
+        let value = math::expf(ln_c);
         if value.is_finite() { value } else { 0.0 }
     }
 }
@@ -503,7 +547,7 @@ impl ConvBake {
 /// The θh axis's value at `cos θh = 10⁻³` (its last node) for `1/w`.
 #[inline]
 fn angle_span(inv_w: f32) -> f32 {
-    math::log2_axis((1.0 + inv_w) / COS_H_MIN as f32)
+    math::log2_axis((1.0 + inv_w) * (1.0 / COS_H_MIN) as f32)
 }
 
 /// The first of the four padded node indices (the cell's index, as the
@@ -568,6 +612,35 @@ mod tests {
     /// The tabulated EPD quantile against the sampler's Newton solve
     /// (`Epd::sample_tan_theta`) over p ∈ [0.2, 5] and u₀ from 1e-30 to
     /// [`BELOW_ONE`].
+    #[test]
+    fn radial_norm_matches_the_closed_form() {
+        let mut rng = Lcg(5);
+        let mut worst = (0.0f64, 0.0, 0.0, 0.0);
+        for _ in 0..400 {
+            // B from 1e-3 to 1e3, c from 1 to 10.
+            let big_b = 10f64.powf(6.0 * rng.next() - 3.0);
+            let c = 1.0 + 9.0 * rng.next() + 1e-3;
+            let bake = RadialNormBake::new(big_b, c);
+            for _ in 0..200 {
+                let sin_i = rng.next();
+                let reach = big_b * (1.0 + sin_i);
+                let m = -(-0.5 * (c - 1.0) * (reach * reach).ln_1p()).exp_m1();
+                let e = (bake.inv_m(sin_i) * m - 1.0).abs();
+                if e > worst.0 {
+                    worst = (e, big_b, c, sin_i);
+                }
+            }
+        }
+        std::eprintln!(
+            "1/M: worst {:.2e} at B {:.3e}, c {:.2}, sin θi {:.4}",
+            worst.0,
+            worst.1,
+            worst.2,
+            worst.3
+        );
+        assert!(worst.0 < 5e-6, "{worst:?}");
+    }
+
     #[test]
     fn slope_quantile_matches_the_solved_quantile() {
         let set = TableSet::embedded();

@@ -47,7 +47,8 @@
 //! are not returned, so `∫ pdf ≤ 1`).
 
 use crate::bake::{
-    ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, SlopeQuantileBake,
+    ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, RadialNormBake,
+    SlopeQuantileBake,
 };
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::{Epd, normal_at};
@@ -274,9 +275,9 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// Construction bakes what depends only on the material and wavelength
 /// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, the sampler's
 /// EPD quantile, and C over `(u, θh)` when the source of C is T3b; module
-/// `bake`), so that `eval` reads small tables. 48 KB (C 23 KB, the
-/// direction bake 12 KB, the quantile 8 KB, G1 4 KB; [`Rgb`] three times
-/// that); `Clone`, not `Copy`.
+/// `bake`), so that `eval` reads small tables. 50 KB (C 23 KB, the
+/// direction bake 12 KB, the quantile 8 KB, G1 4 KB, the diffraction
+/// sampler's `1/M` 2 KB; [`Rgb`] three times that); `Clone`, not `Copy`.
 #[derive(Clone)]
 pub struct TwoScale<'a> {
     ndf: Epd<'a>,
@@ -286,6 +287,8 @@ pub struct TwoScale<'a> {
     slope_quantile: SlopeQuantileBake,
     /// F, Q̄'s factors and σrel/σs over `cos θ`.
     direction: DirectionBake,
+    /// `1/M(sin θi)` of the diffraction sampler.
+    radial_norm: RadialNormBake,
     /// Q̄'s constants of η (`None` for η = 1: Q̄ = 0).
     q: Option<QConstants>,
     conv: &'a (dyn Convolution + Sync),
@@ -451,6 +454,7 @@ impl<'a> TwoScale<'a> {
                 surface.c,
             ),
             q,
+            radial_norm: RadialNormBake::new(big_b, f64::from(surface.c)),
             conv: tables.convolution,
             conv_bake,
             surface,
@@ -829,24 +833,19 @@ impl<'a> TwoScale<'a> {
         }
     }
 
-    /// `(B, s, M)` of the diffraction sampler, or `None` when the spectrum is
-    /// degenerate (σs = 0 or b = 0).
+    /// `(B, s, 1/M)` of the diffraction sampler (M of HP17 52 from the
+    /// bake), or `None` when the spectrum is degenerate (σs = 0 or b = 0) or
+    /// M is not positive.
     fn diffraction_setup(&self, wi: [f64; 3]) -> Option<(f64, f64, f64)> {
-        let s = &self.surface;
-        if !(s.sigma_s > 0.0 && self.big_b > 0.0) {
+        if !(self.surface.sigma_s > 0.0 && self.big_b > 0.0) {
             return None;
         }
         let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
-        let b = self.big_b;
-        let half_cm1 = 0.5 * (f64::from(s.c) - 1.0);
-        let reach = b * (1.0 + sin_i);
-        // M = 1 − (1 + reach²)^(−(c−1)/2); the power (cheaper than exp_m1 and
-        // ln_1p) cancels only where M < 1e-9, which has no mass to sample.
-        let m = 1.0 - math::pow_positive(1.0 + reach * reach, -half_cm1); // (HP17 52)
-        if !(m > 0.0) {
+        let inv_m = self.radial_norm.inv_m(sin_i);
+        if !(inv_m > 0.0) {
             return None;
         }
-        Some((b, sin_i, m))
+        Some((self.big_b, sin_i, inv_m))
     }
 
     /// φmax of (HP17 53) for `r = λ f`: the half-width of the arc of
@@ -856,11 +855,11 @@ impl<'a> TwoScale<'a> {
             return PI;
         }
         let x = (r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i);
-        math::acos(x.max(-1.0).min(1.0))
+        math::acos_approx(x.max(-1.0).min(1.0))
     }
 
     fn diffraction_pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
-        let Some((b, sin_i, m)) = self.diffraction_setup(wi) else {
+        let Some((b, sin_i, inv_m)) = self.diffraction_setup(wi) else {
             return 0.0;
         };
         let (dx, dy) = (wo[0] + wi[0], wo[1] + wi[1]);
@@ -873,8 +872,9 @@ impl<'a> TwoScale<'a> {
             return 0.0;
         }
         let c = f64::from(self.surface.c);
-        let density = (c - 1.0) * b * b * math::pow_positive(1.0 + b * b * r * r, -0.5 * (c + 1.0))
-            / (2.0 * m * phi_max);
+        let density =
+            (c - 1.0) * b * b * math::pow_positive(1.0 + b * b * r * r, -0.5 * (c + 1.0)) * inv_m
+                / (2.0 * phi_max);
         density * wo[2]
     }
 
@@ -903,7 +903,8 @@ impl<'a> TwoScale<'a> {
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
             Lobe::Diffraction => {
-                let (b, sin_i, m) = self.diffraction_setup(wi)?;
+                let (b, sin_i, inv_m) = self.diffraction_setup(wi)?;
+                let m = 1.0 / inv_m;
                 let c = f64::from(self.surface.c);
                 let t = -2.0 / (c - 1.0) * f64::from(math::ln_1pf((-m * u[0]) as f32)); // (HP17 51)
                 let r =
