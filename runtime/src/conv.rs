@@ -45,7 +45,7 @@
 //!        + w_e · f_e · asinh(2 u_e sin x̃)            edge
 //!        + λ · ln(1 + Y (1 − e^(−y/Y)))              NDF
 //!   x̃ = min((x + √(x² + δ²)) / 2, π/2),  x = θh − θe,  δ = s_e / (2 u_e)
-//!   f_e = 1 / (1 + (tan θe / τ_f)²)
+//!   f_e = (p'/p)^m / (1 + (tan θe / τ_f)²)
 //!   ξ = F(τ) / F(τ_max)
 //! ```
 //!
@@ -74,9 +74,9 @@
 //!   keeps growing down to `τ ~ 1e-59`, so the first few angles of such
 //!   nodes hold `C(0)` (where `C` is flat): wasted, not wrong.
 //!
-//! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3` were chosen with
+//! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3`, `m = 0` were chosen with
 //! `studies t3-angle-forms` (docs/design/t3-normalised-angle.md). Everything is known at lookup
-//! time. `τ_max`, `u_floor`, `λ`, `Y`, `κ`, `w_h`, `w_e`, `s_e` and `τ_f` are
+//! time. `τ_max`, `u_floor`, `λ`, `Y`, `κ`, `w_h`, `w_e`, `s_e`, `τ_f` and `m` are
 //! stored in the header (`params`), so the file is self-describing.
 //!
 //! # Out of the domain
@@ -172,6 +172,9 @@ pub struct AngleParams {
     /// `τ_f`: the edge term fades out for edges near the horizon, by
     /// `1 / (1 + (tan θe / τ_f)²)`.
     pub edge_fade_tan: f64,
+    /// `m`: the edge term also fades where the kernel is wider than the
+    /// NDF (where `C` has no edge), by `(p′/p)^m` (0: no such fade).
+    pub edge_softening_fade: f64,
 }
 
 impl ConvParams {
@@ -188,6 +191,7 @@ impl ConvParams {
             edge_weight,
             edge_smoothing,
             edge_fade_tan,
+            edge_softening_fade,
         } = *angle;
         ConvParams {
             angles: angles as f64,
@@ -202,6 +206,7 @@ impl ConvParams {
             edge_weight,
             edge_smoothing,
             edge_fade_tan,
+            edge_softening_fade,
         }
     }
 
@@ -217,6 +222,7 @@ impl ConvParams {
             edge_weight: self.edge_weight,
             edge_smoothing: self.edge_smoothing,
             edge_fade_tan: self.edge_fade_tan,
+            edge_softening_fade: self.edge_softening_fade,
         }
     }
 }
@@ -265,6 +271,12 @@ impl<T: Real> AngleShape<T> {
         // The NDF's edge θe, where y = Y: tan θe = β Y^(1/(2p')).
         let tau_edge = beta * math::exp(math::ln(a.ndf_exponent_cap) / (2.0 * p_eff));
         let fade = 1.0 / (1.0 + (tau_edge / a.edge_fade_tan) * (tau_edge / a.edge_fade_tan));
+        // Where the kernel is wider than the NDF, C has no edge: (p'/p)^m.
+        let fade = if a.edge_softening_fade > 0.0 {
+            fade * math::exp(a.edge_softening_fade * math::ln(p_eff / p))
+        } else {
+            fade
+        };
         let delta = a.edge_smoothing / (2.0 * ue);
         let tau_edge = T::of(tau_edge);
         AngleShape {
@@ -439,7 +451,8 @@ impl<'a> ConvTable<'a> {
             && (0.0..1e6).contains(&angle.horizon_weight)
             && (0.0..1e6).contains(&angle.edge_weight)
             && (0.0..1e6).contains(&angle.edge_smoothing)
-            && angle.edge_fade_tan > 0.0;
+            && angle.edge_fade_tan > 0.0
+            && (0.0..1e6).contains(&angle.edge_softening_fade);
         if !valid {
             return Err(FormatError::Shape(
                 "T3 angle parameters must be positive (softening and term weights finite, ≥ 0)",

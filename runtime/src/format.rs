@@ -277,6 +277,9 @@ header_params! {
         edge_smoothing,
         /// `τ_f`: the edge term fades out for edges near the horizon.
         edge_fade_tan,
+        /// `m`: the edge term fades where the kernel is wider than the NDF,
+        /// by `(p′/p)^m` (0 in format version 2 files: no such fade).
+        edge_softening_fade,
     }
 }
 

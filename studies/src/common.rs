@@ -25,7 +25,23 @@ pub fn committed_t3() -> AlignedBuf {
 
 /// The runtime's cell of `x` on axis `d` of [`AXES`] (clamped to the axis).
 pub fn cell(d: usize, x: f64) -> (usize, f32) {
-    Axis::new(&AXES[d]).expect("valid T3 axis").locate(x as f32)
+    cell_on(&AXES[d], x)
+}
+
+/// The runtime's cell of `x` on the axis `header` (clamped to the axis).
+pub fn cell_on(header: &AxisHeader, x: f64) -> (usize, f32) {
+    Axis::new(header).expect("valid T3 axis").locate(x as f32)
+}
+
+/// [`AXES`] with the node counts `nodes` (u, c, β, p; 0 keeps the table's).
+pub fn axes_with_nodes(nodes: [u32; 4]) -> [AxisHeader; 4] {
+    let mut axes = AXES;
+    for (axis, &n) in axes.iter_mut().zip(&nodes) {
+        if n > 0 {
+            axis.nodes = n;
+        }
+    }
+    axes
 }
 
 /// An exact profile: `C` on the nodes of the studies' profile rule, and `C(0)`.
@@ -65,6 +81,24 @@ impl Exact {
             |t| approx[nodes.partition_point(|&x| x < t).min(approx.len() - 1)],
             &self.values,
         )
+    }
+
+    /// Relative energy error `|∫(C̃ − C) sin θh cos θh| / ∫ C sin θh cos θh`
+    /// of values `approx` at the rule's nodes (as `generator verify`).
+    pub fn energy(&self, approx: &[f64]) -> f64 {
+        let (mut diff, mut total) = (0.0, 0.0);
+        for (((&t, &w), &e), &a) in self
+            .rule
+            .nodes
+            .iter()
+            .zip(&self.rule.weights)
+            .zip(&self.values)
+            .zip(approx)
+        {
+            diff += w * t.cos() * (a - e);
+            total += w * t.cos() * e;
+        }
+        (diff / total).abs()
     }
 
     /// Relative errors of `approx` (at the rule's nodes) split into the core

@@ -26,6 +26,16 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use t3_angle::Angle;
 
+/// Which of T3's axes (u, c, β, p) a string names (`u`, `c`, `b`, `p`).
+fn parse_axes(s: &str) -> [bool; 4] {
+    ['u', 'c', 'b', 'p'].map(|key| s.contains(key))
+}
+
+/// Four node counts (u, c, β, p) from `--nodes`.
+fn parse_nodes(v: &[u32]) -> Result<[u32; 4], String> {
+    <[u32; 4]>::try_from(v).map_err(|_| format!("--nodes takes four counts, got {v:?}"))
+}
+
 /// The workspace's materials file.
 const DEFAULT_MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
 
@@ -72,13 +82,28 @@ enum Study {
     /// (u, c exact), against ξ alone: predicts a table's error without
     /// building it (docs/design/t3-normalised-angle.md).
     T3AnglePatch {
-        /// Verify profiles.
+        /// Profiles.
         #[arg(long, default_value_t = 80)]
         profiles: usize,
+        /// Whose parameter points.
+        #[arg(long, value_enum, default_value_t = Distribution::Verify)]
+        distribution: Distribution,
         /// Angles compared (as for t3-angle-forms).
         #[arg(long = "angle", value_parser = Angle::parse,
               default_values = t3_angle::DEFAULT_ANGLES)]
         angles: Vec<Angle>,
+        /// How the corners are combined (repeatable).
+        #[arg(long = "blend", value_enum, default_values = ["xi"])]
+        blends: Vec<t3_angle::Blend>,
+        /// The axes interpolated (others exact): any of `u`, `c`, `b` (β), `p`.
+        #[arg(long, default_value = "bp")]
+        axes: String,
+        /// `ln C̃`'s floor below `ln C̃(0)` for the residual blends.
+        #[arg(long, default_value_t = 30.0)]
+        residual_floor: f64,
+        /// Node counts of the axes u, c, β, p (0: the table's).
+        #[arg(long, value_delimiter = ',', default_value = "0,0,0,0")]
+        nodes: Vec<u32>,
     },
     /// T3's normalised angle at given points (CSV `u,c,beta,p,theta_h`, e.g.
     /// the BRDF check's): exact C and each angle's, as CSV on stdout
@@ -86,9 +111,16 @@ enum Study {
     T3AngleAtPoints {
         /// The points.
         file: PathBuf,
-        /// β and p interpolated too (as t3-angle-patch), not ξ alone.
-        #[arg(long)]
-        patch: bool,
+        /// The axes interpolated as in t3-angle-patch (`u`, `c`, `b`, `p`;
+        /// empty: ξ alone).
+        #[arg(long, default_value = "")]
+        axes: String,
+        /// How the corners are combined (repeatable).
+        #[arg(long = "blend", value_enum, default_values = ["xi"])]
+        blends: Vec<t3_angle::Blend>,
+        /// Node counts of the axes u, c, β, p (0: the table's).
+        #[arg(long, value_delimiter = ',', default_value = "0,0,0,0")]
+        nodes: Vec<u32>,
         /// Angles compared (as for t3-angle-forms).
         #[arg(long = "angle", value_parser = Angle::parse,
               default_values = t3_angle::DEFAULT_ANGLES)]
@@ -206,15 +238,38 @@ fn main() -> ExitCode {
             t3_angle::softening(profiles, angle, &kappas);
             Ok(())
         }
-        Study::T3AnglePatch { profiles, angles } => {
-            t3_angle::patch(profiles, &angles);
-            Ok(())
+        Study::T3AnglePatch {
+            profiles,
+            distribution,
+            angles,
+            blends,
+            axes,
+            residual_floor,
+            nodes,
+        } => {
+            t3_angle::RESIDUAL_FLOOR.get_or_init(|| residual_floor);
+            parse_nodes(&nodes).map(|nodes| {
+                let grid = common::axes_with_nodes(nodes);
+                t3_angle::patch(
+                    profiles,
+                    distribution,
+                    &angles,
+                    &blends,
+                    parse_axes(&axes),
+                    &grid,
+                )
+            })
         }
         Study::T3AngleAtPoints {
             file,
-            patch,
+            axes,
+            blends,
+            nodes,
             angles,
-        } => t3_angle::at_points(&file, &angles, patch),
+        } => parse_nodes(&nodes).and_then(|nodes| {
+            let grid = common::axes_with_nodes(nodes);
+            t3_angle::at_points(&file, &angles, &blends, parse_axes(&axes), &grid)
+        }),
         Study::T3Axis { axis, triples } => {
             t3_axes::run(axis, triples);
             Ok(())

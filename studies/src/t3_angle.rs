@@ -6,12 +6,15 @@
 //! interpolates it as the lookup does (`twoscale::conv::along_xi`; across β
 //! and p with `twoscale::conv::axis_weights`), against exact `C`.
 
-use crate::common::{AXES, Distribution, Exact, exact_c, floored_ln, percentiles, quantile};
+use crate::common::{Distribution, Exact, cell_on, exact_c, floored_ln, percentiles, quantile};
+use generator::reference::conv::{kernel_integral, ndf_integral};
+use generator::reference::epd::{ndf_peak, ndf_sin_cos};
 use generator::tables::t3;
 use rayon::prelude::*;
 use twoscale::conv::{
     AngleParams, along_xi, axis_weights, normalised_angle, tan_of_normalised_angle,
 };
+use twoscale::format::AxisHeader;
 use twoscale::interp::node_value;
 
 /// An angle under test: the runtime's (any constants), or format 1's.
@@ -27,8 +30,9 @@ pub enum Angle {
 
 impl Angle {
     /// Parses `format1` (format 1 with the shipped constants) or
-    /// `w_h,w_e,s_e,τ_f` (the runtime's angle with those weights and the
-    /// shipped constants otherwise; `τ_f = 0`: no fade).
+    /// `w_h,w_e,s_e,τ_f[,m]` (the runtime's angle with those weights and the
+    /// shipped constants otherwise; `τ_f = 0`: no fade; `m` the edge term's
+    /// fade `(p′/p)^m` where the kernel is wider than the NDF, default 0).
     pub fn parse(s: &str) -> Result<Angle, String> {
         if s == "format1" {
             return Ok(Angle::Format1(t3::ANGLE));
@@ -37,14 +41,17 @@ impl Angle {
             .split(',')
             .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{s}: {e}")))
             .collect::<Result<_, _>>()?;
-        let [horizon, edge, smoothing, fade] = v[..] else {
-            return Err(format!("{s}: expected format1 or w_h,w_e,s_e,tau_f"));
+        let (horizon, edge, smoothing, fade, sharp) = match v[..] {
+            [h, e, s, f] => (h, e, s, f, 0.0),
+            [h, e, s, f, m] => (h, e, s, f, m),
+            _ => return Err(format!("{s}: expected format1 or w_h,w_e,s_e,tau_f[,m]")),
         };
         Ok(Angle::Runtime(AngleParams {
             horizon_weight: horizon,
             edge_weight: edge,
             edge_smoothing: smoothing,
             edge_fade_tan: if fade > 0.0 { fade } else { f64::INFINITY },
+            edge_softening_fade: sharp,
             ..t3::ANGLE
         }))
     }
@@ -102,8 +109,13 @@ impl std::fmt::Display for Angle {
             Angle::Format1(a) => write!(f, "format 1 (κ {})", a.ndf_softening),
             Angle::Runtime(a) => write!(
                 f,
-                "w_h {}, w_e {}, s_e {}, τ_f {}, κ {}",
-                a.horizon_weight, a.edge_weight, a.edge_smoothing, a.edge_fade_tan, a.ndf_softening
+                "w_h {}, w_e {}, s_e {}, τ_f {}, m {}, κ {}",
+                a.horizon_weight,
+                a.edge_weight,
+                a.edge_smoothing,
+                a.edge_fade_tan,
+                a.edge_softening_fade,
+                a.ndf_softening
             ),
         }
     }
@@ -133,15 +145,18 @@ pub const DEFAULT_ANGLES: [&str; 5] = [
     "0.5,0.5,2,3",
 ];
 
-/// `ln C` (floored as stored) at the node angles of `angle` for `point`:
-/// one node of a table built with that angle.
-fn node_ln_values(point: [f64; 4], angle: Angle) -> Vec<f64> {
-    let [u, _, beta, p] = point;
+/// The node angles `θ_k` of `angle` at `point` (one node of a table built
+/// with that angle).
+fn node_thetas([u, _, beta, p]: [f64; 4], angle: Angle) -> Vec<f64> {
     let n = t3::ANGLES;
-    let thetas: Vec<f64> = (0..n)
+    (0..n)
         .map(|k| angle.theta(k as f64 / (n - 1) as f64, u, beta, p))
-        .collect();
-    floored_ln(&exact_c(point, &thetas))
+        .collect()
+}
+
+/// `ln C` (floored as stored) at the node angles of `angle` for `point`.
+fn node_ln_values(point: [f64; 4], angle: Angle) -> Vec<f64> {
+    floored_ln(&exact_c(point, &node_thetas(point, angle)))
 }
 
 /// The lookup's cubic along ξ at `θh`, on `ln C` values `window(first)`.
@@ -151,8 +166,18 @@ fn along_angle(
     theta: f64,
     window: impl FnOnce(usize) -> [f32; 4],
 ) -> f64 {
+    ln_along_angle(angle, [u, 0.0, beta, p], theta, window).exp()
+}
+
+/// [`along_angle`] before the exponential: the cubic's `ln C`.
+fn ln_along_angle(
+    angle: Angle,
+    [u, _, beta, p]: [f64; 4],
+    theta: f64,
+    window: impl FnOnce(usize) -> [f32; 4],
+) -> f64 {
     let xi = angle.xi(theta.tan(), u, beta, p);
-    f64::from(along_xi(t3::ANGLES, xi, window)).exp()
+    f64::from(along_xi(t3::ANGLES, xi, window))
 }
 
 /// The four values of `ln_v` from `first` (as the lookup reads a node).
@@ -170,39 +195,213 @@ fn xi_only(point: [f64; 4], angle: Angle, thetas: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// `C` at `thetas` as a table built with `angle` gives it with u and c exact
-/// and β, p interpolated: the lookup's weights over the β, p nodes around
-/// the point (exact profiles at their own node angles), blended at equal ξ,
-/// then the cubic along ξ at the point's own ξ(θh).
-fn beta_p_patch(point: [f64; 4], angle: Angle, thetas: &[f64]) -> Vec<f64> {
-    let [u, c, beta, p] = point;
-    let (b0, nb, wb) = axis_weights(AXES[2].nodes as usize, crate::common::cell(2, beta), true);
-    let (p0, np, wp) = axis_weights(AXES[3].nodes as usize, crate::common::cell(3, p), true);
-    let mut corners = Vec::new();
-    for (i, &w_beta) in wb[..nb].iter().enumerate() {
-        for (j, &w_p) in wp[..np].iter().enumerate() {
-            let node = [
-                u,
-                c,
-                node_value(&AXES[2], b0 + i),
-                node_value(&AXES[3], p0 + j),
-            ];
-            corners.push((f64::from(w_beta * w_p), node_ln_values(node, angle)));
+/// How the corners of a parameter cell are combined at a query angle `θh`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Blend {
+    /// The lookup's (format 2): `ln C` blended at equal ξ, then the cubic
+    /// along ξ at the query's own ξ(θh).
+    Xi,
+    /// Equal θh: each corner's cubic along ξ at its own ξ of the query's θh,
+    /// then the values blended.
+    Theta,
+    /// A residual table: `ln C − ln C̃` (`twoscale::conv::ln_approximation`
+    /// with each node's own parameters) blended at equal ξ, the cubic at the
+    /// query's ξ, plus `ln C̃` with the query's parameters.
+    Residual,
+    /// [`Blend::Residual`] with the corners at equal θh ([`Blend::Theta`]).
+    ResidualTheta,
+}
+
+/// `ln C̃`'s floor below `ln C̃(0)` in [`Blend::Residual`] (default 30).
+pub static RESIDUAL_FLOOR: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+
+/// One corner of a parameter cell: its lookup weight, parameters, node
+/// angles and `ln C` there (floored as stored).
+struct Corner {
+    weight: f64,
+    point: [f64; 4],
+    thetas: Vec<f64>,
+    ln_v: Vec<f64>,
+}
+
+/// The corners around `point` along the axes flagged in `axes` (u, c, β, p;
+/// the others exact) on the axes `grid`, with the lookup's weights; exact profiles at each
+/// corner's own node angles of `angle`. No axis: the point itself (ξ alone).
+fn corners(point: [f64; 4], angle: Angle, axes: [bool; 4], grid: &[AxisHeader; 4]) -> Vec<Corner> {
+    let per_axis: Vec<Vec<(f64, f64)>> = (0..4)
+        .map(|d| {
+            if axes[d] {
+                let (first, count, w) =
+                    axis_weights(grid[d].nodes as usize, cell_on(&grid[d], point[d]), true);
+                (0..count)
+                    .map(|i| (f64::from(w[i]), node_value(&grid[d], first + i)))
+                    .collect()
+            } else {
+                vec![(1.0, point[d])]
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    for &(wu, u) in &per_axis[0] {
+        for &(wc, c) in &per_axis[1] {
+            for &(wb, beta) in &per_axis[2] {
+                for &(wp, p) in &per_axis[3] {
+                    let node = [u, c, beta, p];
+                    let thetas = node_thetas(node, angle);
+                    let ln_v = floored_ln(&exact_c(node, &thetas));
+                    out.push(Corner {
+                        weight: wu * wc * wb * wp,
+                        point: node,
+                        thetas,
+                        ln_v,
+                    });
+                }
+            }
         }
     }
-    thetas
-        .iter()
-        .map(|&t| {
-            along_angle(angle, point, t, |first| {
-                std::array::from_fn(|k| {
-                    corners
-                        .iter()
-                        .map(|(w, ln_v)| w * ln_v[first + k])
-                        .sum::<f64>() as f32
-                })
+    out
+}
+
+/// `ln C̃` of [`Blend::Residual`] at `θh` for `point`: a closed-form stand-in
+/// for `ln C` from the two limits of docs/model.md §2.5 (narrow kernel
+/// `W_K D(θh)`, narrow NDF `W_D k(2u sin θh) cos²θh`), each capped at the
+/// other's peak (a lobe convolved with a wider one cannot exceed the wider
+/// one's peak), `C̃ = h(W_K D, W_D) + h(W_D k cos², W_K D(0))` with
+/// `h(a, b) = ab/(a + b)`, held at or above `ln C̃(0) − RESIDUAL_FLOOR`.
+fn ln_approx([u, c, beta, p]: [f64; 4], theta: f64) -> f64 {
+    let floor = *RESIDUAL_FLOOR.get_or_init(|| 30.0);
+    let wk = kernel_integral(u, c).expect("T3's domain").ln();
+    let wd = ndf_integral(beta, p).expect("T3's domain").ln();
+    let peak = ndf_peak(beta, p);
+    // ln(a + b) and ln(ab/(a + b)) from ln a, ln b (−∞ allowed).
+    let ln_sum = |a: f64, b: f64| {
+        let (hi, lo) = if a > b { (a, b) } else { (b, a) };
+        if hi == f64::NEG_INFINITY {
+            hi
+        } else {
+            hi + (lo - hi).exp().ln_1p()
+        }
+    };
+    let ln_harmonic = |a: f64, b: f64| a + b - ln_sum(a, b);
+    let narrow_peak = wk + peak.ln();
+    let at = |theta: f64| {
+        let (sin, cos) = theta.sin_cos();
+        let narrow = wk + ndf_sin_cos(beta, p, peak, sin, cos).ln();
+        let wide = wd
+            + f64::from(twoscale::conv::kernel((2.0 * u * sin) as f32, c as f32)).ln()
+            + 2.0 * cos.ln();
+        ln_sum(ln_harmonic(narrow, wd), ln_harmonic(wide, narrow_peak))
+    };
+    at(theta).max(at(0.0) - floor)
+}
+
+/// `C` at `theta` from the corners, combined by `blend`, for the query
+/// `point`.
+fn blended(point: [f64; 4], angle: Angle, corners: &[Corner], blend: Blend, theta: f64) -> f64 {
+    let residual = matches!(blend, Blend::Residual | Blend::ResidualTheta);
+    let stored = |k: &Corner| -> Vec<f64> {
+        if residual {
+            k.ln_v
+                .iter()
+                .zip(&k.thetas)
+                .map(|(v, &t)| v - ln_approx(k.point, t))
+                .collect()
+        } else {
+            k.ln_v.clone()
+        }
+    };
+    let values: Vec<(f64, Vec<f64>)> = corners.iter().map(|k| (k.weight, stored(k))).collect();
+    let ln_c = match blend {
+        Blend::Xi | Blend::Residual => ln_along_angle(angle, point, theta, |first| {
+            std::array::from_fn(|j| {
+                values.iter().map(|(w, v)| w * v[first + j]).sum::<f64>() as f32
             })
+        }),
+        Blend::Theta | Blend::ResidualTheta => corners
+            .iter()
+            .zip(&values)
+            .map(|(k, (w, v))| w * ln_along_angle(angle, k.point, theta, |f| window(v, f)))
+            .sum(),
+    };
+    (ln_c
+        + if residual {
+            ln_approx(point, theta)
+        } else {
+            0.0
         })
-        .collect()
+    .exp()
+}
+
+/// ξ-alone and interpolated errors for each angle and blend on `profiles` of
+/// `distribution`'s points (seed 61): e_L2 and core pointwise on the profile
+/// rule. The corners are the nodes around each point along `axes` (u, c, β,
+/// p; the others exact), at their own node angles: predicts a table's error
+/// without building it.
+pub fn patch(
+    profiles: usize,
+    distribution: Distribution,
+    angles: &[Angle],
+    blends: &[Blend],
+    axes: [bool; 4],
+    grid: &[AxisHeader; 4],
+) {
+    let points = distribution.points(profiles, 61);
+    type Row = (Exact, Vec<Vec<[Vec<f64>; 2]>>);
+    let rows: Vec<Row> = points
+        .par_iter()
+        .map(|&pt| {
+            let exact = Exact::new(pt);
+            let per_angle = angles
+                .iter()
+                .map(|&a| {
+                    let alone = corners(pt, a, [false; 4], grid);
+                    let cell = corners(pt, a, axes, grid);
+                    blends
+                        .iter()
+                        .map(|&b| {
+                            let at = |k: &[Corner]| -> Vec<f64> {
+                                exact
+                                    .rule
+                                    .nodes
+                                    .iter()
+                                    .map(|&t| blended(pt, a, k, b, t))
+                                    .collect()
+                            };
+                            [at(&alone), at(&cell)]
+                        })
+                        .collect()
+                })
+                .collect();
+            (exact, per_angle)
+        })
+        .collect();
+    for (k, angle) in angles.iter().enumerate() {
+        for (b, blend) in blends.iter().enumerate() {
+            for (which, name) in ["ξ only", "patch"].iter().enumerate() {
+                let (mut el2, mut core, mut tail, mut energy) = (vec![], vec![], vec![], vec![]);
+                let mut worst = (0.0f64, [0.0; 4]);
+                for (exact, per_angle) in &rows {
+                    let approx = &per_angle[k][b][which];
+                    let e = exact.e_l2(approx);
+                    if e > worst.0 {
+                        worst = (e, exact.point);
+                    }
+                    el2.push(e);
+                    energy.push(exact.energy(approx));
+                    exact.pointwise(approx, &mut core, &mut tail);
+                }
+                println!(
+                    "{angle} {blend:?} {name:6}: e_L2 median/p90/max {} | energy max {} | \
+                     core median/p95/p99/max {} | tail p95 {} | worst e_L2 at {:?}",
+                    percentiles(&mut el2, &[0.5, 0.9, 1.0]),
+                    percentiles(&mut energy, &[1.0]),
+                    percentiles(&mut core, &[0.5, 0.95, 0.99, 1.0]),
+                    percentiles(&mut tail, &[0.95]),
+                    worst.1,
+                );
+            }
+        }
+    }
 }
 
 /// ξ-only errors (e_L2, core and tail pointwise on the profile rule) of
@@ -298,50 +497,17 @@ pub fn forms(profiles: usize, distribution: Distribution, angles: &[Angle]) {
     }
 }
 
-/// ξ alone against β and p interpolated too ([`beta_p_patch`]), for each
-/// angle on `profiles` of verify's profiles (seed 61): e_L2 and core
-/// pointwise. Predicts a table's β, p error without building it.
-pub fn patch(profiles: usize, angles: &[Angle]) {
-    let points = Distribution::Verify.points(profiles, 61);
-    type Row = (Exact, Vec<[Vec<f64>; 2]>);
-    let rows: Vec<Row> = points
-        .par_iter()
-        .map(|&pt| {
-            let exact = Exact::new(pt);
-            let per_angle = angles
-                .iter()
-                .map(|&a| {
-                    [
-                        xi_only(pt, a, &exact.rule.nodes),
-                        beta_p_patch(pt, a, &exact.rule.nodes),
-                    ]
-                })
-                .collect();
-            (exact, per_angle)
-        })
-        .collect();
-    for (k, angle) in angles.iter().enumerate() {
-        for (which, name) in ["ξ only", "β, p patch"].iter().enumerate() {
-            let (mut el2, mut core, mut tail) = (vec![], vec![], vec![]);
-            for (exact, per_angle) in &rows {
-                let approx = &per_angle[k][which];
-                el2.push(exact.e_l2(approx));
-                exact.pointwise(approx, &mut core, &mut tail);
-            }
-            println!(
-                "{angle} {name:10}: e_L2 median/p90/max {} | core median/p95/max {}",
-                percentiles(&mut el2, &[0.5, 0.9, 1.0]),
-                percentiles(&mut core, &[0.5, 0.95, 1.0]),
-            );
-        }
-    }
-}
-
 /// At given points (`u,c,beta,p,theta_h` CSV with a header line, e.g. the
-/// BRDF check's): exact `C`, and per angle `C` from ξ alone (or with β and p
-/// interpolated, `patch`). Writes CSV to stdout and the relative error's
-/// p95 / max per angle to stderr.
-pub fn at_points(path: &std::path::Path, angles: &[Angle], patch: bool) -> Result<(), String> {
+/// BRDF check's): exact `C`, and per angle and blend `C` from the corners
+/// along `axes` (none: ξ alone; see [`patch`]). Writes CSV to stdout and the
+/// relative error's p95 / p99 / max per angle and blend to stderr.
+pub fn at_points(
+    path: &std::path::Path,
+    angles: &[Angle],
+    blends: &[Blend],
+    axes: [bool; 4],
+    grid: &[AxisHeader; 4],
+) -> Result<(), String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let points: Vec<[f64; 5]> = text
         .lines()
@@ -357,30 +523,33 @@ pub fn at_points(path: &std::path::Path, angles: &[Angle], patch: bool) -> Resul
             let pt = [u, c, beta, p];
             let mut out = vec![exact_c(pt, &[theta])[0]];
             for &a in angles {
-                out.push(if patch {
-                    beta_p_patch(pt, a, &[theta])[0]
-                } else {
-                    xi_only(pt, a, &[theta])[0]
-                });
+                let cell = corners(pt, a, axes, grid);
+                for &b in blends {
+                    out.push(blended(pt, a, &cell, b, theta));
+                }
             }
             out
         })
         .collect();
-    let names: Vec<String> = angles.iter().map(|a| format!("\"{a}\"")).collect();
+    let names: Vec<String> = angles
+        .iter()
+        .flat_map(|a| blends.iter().map(move |b| format!("\"{a} {b:?}\"")))
+        .collect();
     println!("exact,{}", names.join(","));
     for r in &rows {
         let cells: Vec<String> = r.iter().map(|x| x.to_string()).collect();
         println!("{}", cells.join(","));
     }
-    for (k, angle) in angles.iter().enumerate() {
+    for (k, name) in names.iter().enumerate() {
         let mut rel: Vec<f64> = rows
             .iter()
             .map(|r| ((r[k + 1] - r[0]) / r[0]).abs())
             .collect();
         eprintln!(
-            "{angle}: {} points, relative error p95 {:.2}%, max {:.2}%",
+            "{name}: {} points, relative error p95 {:.2}%, p99 {:.2}%, max {:.2}%",
             rel.len(),
             100.0 * quantile(&mut rel, 0.95),
+            100.0 * quantile(&mut rel, 0.99),
             100.0 * quantile(&mut rel, 1.0)
         );
     }

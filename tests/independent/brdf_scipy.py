@@ -21,7 +21,9 @@ QUADPACK reliably reaches 1e-8; see conv_scipy.py).
 
 With --against-reference, SciPy is skipped and `table` is measured against the
 generator's own f64 `reference` column (fast, for many points; the reference
-itself is what the default mode checks).
+itself is what the default mode checks). With --c-points, the points' arguments
+of C are printed instead (CSV `u,c,beta,p,theta_h`, the input of
+`studies t3-angle-at-points`).
 
 Exits 1 if `reference` misses 1e-6 relative, or `table` misses 1% at the
 median or 5% at the 95th percentile.
@@ -132,6 +134,18 @@ def main():
                   math.exp(rng.uniform(math.log(0.5), math.log(20))), rng.uniform(1.2, 6),
                   rng.uniform(0.2, 2.5), rng.uniform(0.5, 8), rng.uniform(0.4, 0.7)]
         rows.append(params + direction(rng) + direction(rng))
+    if "--c-points" in sys.argv[1:]:
+        print("u,c,beta,p,theta_h")
+        for r in rows:
+            beta, p, _, b, c, _, _, lam = r[:8]
+            wi, wo = r[8:11], r[11:14]
+            hs = [a + b_ for a, b_ in zip(wi, wo)]
+            ln = math.sqrt(sum(x * x for x in hs))
+            h = [x / ln for x in hs]
+            cos_d = sum(a * b_ for a, b_ in zip(wi, h))
+            theta_h = math.atan2(math.hypot(h[0], h[1]), h[2])
+            print(",".join(repr(x) for x in [b / lam * cos_d, c, beta, p, theta_h]))
+        return
     header = "beta,p,sigma_s,b,c,n,k,lambda,ix,iy,iz,ox,oy,oz"
     csv = header + "\n" + "".join(",".join(repr(x) for x in r) + "\n" for r in rows)
     out = subprocess.run([os.environ.get("GENERATOR", str(ROOT / "target/release/generator")), "query", "brdf"],

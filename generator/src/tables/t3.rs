@@ -137,6 +137,7 @@ pub const ANGLE: AngleParams = AngleParams {
     edge_weight: 0.5,
     edge_smoothing: 2.0,
     edge_fade_tan: 3.0,
+    edge_softening_fade: 0.0,
 };
 
 /// T3a stores `ln(g² + G_OFFSET)`: smooth through `g → 0` (flat profiles).
