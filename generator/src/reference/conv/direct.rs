@@ -284,6 +284,11 @@ fn outer_cuts(theta_h: f64, outer: &Lobe, inner: &Lobe, inner_bp: &[f64]) -> (Ou
     (map, cuts)
 }
 
+/// Fraction of the accurate pass's absolute tolerance that the circles
+/// skipped in [`OuterMap::Kernel`]'s variable may add up to (see
+/// [`nested_pass`]).
+const NEGLIGIBLE: f64 = 1e-3;
+
 /// Spacing of the grid of [`OuterMap::Kernel`]'s variable `s` on which the
 /// outer integral is split: a piece of length 2 has the singularities
 /// `s = ±iπ/2` at 1.6 half-lengths, within reach of G7–K15 at `1e-12`
@@ -532,12 +537,26 @@ fn nested_pass(
     let evaluations = Cell::new(0usize);
     let failure: Cell<Option<QuadError>> = Cell::new(None);
     let inner_tol = Tolerance::new(ring_abs, 0.1 * rel_tol);
+    // Circles whose bound is below `negligible` are skipped (see below).
+    let negligible = match map {
+        OuterMap::Kernel { .. } => NEGLIGIBLE * abs_tol / (cuts[pieces] - cuts[0]),
+        OuterMap::Polar => 0.0,
+    };
     let integrand = |x: f64| -> f64 {
         let (rho, jac) = map.rho(x);
         let (s, c) = rho.sin_cos();
         let fa = outer.value(s, c) * jac;
         if fa == 0.0 {
             return 0.0;
+        }
+        // The kernel decreases away from its axis, so R(ρ) ≤ 2π K(|ρ − θh|):
+        // a circle bounded by `negligible` moves the result by less than
+        // NEGLIGIBLE · abs_tol over the whole outer range.
+        if negligible > 0.0 {
+            let sd = (0.5 * (rho - theta_h)).sin();
+            if fa * s * 2.0 * PI * inner.value_chord2(4.0 * sd * sd) <= negligible {
+                return 0.0;
+            }
         }
         match ring(
             inner,
