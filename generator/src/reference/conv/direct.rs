@@ -286,7 +286,8 @@ fn outer_cuts(theta_h: f64, outer: &Lobe, inner: &Lobe, inner_bp: &[f64]) -> (Ou
 
 /// Fraction of the accurate pass's absolute tolerance that the circles
 /// skipped in [`OuterMap::Kernel`]'s variable may add up to (see
-/// [`nested_pass`]).
+/// [`nested_pass`]), and of a circle's tolerance that the kernel's skipped
+/// arcs may add up to (see [`ring`]).
 const NEGLIGIBLE: f64 = 1e-3;
 
 /// Spacing of the grid of [`OuterMap::Kernel`]'s variable `s` on which the
@@ -396,6 +397,21 @@ impl ArcMap {
                 let rm2 = r * m * m;
                 let e = 4.0 * t2 + rm2;
                 (base + 4.0 * sh * (rm2 / e), jac * (1.0 + t2) / e)
+            }
+        }
+    }
+
+    /// For [`ArcMap::Kernel`], a bound of the arc `[t0, t1]`'s integral:
+    /// the kernel decreases with `ψ`, which decreases with `t`
+    /// (`tan(ψ/2) = √r (1 − t²)/(2t)`), so the integral is at most the
+    /// kernel at `t1` times the arc's length in `ψ`. `None` for the azimuth
+    /// (the NDF is not monotonic).
+    fn arc_bound(&self, inner: &Lobe, t0: f64, t1: f64) -> Option<f64> {
+        match *self {
+            ArcMap::Azimuth { .. } => None,
+            ArcMap::Kernel { r, .. } => {
+                let psi = |t: f64| 2.0 * (r.sqrt() * (1.0 - t * t)).atan2(2.0 * t);
+                Some(inner.value_chord2(self.point(t1).0) * (psi(t0) - psi(t1)))
             }
         }
     }
@@ -627,8 +643,16 @@ fn ring(
         Ring::Arcs { map, cuts } => (map, cuts),
     };
     let g = |t: f64| map.value(inner, t);
+    let arcs = cuts.len() - 1;
     let mut sum = 0.0;
-    for pair in cuts.windows(2) {
+    // Nearest arc first (the kernel's map runs from ψ_max at cuts[0] to
+    // ψ = 0 at 1), so that `sum` can bound what the farther arcs may skip.
+    for pair in cuts.windows(2).rev() {
+        if let Some(bound) = map.arc_bound(inner, pair[0], pair[1]) {
+            if bound * arcs as f64 <= NEGLIGIBLE * tol.abs.max(tol.rel * sum) {
+                continue;
+            }
+        }
         match integrate_with_rule(g, pair[0], pair[1], tol, DEFAULT_MAX_INTERVALS, rule) {
             Ok(est) => {
                 evaluations.set(evaluations.get() + est.evaluations);
