@@ -230,12 +230,14 @@ fn kernel_sc(u: f64, q: f64, sin_gamma: f64, cos_gamma: f64) -> f64 {
 }
 
 /// [`kernel_sc`] given `x² = 4u² sin²γ` and `cos γ`: `(1 + x²)^(−q) cos²γ`,
-/// 0 for `cos γ ≤ 0`.
+/// 0 for `cos γ ≤ 0`. `ln(1 + x²)` rather than `ln_1p(x²)`: rounding
+/// `1 + x²` errs by `≤ 1.1e-16` in the logarithm, `≤ 1.1e-16 q` relative in
+/// the kernel, and `ln` costs about half the instructions of `ln_1p`.
 fn kernel_x2(q: f64, x2: f64, cos_gamma: f64) -> f64 {
     if cos_gamma.is_nan() || cos_gamma <= 0.0 {
         return 0.0;
     }
-    (-q * x2.ln_1p()).exp() * cos_gamma * cos_gamma
+    (-q * (1.0 + x2).ln()).exp() * cos_gamma * cos_gamma
 }
 
 /// One of the two rotationally symmetric lobes of the convolution, as a

@@ -264,23 +264,27 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
 /// the progress bar, so that its ETA is honest although node costs span four
 /// decades). Nodes whose zonal-harmonic band limit ([`zh_band_estimate`]) is
 /// affordable cost little once the lobes' moments are shared; the others take
-/// the direct quadrature at every angle, whose cost grows with the kernel's
-/// narrowness (more breakpoints): measured on a sample of nodes
-/// (`studies t3-node-cost`, docs/design/t3-build-speed.md).
+/// the direct quadrature at every angle, whose lobe evaluations were fitted
+/// on every 7th node (`studies t3-direct-cost --stride 7`, 1 528 direct
+/// nodes with `u > 100`) as `634 000 (u/100)^0.056 β^0.103 p^(−0.358)`
+/// (half the nodes within 0.68–1.44× of it), at ≈ 90 ns per evaluation
+/// (docs/design/t3-build-speed.md §9).
 pub fn node_cost(index: usize) -> u64 {
     let [u, c, beta, p] = node_params(index);
     let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
     if zh_band_estimate(&params) <= ZH_MAX_BAND {
         ZH_NODE_COST
     } else {
-        (DIRECT_NODE_COST * (1.0 + (u / 100.0).max(1.0).ln() / 3.4)) as u64
+        let shape = 0.056 * (u.max(1.0) / 100.0).ln() + 0.103 * beta.ln() - 0.358 * p.ln();
+        (DIRECT_NODE_COST * shape.exp()) as u64
     }
 }
 
 /// [`node_cost`] of a zonal-harmonic node (moments amortised), 0.1 ms units.
 const ZH_NODE_COST: u64 = 20;
-/// [`node_cost`] of a direct-quadrature node at `u = 100`, 0.1 ms units.
-const DIRECT_NODE_COST: f64 = 1000.0;
+/// [`node_cost`] of a direct-quadrature node at `u = 100`, `β = 1`, `p = 1`
+/// (634 000 evaluations at ≈ 90 ns), 0.1 ms units.
+const DIRECT_NODE_COST: f64 = 570.0;
 
 /// Computes the nodes `indices` (in that order), advancing `progress` by
 /// each node's [`node_cost`]; one [`MomentCache`] is shared by all.
