@@ -125,6 +125,9 @@ static inline double {p}_angle_f(double tau, double u, double beta, double p) {{
     double p_eff = p / (1.0 + {u}_NDF_SOFTENING * p / (2.0 * ue * beta));
     double tau_edge = beta * exp(log({u}_NDF_EXPONENT_CAP) / (2.0 * p_eff));
     double fade = 1.0 / (1.0 + (tau_edge / {u}_EDGE_FADE_TAN) * (tau_edge / {u}_EDGE_FADE_TAN));
+    if ({u}_EDGE_SOFTENING_FADE > 0.0) {{
+        fade *= exp({u}_EDGE_SOFTENING_FADE * log(p_eff / p));
+    }}
     double delta = {u}_EDGE_SMOOTHING / (2.0 * ue);
     double secant = sqrt(1.0 + tau * tau);
     double kernel = {p}_asinh_pos(2.0 * ue * tau / secant);

@@ -126,7 +126,10 @@ pub const ANGLES: usize = 32;
 /// and `studies t3-angle-forms`, ξ interpolation alone: at the BRDF check's 400
 /// points p95 4.3% → 0.37%, max 11% → 3.7% against format 1's angle; on
 /// verify's distribution e_L2 max 0.99% → 0.46%, pointwise p95 0.46% →
-/// 0.77%; docs/design/t3-normalised-angle.md).
+/// 0.77%; docs/design/t3-normalised-angle.md), and since format 3 the edge
+/// term faded by `(p′/p)^m`, `m = 2`, where the kernel is wider than the NDF
+/// (patch mode, β and p interpolated: verify's e_L2 max 11% → 3.1%, energy
+/// 23% → 4.3%; docs/design/t3-accuracy-candidates.md).
 pub const ANGLE: AngleParams = AngleParams {
     tau_max: 1e4,
     kernel_scale_floor: 1.0,
@@ -137,7 +140,7 @@ pub const ANGLE: AngleParams = AngleParams {
     edge_weight: 0.5,
     edge_smoothing: 2.0,
     edge_fade_tan: 3.0,
-    edge_softening_fade: 0.0,
+    edge_softening_fade: 2.0,
 };
 
 /// T3a stores `ln(g² + G_OFFSET)`: smooth through `g → 0` (flat profiles).
