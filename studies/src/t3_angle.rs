@@ -135,14 +135,15 @@ fn format1_f(tau: f64, u: f64, beta: f64, p: f64, a: &AngleParams) -> f64 {
 }
 
 /// The angles compared by default: format 1, the horizon term alone, the
-/// edge term unsmoothed, smoothed and faded, and the shipped form
-/// (`½, ½, 2, 3`).
-pub const DEFAULT_ANGLES: [&str; 5] = [
+/// edge term unsmoothed, smoothed and faded, format 2's (`½, ½, 2, 3`) and
+/// the shipped form of format 3 (`½, ½, 2, 3, m = 2`).
+pub const DEFAULT_ANGLES: [&str; 6] = [
     "format1",
     "0.5,0,0,0",
     "0.5,1,0,0",
     "0.5,1,2,3",
     "0.5,0.5,2,3",
+    "0.5,0.5,2,3,2",
 ];
 
 /// The node angles `θ_k` of `angle` at `point` (one node of a table built
