@@ -234,7 +234,7 @@ const ANGLE_CASES: [(f64, f64, f64); 6] = [
 /// The runtime's `F(τ)` against its formula written directly with angles:
 /// kernel term `asinh(2 u_e sin θh)`, horizon term `½ ln(1 + τ²)`, edge term
 /// `asinh(2 u_e sin x̃)` with `x̃` the smoothed positive part of `θh − θe`,
-/// `θe = atan(β Y^(1/(2p')))`, faded by `1 / (1 + (tan θe / τ_f)²)`, NDF
+/// `θe = atan(β Y^(1/(2p')))`, faded by `(p'/p)^m / (1 + (tan θe / τ_f)²)`, NDF
 /// term `ln(1 + Y(1 − e^(−y/Y)))`. (The runtime forms `θh − θe` by one
 /// `atan` of `(τ − τe) / (1 + τ τe)`.)
 #[test]
@@ -247,7 +247,8 @@ fn normalised_angle_matches_its_formula() {
         let y = (tau / beta).powf(2.0 * p_eff);
         let cap = a.ndf_exponent_cap;
         let theta_e = (beta * cap.powf(1.0 / (2.0 * p_eff))).atan();
-        let fade = 1.0 / (1.0 + (theta_e.tan() / a.edge_fade_tan).powi(2));
+        let fade = (p_eff / p).powf(a.edge_softening_fade)
+            / (1.0 + (theta_e.tan() / a.edge_fade_tan).powi(2));
         let x = theta - theta_e;
         let delta = a.edge_smoothing / (2.0 * ue);
         let smoothed =
