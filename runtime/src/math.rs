@@ -69,8 +69,6 @@ forward! {
     atan(x) -> f64 = atan / atan;
     /// arctan x (f32).
     atanf(x) -> f32 = atan / atanf;
-    /// arccos x (f64), NaN outside [−1, 1] (callers clamp).
-    acos(x) -> f64 = acos / acos;
 }
 
 /// ln(1 + x) (f32) from `ln`: `ln(u) x/(u − 1)` with `u = 1 + x` rounded,
