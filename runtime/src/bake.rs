@@ -10,7 +10,7 @@
 //! * [`MaskingBake`]: Smith G1 (T1 at the material's p) on 1025 nodes even in
 //!   `y = a/(1 + a)`, `a = β tan θ`, linear between nodes; `y = 1` is the
 //!   horizon (G1 = 0).
-//! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 36 × 150
+//! * [`ConvBake`]: `ln C(θh; u)` for the material's `(c, β, p)` on 33 × 130
 //!   nodes, `u = B cos θd ∈ [0, B]` even in `log₂(1 + u/u₀) + a u` and θh
 //!   even in `x = ln((1 + sin θh / w(u)) / cos θh)` per row (the logarithms are
 //!   [`math::log2_axis`], a cheap C¹ stand-in), Catmull–Rom in both (edge cells
@@ -37,9 +37,9 @@ const MU_NODES: usize = 257;
 /// Nodes of [`MaskingBake`].
 const MASKING_NODES: usize = 1025;
 /// `u` nodes of [`ConvBake`].
-pub const CONV_U_NODES: usize = 36;
+pub const CONV_U_NODES: usize = 33;
 /// `sin θh` nodes of [`ConvBake`].
-pub const CONV_S_NODES: usize = 150;
+pub const CONV_S_NODES: usize = 130;
 /// [`CONV_U_NODES`] and [`CONV_S_NODES`] with a ghost node at each end.
 const PADDED_U: usize = CONV_U_NODES + 2;
 const PADDED_S: usize = CONV_S_NODES + 2;
@@ -263,6 +263,14 @@ impl RadialNormBake {
             };
         }
         RadialNormBake { inv_m }
+    }
+
+    /// The bake of a spectrum without diffraction (σs = 0 or B = 0): `1/M`
+    /// is 0 everywhere, nothing is sampled from it, and nothing is computed.
+    pub fn none() -> Self {
+        RadialNormBake {
+            inv_m: [0.0f32; RADIAL_NODES],
+        }
     }
 
     /// `1/M` at `sin θi` (clamped to [0, 1]).
@@ -598,7 +606,7 @@ mod tests {
             }
             std::eprintln!("C bake: worst {worst:?}");
             // The grid's interpolation error of T3b's own profile (measured
-            // 0.31% and 0.28%; docs/design/per-material-bake.md).
+            // 0.31% and 0.38%; docs/design/per-material-bake.md).
             assert!(
                 worst.0 < 5e-3,
                 "c {c}, β {beta}, p {p}, B {big_b}: baked C off by {:.2e} at θh {:.3}, u {:.2}",

@@ -275,7 +275,7 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// Construction bakes what depends only on the material and wavelength
 /// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, the sampler's
 /// EPD quantile, and C over `(u, θh)` when the source of C is T3b; module
-/// `bake`), so that `eval` reads small tables. 50 KB (C 23 KB, the
+/// `bake`), so that `eval` reads small tables. 45 KB (C 18 KB, the
 /// direction bake 12 KB, the quantile 8 KB, G1 4 KB, the diffraction
 /// sampler's `1/M` 2 KB; [`Rgb`] three times that); `Clone`, not `Copy`.
 #[derive(Clone)]
@@ -454,7 +454,12 @@ impl<'a> TwoScale<'a> {
                 surface.c,
             ),
             q,
-            radial_norm: RadialNormBake::new(big_b, f64::from(surface.c)),
+            // Read only when there is diffraction (`diffraction_setup`).
+            radial_norm: if sigma_s > 0.0 && big_b > 0.0 {
+                RadialNormBake::new(big_b, f64::from(surface.c))
+            } else {
+                RadialNormBake::none()
+            },
             conv: tables.convolution,
             conv_bake,
             surface,
