@@ -529,9 +529,12 @@ impl ConvBake {
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
         let u = u.max(0.0).min(self.big_b);
+        // 1/cos θh and tan θh do not wait for `w(u)`: only a multiply-add does.
+        let sec_h = 1.0 / cos_h.max(COS_H_MIN as f32);
+        let tan_h = sin_h.max(0.0).min(1.0) * sec_h;
         let x_u = u_axis(u, self.u_linear) * self.u_scale;
         let inv_w = self.inv_width(u);
-        let x_h = (1.0 + sin_h.max(0.0).min(1.0) * inv_w) / cos_h.max(COS_H_MIN as f32);
+        let x_h = sec_h + tan_h * inv_w;
         let x_s = math::log2_axis(x_h) * ((CONV_S_NODES - 1) as f32 / angle_span(inv_w));
         let (ju, wu) = catmull_rom(x_u, CONV_U_NODES);
         let (ks, ws) = catmull_rom(x_s, CONV_S_NODES);

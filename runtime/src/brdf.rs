@@ -567,7 +567,7 @@ impl<'a> TwoScale<'a> {
     /// G(i, o) added to `geometry`.
     fn with_masking(&self, geometry: Geometry) -> Pair {
         let (wi, wo) = (geometry.wi, geometry.wo);
-        let tangential = |w: [f64; 3]| math::sqrt(w[0] * w[0] + w[1] * w[1]) as f32;
+        let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
         let (g1_i, g1_o) = (
             self.masking.g1(tangential(wi), wi[2] as f32),
             self.masking.g1(tangential(wo), wo[2] as f32),
@@ -637,7 +637,8 @@ impl<'a> TwoScale<'a> {
         let (a_spec, one_minus_a_over) = exp_and_one_minus_over(x, sigma_rel_sq);
 
         // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
-        let rho_ct = self.fresnel_at(cells[2]) * d * g / (4.0 * cos_i * cos_o);
+        // D last: the other factors do not wait for its exponentials.
+        let rho_ct = self.fresnel_at(cells[2]) * g / (4.0 * cos_i * cos_o) * d;
         let specular = a_spec * rho_ct;
 
         // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
@@ -831,7 +832,7 @@ impl<'a> TwoScale<'a> {
         } = *geometry;
         match lobe {
             // D(h) cos θh / (4 i·h)
-            Lobe::Specular if cos_d > 0.0 => d * cos_h / (4.0 * cos_d),
+            Lobe::Specular if cos_d > 0.0 => cos_h / (4.0 * cos_d) * d,
             Lobe::Specular => 0.0,
             Lobe::Diffraction => self.diffraction_pdf(wi, wo),
             Lobe::Base => wo[2] / PI,

@@ -80,6 +80,8 @@ impl<'a> Epd<'a> {
             return 0.0;
         }
         let cos_sq = cos_theta * cos_theta;
+        // 1/cos⁴θ alongside the exponentials, not after them.
+        let inv_cos4 = 1.0 / (cos_sq * cos_sq);
         let tan_sq = tan_sq(m);
         // libm's f32 powf and expf: the inlined f64 forms (math::pow_positive,
         // exp_inline) count fewer instructions but ran slower (speed.md).
@@ -94,7 +96,7 @@ impl<'a> Epd<'a> {
             return 0.0;
         }
         // A unit `m` has cos⁴θ ≫ 0 here; a shorter one can underflow it to 0.
-        (self.norm * falloff / (cos_sq * cos_sq)).min(f32::MAX)
+        (self.norm * inv_cos4 * falloff).min(f32::MAX)
     }
 
     /// Smith Λ (HP17 37) of direction `w`, from T1. Normal incidence → 0; at or
