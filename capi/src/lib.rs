@@ -76,7 +76,7 @@ pub struct ts_tables {
     inner: Arc<Tables>,
 }
 
-/// An RGB material built from a `ts_tables`. Opaque; about 100 KB.
+/// An RGB material built from a `ts_tables`. Opaque; about 136 KB.
 pub struct ts_material {
     /// Borrows `_tables` (declared after it, so dropped before it).
     rgb: Rgb<'static>,
@@ -691,7 +691,7 @@ pub unsafe extern "C" fn ts_material_preset(
 
 /// The material `desc` describes. Construction bakes per-material tables
 /// (milliseconds): build once per material, not per evaluation. The model
-/// (~100 KB) is built on the calling thread's stack before it moves to the
+/// (~136 KB) is built on the calling thread's stack before it moves to the
 /// heap, so call `ts_material_*` from a thread whose stack is well above
 /// that. NULL on failure (`TS_ERR_INVALID` names the field).
 ///
