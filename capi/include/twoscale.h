@@ -132,7 +132,7 @@
 #define TS_HALO_INCIDENT 1
 
 /**
- * An RGB material built from a `ts_tables`. Opaque; about 100 KB.
+ * An RGB material built from a `ts_tables`. Opaque; about 136 KB.
  */
 typedef struct ts_material ts_material;
 
@@ -369,7 +369,7 @@ ts_material *ts_material_preset(const ts_tables *t,
 /**
  * The material `desc` describes. Construction bakes per-material tables
  * (milliseconds): build once per material, not per evaluation. The model
- * (~100 KB) is built on the calling thread's stack before it moves to the
+ * (~136 KB) is built on the calling thread's stack before it moves to the
  * heap, so call `ts_material_*` from a thread whose stack is well above
  * that. NULL on failure (`TS_ERR_INVALID` names the field).
  *
