@@ -44,6 +44,41 @@ pub fn axes_with_nodes(nodes: [u32; 4]) -> [AxisHeader; 4] {
     axes
 }
 
+/// [`axes_with_nodes`] with the u axis even in `ln(u + u_offset)`, the c
+/// axis even in `ln(c − 1) + c_linear · c` and the p axis even in
+/// `p^p_power` where given (the nodes' placement).
+pub fn axes_with(
+    nodes: [u32; 4],
+    u_offset: Option<f64>,
+    c_linear: Option<f64>,
+    p_power: Option<f64>,
+) -> [AxisHeader; 4] {
+    let mut axes = axes_with_nodes(nodes);
+    if let Some(power) = p_power {
+        axes[3].param = power;
+    }
+    if let Some(offset) = u_offset {
+        axes[0].param = offset;
+    }
+    if let Some(linear) = c_linear {
+        axes[1].param2 = linear;
+    }
+    axes
+}
+
+/// `u,c,beta,p` points from a CSV file with a header line.
+pub fn read_points(path: &Path) -> Result<Vec<[f64; 4]>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<f64> = l.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            (v.len() >= 4).then(|| [v[0], v[1], v[2], v[3]])
+        })
+        .collect())
+}
+
 /// An exact profile: `C` on the nodes of the studies' profile rule, and `C(0)`.
 pub struct Exact {
     /// `(u, c, β, p)`.

@@ -46,6 +46,41 @@ struct Cli {
     study: Study,
 }
 
+/// A T3 layout for the patch-mode studies: node counts, the u and c axes'
+/// node placement and the normalised angles per node.
+#[derive(clap::Args)]
+struct Layout {
+    /// Node counts of the axes u, c, β, p (0: the table's).
+    #[arg(long, value_delimiter = ',', default_value = "0,0,0,0")]
+    nodes: Vec<u32>,
+    /// The u axis even in `ln(u + OFFSET)` (the table's: 0.1).
+    #[arg(long)]
+    u_offset: Option<f64>,
+    /// The c axis even in `ln(c − 1) + LINEAR · c` (the table's: 0.5).
+    #[arg(long)]
+    c_linear: Option<f64>,
+    /// The p axis even in `p^POWER` (the table's: −0.5; negative).
+    #[arg(long, allow_hyphen_values = true)]
+    p_power: Option<f64>,
+    /// Normalised angles ξ per node (the table's: 32).
+    #[arg(long)]
+    xi: Option<usize>,
+}
+
+impl Layout {
+    /// The parameter axes (and sets [`t3_angle::XI_COUNT`]).
+    fn grid(&self) -> Result<[twoscale::format::AxisHeader; 4], String> {
+        if let Some(n) = self.xi {
+            if n < 4 {
+                return Err(format!("--xi {n}: at least 4"));
+            }
+            t3_angle::XI_COUNT.get_or_init(|| n);
+        }
+        parse_nodes(&self.nodes)
+            .map(|n| common::axes_with(n, self.u_offset, self.c_linear, self.p_power))
+    }
+}
+
 #[derive(Subcommand)]
 enum Study {
     /// T3's normalised angle, ξ alone: each form's error on exact profiles
@@ -101,9 +136,21 @@ enum Study {
         /// `ln C̃`'s floor below `ln C̃(0)` for the residual blends.
         #[arg(long, default_value_t = 30.0)]
         residual_floor: f64,
-        /// Node counts of the axes u, c, β, p (0: the table's).
-        #[arg(long, value_delimiter = ',', default_value = "0,0,0,0")]
-        nodes: Vec<u32>,
+        /// The table's layout.
+        #[command(flatten)]
+        layout: Layout,
+        /// Profiles at these points (CSV `u,c,beta,p` with a header line)
+        /// instead of the distribution's.
+        #[arg(long)]
+        points: Option<PathBuf>,
+        /// Also print each profile's figures.
+        #[arg(long)]
+        per_profile: bool,
+        /// Seed of the distribution's points (2017 with `--distribution
+        /// verify --profiles 160`: `generator verify --table t3 --points
+        /// 80000`'s profiles).
+        #[arg(long, default_value_t = 61)]
+        seed: u64,
     },
     /// T3's normalised angle at given points (CSV `u,c,beta,p,theta_h`, e.g.
     /// the BRDF check's): exact C and each angle's, as CSV on stdout
@@ -118,9 +165,9 @@ enum Study {
         /// How the corners are combined (repeatable).
         #[arg(long = "blend", value_enum, default_values = ["xi"])]
         blends: Vec<t3_angle::Blend>,
-        /// Node counts of the axes u, c, β, p (0: the table's).
-        #[arg(long, value_delimiter = ',', default_value = "0,0,0,0")]
-        nodes: Vec<u32>,
+        /// The table's layout.
+        #[command(flatten)]
+        layout: Layout,
         /// Angles compared (as for t3-angle-forms).
         #[arg(long = "angle", value_parser = Angle::parse,
               default_values = t3_angle::DEFAULT_ANGLES)]
@@ -245,29 +292,36 @@ fn main() -> ExitCode {
             blends,
             axes,
             residual_floor,
-            nodes,
+            layout,
+            points,
+            per_profile,
+            seed,
         } => {
             t3_angle::RESIDUAL_FLOOR.get_or_init(|| residual_floor);
-            parse_nodes(&nodes).map(|nodes| {
-                let grid = common::axes_with_nodes(nodes);
-                t3_angle::patch(
-                    profiles,
-                    distribution,
-                    &angles,
-                    &blends,
-                    parse_axes(&axes),
-                    &grid,
-                )
+            let points = match points {
+                Some(path) => common::read_points(&path),
+                None => Ok(distribution.points(profiles, seed)),
+            };
+            points.and_then(|points| {
+                layout.grid().map(|grid| {
+                    t3_angle::patch(
+                        &points,
+                        &angles,
+                        &blends,
+                        parse_axes(&axes),
+                        &grid,
+                        per_profile,
+                    )
+                })
             })
         }
         Study::T3AngleAtPoints {
             file,
             axes,
             blends,
-            nodes,
+            layout,
             angles,
-        } => parse_nodes(&nodes).and_then(|nodes| {
-            let grid = common::axes_with_nodes(nodes);
+        } => layout.grid().and_then(|grid| {
             t3_angle::at_points(&file, &angles, &blends, parse_axes(&axes), &grid)
         }),
         Study::T3Axis { axis, triples } => {

@@ -146,10 +146,19 @@ pub const DEFAULT_ANGLES: [&str; 6] = [
     "0.5,0.5,2,3,2",
 ];
 
+/// Normalised angles per node in the studies' tables (default
+/// `t3::ANGLES`; `--xi` of t3-angle-patch and t3-angle-at-points).
+pub static XI_COUNT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+
+/// [`XI_COUNT`], or `t3::ANGLES` when unset.
+fn xi_count() -> usize {
+    *XI_COUNT.get_or_init(|| t3::ANGLES)
+}
+
 /// The node angles `θ_k` of `angle` at `point` (one node of a table built
 /// with that angle).
 fn node_thetas([u, _, beta, p]: [f64; 4], angle: Angle) -> Vec<f64> {
-    let n = t3::ANGLES;
+    let n = xi_count();
     (0..n)
         .map(|k| angle.theta(k as f64 / (n - 1) as f64, u, beta, p))
         .collect()
@@ -178,7 +187,7 @@ fn ln_along_angle(
     window: impl FnOnce(usize) -> [f32; 4],
 ) -> f64 {
     let xi = angle.xi(theta.tan(), u, beta, p);
-    f64::from(along_xi(t3::ANGLES, xi, window))
+    f64::from(along_xi(xi_count(), xi, window))
 }
 
 /// The four values of `ln_v` from `first` (as the lookup reads a node).
@@ -333,20 +342,20 @@ fn blended(point: [f64; 4], angle: Angle, corners: &[Corner], blend: Blend, thet
     .exp()
 }
 
-/// ξ-alone and interpolated errors for each angle and blend on `profiles` of
-/// `distribution`'s points (seed 61): e_L2 and core pointwise on the profile
-/// rule. The corners are the nodes around each point along `axes` (u, c, β,
-/// p; the others exact), at their own node angles: predicts a table's error
-/// without building it.
+/// ξ-alone and interpolated errors for each angle and blend on `points`
+/// (e.g. `profiles` of a distribution's, seed 61): e_L2 and core pointwise on
+/// the profile rule. The corners are the nodes around each point along `axes`
+/// (u, c, β, p; the others exact), at their own node angles: predicts a
+/// table's error without building it. `per_profile`: also each point's
+/// figures.
 pub fn patch(
-    profiles: usize,
-    distribution: Distribution,
+    points: &[[f64; 4]],
     angles: &[Angle],
     blends: &[Blend],
     axes: [bool; 4],
     grid: &[AxisHeader; 4],
+    per_profile: bool,
 ) {
-    let points = distribution.points(profiles, 61);
     type Row = (Exact, Vec<Vec<[Vec<f64>; 2]>>);
     let rows: Vec<Row> = points
         .par_iter()
@@ -381,24 +390,42 @@ pub fn patch(
             for (which, name) in ["ξ only", "patch"].iter().enumerate() {
                 let (mut el2, mut core, mut tail, mut energy) = (vec![], vec![], vec![], vec![]);
                 let mut worst = (0.0f64, [0.0; 4]);
+                let mut worst_energy = (0.0f64, [0.0; 4]);
                 for (exact, per_angle) in &rows {
                     let approx = &per_angle[k][b][which];
                     let e = exact.e_l2(approx);
                     if e > worst.0 {
                         worst = (e, exact.point);
                     }
+                    let en = exact.energy(approx);
+                    if en > worst_energy.0 {
+                        worst_energy = (en, exact.point);
+                    }
                     el2.push(e);
-                    energy.push(exact.energy(approx));
-                    exact.pointwise(approx, &mut core, &mut tail);
+                    energy.push(en);
+                    let (mut c, mut t) = (vec![], vec![]);
+                    exact.pointwise(approx, &mut c, &mut t);
+                    if per_profile && which == 1 {
+                        println!(
+                            "  {:?}: e_L2 {:.2}% energy {:.2}% core p95/max {}",
+                            exact.point,
+                            100.0 * e,
+                            100.0 * en,
+                            percentiles(&mut c, &[0.95, 1.0])
+                        );
+                    }
+                    core.extend(c);
+                    tail.extend(t);
                 }
                 println!(
-                    "{angle} {blend:?} {name:6}: e_L2 median/p90/max {} | energy max {} | \
-                     core median/p95/p99/max {} | tail p95 {} | worst e_L2 at {:?}",
+                    "{angle} {blend:?} {name:6}: e_L2 median/p90/max {} | energy p90/max {} | \
+                     core median/p95/p99/max {} | tail p95 {} | worst e_L2 at {:?}, energy at {:?}",
                     percentiles(&mut el2, &[0.5, 0.9, 1.0]),
-                    percentiles(&mut energy, &[1.0]),
+                    percentiles(&mut energy, &[0.9, 1.0]),
                     percentiles(&mut core, &[0.5, 0.95, 0.99, 1.0]),
                     percentiles(&mut tail, &[0.95]),
                     worst.1,
+                    worst_energy.1,
                 );
             }
         }
