@@ -360,6 +360,8 @@ impl OuterMap {
 }
 
 /// The circle of polar radius `ρ` around `A` as seen by the inner lobe.
+// Large on purpose: the kernel's cuts live on the stack (see `Cuts`).
+#[allow(clippy::large_enum_variant)]
 enum Ring {
     /// Entirely beyond the horizon of `B`.
     Empty,
@@ -380,6 +382,8 @@ const INLINE_CUTS: usize = 32;
 /// The ascending cuts of a [`Ring`]: the kernel's on the stack (one circle
 /// is ≈ 50 lobe evaluations, and an allocation per circle cost ≈ 4% of the
 /// instructions), the NDF's on the heap.
+// Large on purpose: no allocation per circle.
+#[allow(clippy::large_enum_variant)]
 enum Cuts {
     /// `t[..len]`.
     Inline { t: [f64; INLINE_CUTS], len: usize },
