@@ -215,6 +215,11 @@ enum Study {
         /// Time every `stride`-th node.
         #[arg(long, default_value_t = 61)]
         stride: usize,
+        /// Only the nodes that the build tries by zonal harmonics (with
+        /// `--stride 1`: the zonal-harmonic part of the whole build, moments
+        /// shared as in the build).
+        #[arg(long)]
+        zh_only: bool,
     },
     /// The T3 build's direct quadrature: lobe evaluations and time of every
     /// `stride`-th direct node, all angles; saves or compares the values
@@ -341,8 +346,8 @@ fn main() -> ExitCode {
             t3_interp::spline(profiles, seed, distribution, &snap);
             Ok(())
         }
-        Study::T3NodeCost { stride } => {
-            t3_node_cost::run(stride);
+        Study::T3NodeCost { stride, zh_only } => {
+            t3_node_cost::run(stride, zh_only);
             Ok(())
         }
         Study::T3DirectCost {

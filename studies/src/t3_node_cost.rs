@@ -3,15 +3,20 @@
 //! `stride`-th node; 61 is coprime with every axis length, so the sample
 //! spreads over all four axes) and prints one CSV row per node, then the
 //! totals by method and by u node, extrapolated to the whole grid (×stride).
-//! One thread (the per-node CPU time is what the figures are about).
+//! One thread (the per-node CPU time is what the figures are about). With
+//! `zh_only`, only the nodes that the build tries by zonal harmonics
+//! (`zh_band_estimate ≤ ZH_MAX_BAND`).
 
-use generator::reference::conv::{Method, MomentCache, convolution_profile_cached};
+use generator::reference::conv::{
+    Method, MomentCache, Params, ZH_MAX_BAND, convolution_profile_cached, zh_band_estimate,
+};
 use generator::tables::t3::{angle_rule, fit_paper_form, node_params};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-/// Times every `stride`-th node; CSV rows on stdout, totals on stderr.
-pub fn run(stride: usize) {
+/// Times every `stride`-th node (only the zonal-harmonic ones with
+/// `zh_only`); CSV rows on stdout, totals on stderr.
+pub fn run(stride: usize, zh_only: bool) {
     let stride = stride.max(1);
     let total = 28 * 10 * 12 * 12;
     println!("index,u,c,beta,p,method,band,profile_s,fit_s");
@@ -23,6 +28,10 @@ pub fn run(stride: usize) {
     let cache = MomentCache::new();
     for index in (0..total).step_by(stride) {
         let [u, c, beta, p] = node_params(index);
+        let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
+        if zh_only && zh_band_estimate(&params) > ZH_MAX_BAND {
+            continue;
+        }
         let (thetas, weights) = angle_rule(u, beta, p);
         let start = Instant::now();
         let (values, method) =

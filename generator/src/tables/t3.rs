@@ -270,8 +270,8 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
 /// the direct quadrature at every angle, whose lobe evaluations were fitted
 /// on every 7th node (`studies t3-direct-cost --stride 7`, 1 528 direct
 /// nodes with `u > 100`) as `634 000 (u/100)^0.056 β^0.103 p^(−0.358)`
-/// (half the nodes within 0.68–1.44× of it), at ≈ 90 ns per evaluation
-/// (docs/design/t3-build-speed.md §9).
+/// (half the nodes within 0.68–1.44× of it), at ≈ 76 ns per evaluation
+/// (docs/design/t3-build-speed.md §9, §10).
 pub fn node_cost(index: usize) -> u64 {
     let [u, c, beta, p] = node_params(index);
     let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
@@ -286,8 +286,9 @@ pub fn node_cost(index: usize) -> u64 {
 /// [`node_cost`] of a zonal-harmonic node (moments amortised), 0.1 ms units.
 const ZH_NODE_COST: u64 = 20;
 /// [`node_cost`] of a direct-quadrature node at `u = 100`, `β = 1`, `p = 1`
-/// (634 000 evaluations at ≈ 90 ns), 0.1 ms units.
-const DIRECT_NODE_COST: f64 = 570.0;
+/// (634 000 evaluations at ≈ 76 ns: §9's 90 ns × 0.84, the CPU time of the
+/// direct quadrature after §10), 0.1 ms units.
+const DIRECT_NODE_COST: f64 = 480.0;
 
 /// Computes the nodes `indices` (results in that order), advancing
 /// `progress` by each node's [`node_cost`]; one [`MomentCache`] is shared by
