@@ -575,17 +575,7 @@ mod tests {
     use super::*;
     use crate::TableSet;
 
-    /// A small deterministic generator of uniforms in [0, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::test_rng::Lcg;
 
     /// The C bake against the slice it samples, at 2000 random (θh, u).
     #[test]
@@ -620,9 +610,8 @@ mod tests {
         }
     }
 
-    /// The tabulated EPD quantile against the sampler's Newton solve
-    /// (`Epd::sample_tan_theta`) over p ∈ [0.2, 5] and u₀ from 1e-30 to
-    /// [`BELOW_ONE`].
+    /// The baked `1/M` against its closed form (HP17 52) over B ∈ [1e-3, 1e3],
+    /// c ∈ [1, 10] and sin θi ∈ [0, 1).
     #[test]
     fn radial_norm_matches_the_closed_form() {
         let mut rng = Lcg(5);
@@ -652,6 +641,9 @@ mod tests {
         assert!(worst.0 < 5e-6, "{worst:?}");
     }
 
+    /// The tabulated EPD quantile against the sampler's Newton solve
+    /// (`Epd::sample_tan_theta`) over p ∈ [0.2, 5] and u₀ from 1e-30 to
+    /// [`BELOW_ONE`].
     #[test]
     fn slope_quantile_matches_the_solved_quantile() {
         let set = TableSet::embedded();

@@ -1317,13 +1317,8 @@ mod tests {
     /// (34 values, offsets up to ±50, ranges from 2% of the magnitude to 50).
     #[test]
     fn quantise_node_is_idempotent() {
-        let mut state = 3u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::test_rng::Lcg(3);
+        let mut next = || rng.next();
         for _ in 0..20_000 {
             let lo = 100.0 * next() - 50.0;
             // Codes round-trip where the step exceeds the f32 spacing of the

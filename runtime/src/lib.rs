@@ -31,6 +31,8 @@ pub mod mmap;
 pub mod sh;
 pub mod smith;
 pub mod table_set;
+#[cfg(test)]
+mod test_rng;
 
 pub use brdf::{Rgb, TwoScale};
 pub use conv::{ConvFitTable, ConvTable, Convolution};

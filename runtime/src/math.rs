@@ -384,13 +384,8 @@ mod tests {
     /// `exp_inline` over their ranges.
     #[test]
     fn pow_positive_matches_pow() {
-        let mut state = 1u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::test_rng::Lcg(1);
+        let mut next = || rng.next();
         let mut worst = 0.0f64;
         for k in 0..200_000 {
             let x = if k % 4 == 0 {
@@ -468,7 +463,7 @@ mod tests {
         (f64::from(got) - exact).abs() / ulp
     }
 
-    /// `ln_1pf_via_ln` against f64 over f32's range.
+    /// `acos_approx` against `acos` on 200 001 points of [−1, 1].
     #[test]
     fn acos_approx_is_within_its_bound() {
         let mut worst = (0.0f64, 0.0f64);
@@ -484,6 +479,7 @@ mod tests {
         assert_eq!(acos_approx(1.0), 0.0);
     }
 
+    /// `ln_1pf_via_ln` against f64 over f32's range.
     #[test]
     fn ln_1pf_via_ln_is_within_a_few_ulp() {
         let mut worst_1p = (0.0f64, 0.0f32);

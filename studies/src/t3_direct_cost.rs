@@ -7,10 +7,8 @@
 //! (same stride): the agreement of a changed quadrature with the old one on
 //! real T3 nodes, every angle.
 
-use generator::reference::conv::{
-    DirectOptions, Params, ZH_MAX_BAND, convolution_direct, zh_band_estimate,
-};
-use generator::tables::t3::{angle_rule, node_params};
+use generator::reference::conv::{DirectOptions, convolution_direct};
+use generator::tables::t3::{angle_rule, node_count, node_params, node_tries_zonal_harmonics};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
@@ -21,14 +19,9 @@ type NodeRun = (usize, usize, f64, Vec<f64>);
 /// Runs the sample (see the module documentation).
 pub fn run(stride: usize, save: Option<&Path>, compare: Option<&Path>) -> Result<(), String> {
     let stride = stride.max(1);
-    let total = 28 * 10 * 12 * 12;
-    let nodes: Vec<usize> = (0..total)
+    let nodes: Vec<usize> = (0..node_count())
         .step_by(stride)
-        .filter(|&i| {
-            let [u, c, beta, p] = node_params(i);
-            let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
-            zh_band_estimate(&params) > ZH_MAX_BAND
-        })
+        .filter(|&i| !node_tries_zonal_harmonics(i))
         .collect();
     let opts = DirectOptions::default();
     let start = Instant::now();

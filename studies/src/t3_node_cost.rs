@@ -5,12 +5,12 @@
 //! totals by method and by u node, extrapolated to the whole grid (×stride).
 //! One thread (the per-node CPU time is what the figures are about). With
 //! `zh_only`, only the nodes that the build tries by zonal harmonics
-//! (`zh_band_estimate ≤ ZH_MAX_BAND`).
+//! (`t3::node_tries_zonal_harmonics`).
 
-use generator::reference::conv::{
-    Method, MomentCache, Params, ZH_MAX_BAND, convolution_profile_cached, zh_band_estimate,
+use generator::reference::conv::{Method, MomentCache, convolution_profile_cached};
+use generator::tables::t3::{
+    angle_rule, fit_paper_form, node_count, node_params, node_tries_zonal_harmonics,
 };
-use generator::tables::t3::{angle_rule, fit_paper_form, node_params};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -18,7 +18,7 @@ use std::time::Instant;
 /// `zh_only`); CSV rows on stdout, totals on stderr.
 pub fn run(stride: usize, zh_only: bool) {
     let stride = stride.max(1);
-    let total = 28 * 10 * 12 * 12;
+    let total = node_count();
     println!("index,u,c,beta,p,method,band,profile_s,fit_s");
     let mut by_method: BTreeMap<String, (usize, f64)> = BTreeMap::new();
     let mut by_u: BTreeMap<u64, (usize, f64)> = BTreeMap::new();
@@ -27,11 +27,10 @@ pub fn run(stride: usize, zh_only: bool) {
     // whole grid, so the zonal-harmonic figures are upper bounds.
     let cache = MomentCache::new();
     for index in (0..total).step_by(stride) {
-        let [u, c, beta, p] = node_params(index);
-        let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
-        if zh_only && zh_band_estimate(&params) > ZH_MAX_BAND {
+        if zh_only && !node_tries_zonal_harmonics(index) {
             continue;
         }
+        let [u, c, beta, p] = node_params(index);
         let (thetas, weights) = angle_rule(u, beta, p);
         let start = Instant::now();
         let (values, method) =

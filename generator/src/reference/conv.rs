@@ -442,6 +442,13 @@ pub fn convolution_profile_with_method(
     convolution_profile_cached(u, c, beta, p, theta_h, &MomentCache::new())
 }
 
+/// Whether [`convolution_profile_cached`] tries zonal harmonics first at
+/// `params`: the estimated band limit ([`zh_band_estimate`]) is at most
+/// [`ZH_MAX_BAND`]. Otherwise the direct quadrature is used at once.
+pub fn tries_zonal_harmonics(params: &Params) -> bool {
+    zh_band_estimate(params) <= ZH_MAX_BAND
+}
+
 /// [`convolution_profile_with_method`] taking the zonal-harmonic moments
 /// from `cache`, for many profiles that share lobes (the T3 grid): the
 /// results are bit-identical to the uncached ones (see [`MomentCache`]).
@@ -457,7 +464,7 @@ pub fn convolution_profile_cached(
     for &t in theta_h {
         Params::validate_theta(t)?;
     }
-    if zh_band_estimate(&params) <= ZH_MAX_BAND {
+    if tries_zonal_harmonics(&params) {
         let opts = ZhOptions {
             max_band: ZH_MAX_BAND,
             ..ZhOptions::default()

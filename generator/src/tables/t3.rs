@@ -60,8 +60,8 @@ use twoscale::{Table, TableId};
 use super::{Accuracy, BuildError, GENERATOR_VERSION, SpotCheck, TableKind};
 use crate::fit::{WidthFitOptions, fit_k_lobe};
 use crate::reference::conv::{
-    ConvError, MomentCache, Params, ProfileRule, ZH_MAX_BAND, convolution_profile,
-    convolution_profile_cached, zh_band_estimate,
+    ConvError, MomentCache, Params, ProfileRule, convolution_profile, convolution_profile_cached,
+    tries_zonal_harmonics,
 };
 use crate::rng::SplitMix64;
 
@@ -161,7 +161,8 @@ pub struct Conv;
 
 const AXES: [AxisHeader; 4] = [U_AXIS, C_AXIS, BETA_AXIS, P_AXIS];
 
-fn node_count() -> usize {
+/// The number of T3's nodes (the product of the axes' node counts).
+pub fn node_count() -> usize {
     AXES.iter().map(|a| a.nodes as usize).product()
 }
 
@@ -265,22 +266,28 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
 
 /// Estimated cost of node `index`, in units of 0.1 ms of CPU (the weights of
 /// the progress bar, so that its ETA is honest although node costs span four
-/// decades). Nodes whose zonal-harmonic band limit ([`zh_band_estimate`]) is
-/// affordable cost little once the lobes' moments are shared; the others take
+/// decades). Nodes tried by zonal harmonics ([`node_tries_zonal_harmonics`])
+/// cost little once the lobes' moments are shared; the others take
 /// the direct quadrature at every angle, whose lobe evaluations were fitted
 /// on every 7th node (`studies t3-direct-cost --stride 7`, 1 528 direct
 /// nodes with `u > 100`) as `634 000 (u/100)^0.056 β^0.103 p^(−0.358)`
 /// (half the nodes within 0.68–1.44× of it), at ≈ 76 ns per evaluation
 /// (docs/design/t3-build-speed.md §9, §10).
 pub fn node_cost(index: usize) -> u64 {
-    let [u, c, beta, p] = node_params(index);
-    let params = Params::new(u, c, beta, p).expect("grid nodes are valid");
-    if zh_band_estimate(&params) <= ZH_MAX_BAND {
+    let [u, _, beta, p] = node_params(index);
+    if node_tries_zonal_harmonics(index) {
         ZH_NODE_COST
     } else {
         let shape = 0.056 * (u.max(1.0) / 100.0).ln() + 0.103 * beta.ln() - 0.358 * p.ln();
         (DIRECT_NODE_COST * shape.exp()) as u64
     }
+}
+
+/// Whether node `index` is tried by zonal harmonics first
+/// ([`tries_zonal_harmonics`]); otherwise it takes the direct quadrature.
+pub fn node_tries_zonal_harmonics(index: usize) -> bool {
+    let [u, c, beta, p] = node_params(index);
+    tries_zonal_harmonics(&Params::new(u, c, beta, p).expect("grid nodes are valid"))
 }
 
 /// [`node_cost`] of a zonal-harmonic node (moments amortised), 0.1 ms units.
