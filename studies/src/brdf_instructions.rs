@@ -31,6 +31,46 @@ pub const OPERATIONS: [&str; 10] = [
     "construct-rgb",
 ];
 
+/// One of [`OPERATIONS`], resolved once so that the timed loop matches on
+/// an enum rather than comparing strings per call.
+#[derive(Clone, Copy)]
+enum Operation {
+    GgxEval,
+    GgxEvalRgb,
+    GgxSampleEval,
+    Eval,
+    EvalT3a,
+    EvalRgb,
+    Pdf,
+    Sample,
+    Construct,
+    ConstructRgb,
+}
+
+impl Operation {
+    /// The operation named `name`, or an error listing [`OPERATIONS`].
+    fn named(name: &str) -> Result<Self, String> {
+        Ok(match name {
+            "ggx-eval" => Operation::GgxEval,
+            "ggx-eval-rgb" => Operation::GgxEvalRgb,
+            "ggx-sample-eval" => Operation::GgxSampleEval,
+            "eval" => Operation::Eval,
+            "eval-t3a" => Operation::EvalT3a,
+            "eval-rgb" => Operation::EvalRgb,
+            "pdf" => Operation::Pdf,
+            "sample" => Operation::Sample,
+            "construct" => Operation::Construct,
+            "construct-rgb" => Operation::ConstructRgb,
+            other => {
+                return Err(format!(
+                    "unknown operation {other}; one of {}",
+                    OPERATIONS.join(", ")
+                ));
+            }
+        })
+    }
+}
+
 /// The models and inputs every operation runs on (the same set-up for every
 /// operation and count).
 pub struct Workload<'a> {
@@ -65,43 +105,38 @@ impl<'a> Workload<'a> {
         let n = inputs.pairs.len();
         let (set, model, model_fit, ggx, rgb) =
             (self.set, &self.model, &self.model_fit, &self.ggx, &self.rgb);
+        let operation = Operation::named(operation)?;
         let mut sum = 0.0f32;
         for k in start..start + calls {
             let (i, o) = inputs.pairs[k % n];
             let (iu, u) = inputs.uniforms[k % n];
             sum += match operation {
-                "ggx-eval" => ggx.eval(black_box(i), black_box(o)),
-                "ggx-eval-rgb" => ggx.eval_rgb(&self.rgb_eta, black_box(i), black_box(o))[1],
-                "ggx-sample-eval" => ggx
+                Operation::GgxEval => ggx.eval(black_box(i), black_box(o)),
+                Operation::GgxEvalRgb => ggx.eval_rgb(&self.rgb_eta, black_box(i), black_box(o))[1],
+                Operation::GgxSampleEval => ggx
                     .sample_eval(black_box(iu), [u[1], u[2]])
                     .map_or(0.0, |(_, pdf, value)| value / pdf),
-                "eval" => model.eval(black_box(i), black_box(o)),
-                "eval-t3a" => model_fit.eval(black_box(i), black_box(o)),
-                "eval-rgb" => rgb.eval(black_box(i), black_box(o))[1],
-                "pdf" => model.pdf(black_box(i), black_box(o)),
-                "sample" => model
+                Operation::Eval => model.eval(black_box(i), black_box(o)),
+                Operation::EvalT3a => model_fit.eval(black_box(i), black_box(o)),
+                Operation::EvalRgb => rgb.eval(black_box(i), black_box(o))[1],
+                Operation::Pdf => model.pdf(black_box(i), black_box(o)),
+                Operation::Sample => model
                     .sample(black_box(iu), black_box(u))
                     .map_or(0.0, |s| s.value / s.pdf),
                 // One wavelength's model per call (as criterion's `two_scale_new`).
-                "construct" => TwoScale::conductor(
+                Operation::Construct => TwoScale::conductor(
                     &set.brdf_tables(),
                     black_box(HP17_NICKEL_SURFACE),
                     cost::LAMBDA,
                     cost::NICKEL_LIKE,
                 )
                 .eval(i, o),
-                "construct-rgb" => Rgb::new(
+                Operation::ConstructRgb => Rgb::new(
                     &set.brdf_tables(),
                     black_box(&PRESETS[0].1),
                     Options::default(),
                 )
                 .eval(i, o)[1],
-                other => {
-                    return Err(format!(
-                        "unknown operation {other}; one of {}",
-                        OPERATIONS.join(", ")
-                    ));
-                }
             };
         }
         Ok(black_box(sum))
