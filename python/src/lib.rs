@@ -1,6 +1,6 @@
 //! Python bindings of the two-scale BRDF: the RGB model of a material over
 //! NumPy arrays of directions, the table lookups (T1 G1, T2 σrel/σs, T3 C),
-//! and the f64 reference of each quantity (`generator::reference`).
+//! and the f64 reference of each quantity (`twoscale_reference::reference`).
 //!
 //! Conventions are the runtime's (`twoscale::brdf`): unit vectors in the
 //! local frame (normal `+z`), `wi` towards the light, `wo` towards the
@@ -13,8 +13,8 @@
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
-use generator::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
-use generator::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
+use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
+use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -398,7 +398,7 @@ impl Material {
     }
 
     /// The f64 reference ρ(wi, wo) per channel (exact Λ, σrel, C;
-    /// `generator::reference::brdf`), for conductors without a Lambertian
+    /// `twoscale_reference::reference::brdf`), for conductors without a Lambertian
     /// term: (N, 3) float64. Costs 1–30 ms per row and channel.
     fn eval_reference<'py>(
         &self,

@@ -1,8 +1,8 @@
 //! What the T3 studies share: exact profiles, the committed table, the two
 //! parameter distributions, and error summaries.
 
-use generator::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
-use generator::rng::SplitMix64;
+use twoscale_reference::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
+use twoscale_reference::rng::SplitMix64;
 use generator::tables::t3;
 use generator::tables::t4::WORKSPACE_TABLES;
 use std::path::Path;

@@ -7,7 +7,7 @@
 //! (same stride): the agreement of a changed quadrature with the old one on
 //! real T3 nodes, every angle.
 
-use generator::reference::conv::{DirectOptions, convolution_direct};
+use twoscale_reference::reference::conv::{DirectOptions, convolution_direct};
 use generator::tables::t3::{angle_rule, node_count, node_params, node_tries_zonal_harmonics};
 use rayon::prelude::*;
 use std::path::Path;

@@ -7,7 +7,7 @@
 //! `zh_only`, only the nodes that the build tries by zonal harmonics
 //! (`t3::node_tries_zonal_harmonics`).
 
-use generator::reference::conv::{Method, MomentCache, convolution_profile_cached};
+use twoscale_reference::reference::conv::{Method, MomentCache, convolution_profile_cached};
 use generator::tables::t3::{
     angle_rule, fit_paper_form, node_count, node_params, node_tries_zonal_harmonics,
 };
