@@ -23,11 +23,10 @@ use twoscale::brdf::{
     BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, Options, RGB_WAVELENGTHS, Rgb,
     SigmaRelMode, Surface,
 };
-use twoscale::format::{AlignedBuf, aligned_copy};
+use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
-use twoscale::mmap::MappedFile;
 use twoscale::table_set::TABLES;
-use twoscale::{Complex, TableBytes, TableSet, TableSetError};
+use twoscale::{Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
 
 /// Success.
 pub const TS_OK: c_int = 0;
@@ -73,14 +72,14 @@ pub const TS_HALO_INCIDENT: i32 = 1;
 
 /// A validated set of the four tables (T1, T2, T3, T5). Opaque.
 pub struct ts_tables {
-    inner: Arc<Tables>,
+    inner: Arc<OwnedTableSet>,
 }
 
 /// An RGB material built from a `ts_tables`. Opaque; about 136 KB.
 pub struct ts_material {
     /// Borrows `_tables` (declared after it, so dropped before it).
     rgb: Rgb<'static>,
-    _tables: Arc<Tables>,
+    _tables: Arc<OwnedTableSet>,
 }
 
 /// The bytes of the four table files, for `ts_tables_from_bytes`.
@@ -155,63 +154,6 @@ pub struct ts_sample {
     pub pdf: f32,
     /// ρ(wi, wo) per channel, as `ts_eval_rgb`.
     pub value: [f32; 3],
-}
-
-/// Where a handle's table bytes live; the set borrows them.
-enum Storage {
-    Copied(AlignedBuf),
-    Mapped(MappedFile),
-}
-
-impl Storage {
-    fn bytes(&self) -> &[u8] {
-        match self {
-            Storage::Copied(buf) => buf.bytes(),
-            Storage::Mapped(map) => map.bytes(),
-        }
-    }
-}
-
-/// A table set and the storage it borrows.
-struct Tables {
-    /// Borrows `_storage` (declared after it, so dropped before it), or the
-    /// embedded tables (truly `'static`).
-    set: TableSet<'static>,
-    _storage: Vec<Storage>,
-}
-
-impl Tables {
-    fn embedded() -> Result<Tables, TableSetError> {
-        Ok(Tables {
-            set: TableSet::from_bytes(TableSet::embedded_bytes())?,
-            _storage: Vec::new(),
-        })
-    }
-
-    /// Validates the four files held by `storage` (in the order of `TABLES`).
-    fn from_storage(storage: Vec<Storage>) -> Result<Tables, TableSetError> {
-        let bytes = |k: usize| -> &'static [u8] {
-            let slice: *const [u8] = storage[k].bytes();
-            // SAFETY: the slice lies in a heap buffer (`AlignedBuf`) or a
-            // memory map owned by `storage[k]`; neither moves when `storage`
-            // moves into the returned `Tables`, neither is ever written, and
-            // both live until `Tables::_storage` is dropped, which happens
-            // after `Tables::set` (field order). The set, and every `Rgb`
-            // made from it, is reachable only through the `Arc<Tables>` that
-            // keeps the storage alive.
-            unsafe { &*slice }
-        };
-        let set = TableSet::from_bytes(TableBytes {
-            smith: bytes(0),
-            sigma_ratio: bytes(1),
-            convolution: bytes(2),
-            diffuse_fresnel: bytes(3),
-        })?;
-        Ok(Tables {
-            set,
-            _storage: storage,
-        })
-    }
 }
 
 /// A failure: a status code and its message.
@@ -464,7 +406,7 @@ impl ts_material_desc {
     }
 }
 
-fn new_tables(tables: Tables) -> Box<ts_tables> {
+fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
     Box::new(ts_tables {
         inner: Arc::new(tables),
     })
@@ -472,7 +414,7 @@ fn new_tables(tables: Tables) -> Box<ts_tables> {
 
 /// Builds the material handle of `material` from the set behind `t`.
 fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
-    let rgb: Rgb<'_> = t.inner.set.rgb(material, options);
+    let rgb: Rgb<'_> = t.inner.set().rgb(material, options);
     // SAFETY: `rgb` borrows only the `TableSet` inside the `Arc` allocation
     // (which never moves) and, through it, the table storage it owns. The
     // handle keeps a clone of that `Arc` in `_tables`, dropped after `rgb`
@@ -504,7 +446,10 @@ pub extern "C" fn ts_last_status() -> c_int {
 /// The tables compiled into the library (no files needed). NULL on failure.
 #[unsafe(no_mangle)]
 pub extern "C" fn ts_tables_embedded() -> *mut ts_tables {
-    handle(|| Ok(new_tables(Tables::embedded()?)))
+    handle(|| {
+        let set = TableSet::from_bytes(TableSet::embedded_bytes())?;
+        Ok(new_tables(OwnedTableSet::from_static(set)))
+    })
 }
 
 /// Memory-maps and validates the four table files of directory `dir`
@@ -531,17 +476,7 @@ pub unsafe extern "C" fn ts_tables_open(dir: *const c_char) -> *mut ts_tables {
             dir.to_str()
                 .map_err(|e| Fail::new(TS_ERR_INVALID, format!("dir is not UTF-8: {e}")))?,
         );
-        let storage = TABLES
-            .iter()
-            .map(|id| {
-                let path = dir.join(format!("{}.tbl", id.name()));
-                match MappedFile::open(&path) {
-                    Ok(map) => Ok(Storage::Mapped(map)),
-                    Err(error) => Err(TableSetError::Io { path, error }),
-                }
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(new_tables(Tables::from_storage(storage)?))
+        Ok(new_tables(TableSet::open(dir)?))
     })
 }
 
@@ -560,30 +495,40 @@ pub unsafe extern "C" fn ts_tables_from_bytes(bytes: *const ts_table_bytes) -> *
         non_null(bytes, "bytes")?;
         // SAFETY: non-null; the caller passes a valid `ts_table_bytes`.
         let b = unsafe { &*bytes };
-        let files = [
-            (b.smith, b.smith_len),
-            (b.sigma_ratio, b.sigma_ratio_len),
-            (b.convolution, b.convolution_len),
-            (b.diffuse_fresnel, b.diffuse_fresnel_len),
-        ];
-        let storage = files
+        let file = |id: TableId| match id {
+            TableId::SmithG1 => (b.smith, b.smith_len),
+            TableId::SigmaRatio => (b.sigma_ratio, b.sigma_ratio_len),
+            TableId::Convolution => (b.convolution, b.convolution_len),
+            TableId::DiffuseFresnel => (b.diffuse_fresnel, b.diffuse_fresnel_len),
+            TableId::ShBrdf => (std::ptr::null(), 0),
+        };
+        let mut copies = TABLES
             .iter()
-            .zip(TABLES)
-            .map(|(&(ptr, len), id)| {
-                non_null(ptr, &format!("the bytes of {}.tbl", id.name()))?;
+            .map(|&id| {
+                let (ptr, len) = file(id);
+                let name = id.file_name();
+                non_null(ptr, &format!("the bytes of {name}"))?;
                 if len > isize::MAX as usize {
                     return Err(Fail::new(
                         TS_ERR_INVALID,
-                        format!("{}.tbl: length {len} is too large", id.name()),
+                        format!("{name}: length {len} is too large"),
                     ));
                 }
                 // SAFETY: non-null, `len` ≤ isize::MAX, and the caller
                 // guarantees `len` readable bytes; `u8` needs no alignment.
                 let slice = unsafe { std::slice::from_raw_parts(ptr, len) };
-                Ok(Storage::Copied(aligned_copy(slice)))
+                Ok(Some(TableStorage::Copied(aligned_copy(slice))))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(new_tables(Tables::from_storage(storage)?))
+        let set = OwnedTableSet::from_storage(|id| {
+            let k = TABLES.iter().position(|&t| t == id);
+            k.and_then(|k| copies.get_mut(k)?.take())
+                .ok_or(TableSetError::Format {
+                    table: id,
+                    error: FormatError::BadHeader("no bytes given"),
+                })
+        })?;
+        Ok(new_tables(set))
     })
 }
 

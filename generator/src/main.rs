@@ -326,9 +326,7 @@ fn catalogue(t4: &[ShBrdf]) -> Vec<&dyn TableKind> {
     kinds
 }
 
-/// The tables named: a name selects the table whose file stem it is, else
-/// the tables whose stems start with it, if they are all of one table id
-/// (so `t4` selects every material's T4).
+/// The tables named ([`tables::select`]); every table when none is named.
 fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableKind>, Error> {
     let all = catalogue(t4);
     if names.is_empty() {
@@ -336,23 +334,7 @@ fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableK
     }
     let mut chosen: Vec<&dyn TableKind> = Vec::new();
     for n in names {
-        let exact: Vec<_> = all.iter().filter(|t| t.file_stem() == *n).collect();
-        let matches: Vec<_> = if exact.is_empty() {
-            all.iter()
-                .filter(|t| t.file_stem().starts_with(n.as_str()))
-                .collect()
-        } else {
-            exact
-        };
-        let one_id = matches.windows(2).all(|w| w[0].id() == w[1].id());
-        if matches.is_empty() || !one_id {
-            let known: Vec<_> = all.iter().map(|t| t.file_stem()).collect();
-            return Err(Error::Usage(format!(
-                "unknown or ambiguous table '{n}' (known: {})",
-                known.join(", ")
-            )));
-        }
-        chosen.extend(matches.into_iter().copied());
+        chosen.extend(tables::select(n, &all).map_err(Error::Usage)?);
     }
     Ok(chosen)
 }

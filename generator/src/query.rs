@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use twoscale::{Convolution, TableSet, TableSetError};
+use twoscale::{Convolution, OwnedTableSet, TableSet, TableSetError};
 
 use crate::reference::{brdf, conv, epd, fresnel, kcorr};
 
@@ -340,7 +340,6 @@ pub fn run(
         .collect::<Result<Vec<usize>, QueryError>>()?;
 
     // Load the tables before reading rows, so a missing file fails fast.
-    // (`TableSet::open` keeps its maps for the process: one set per run.)
     let set = if quantity.uses_tables() {
         Some(TableSet::open(tables).map_err(QueryError::Tables)?)
     } else {
@@ -372,7 +371,7 @@ pub fn run(
         if let Some((&column, &value)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(RowError::NotFinite { column, value });
         }
-        let out = quantity.evaluate(set.as_ref(), &values)?;
+        let out = quantity.evaluate(set.as_ref().map(OwnedTableSet::set), &values)?;
         Ok(format!("{},{}", fields.join(","), out.join(",")))
     };
     let results: Vec<(usize, Result<String, RowError>)> = rows

@@ -13,8 +13,6 @@
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
-use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
-use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -25,6 +23,8 @@ use twoscale::brdf::{
 };
 use twoscale::epd::{BETA_RANGE, P_RANGE};
 use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
+use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
+use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 
 /// The committed tables, compiled into the extension.
 static TABLES: LazyLock<TableSet<'static>> = LazyLock::new(TableSet::embedded);

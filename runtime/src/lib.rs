@@ -41,4 +41,6 @@ pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};
+#[cfg(feature = "std")]
+pub use table_set::{OwnedTableSet, TableStorage};
 pub use table_set::{TableBytes, TableSet, TableSetError, UnknownMaterial};

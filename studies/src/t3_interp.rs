@@ -9,11 +9,11 @@
 //!   storage), along the parameters, along ξ, or both.
 
 use crate::common::{AXES, Distribution, Exact, cell, committed_t3, percentiles};
-use twoscale_reference::bspline::prefilter;
 use generator::tables::t3;
 use rayon::prelude::*;
 use twoscale::conv::{ConvTable, FIT_CHANNELS, along_xi, axis_weights, normalised_angle};
 use twoscale::interp::{bspline_weights, node_value};
+use twoscale_reference::bspline::prefilter;
 
 /// The committed T3 as the runtime reads it, with `cubic` parameter axes,
 /// at the rule nodes of `exact`.

@@ -37,7 +37,7 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, ShBrdfParams, aligned_copy};
+use twoscale::format::{AlignedBuf, AxisHeader, Mapping, ShBrdfParams, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
 use twoscale::{Complex, ShBrdfTable, TableBytes, TableId, TableSet, TwoScale};
 
@@ -51,13 +51,8 @@ use crate::sh::{IsotropicBrdf, default_quadrature, project};
 /// The workspace's table directory, where T4 falls back to for its inputs.
 pub const WORKSPACE_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
 
-/// The tables the two-scale model reads, in the order `build` writes them.
-pub const INPUTS: [TableId; 4] = [
-    TableId::SmithG1,
-    TableId::SigmaRatio,
-    TableId::DiffuseFresnel,
-    TableId::Convolution,
-];
+/// The tables the two-scale model reads: the runtime's set.
+pub const INPUTS: [TableId; 4] = twoscale::table_set::TABLES;
 
 /// Verification target: `max |f_SH − f| / max f` over the random pairs, with
 /// `f = ρ cos θi cos θo` (what the matrix represents; dividing by the cosines
@@ -107,7 +102,8 @@ pub fn input_dir(preferred: &Path) -> PathBuf {
 pub struct ModelInputs {
     /// Where they were read from.
     pub dir: PathBuf,
-    buffers: [AlignedBuf; 4],
+    /// The files of [`INPUTS`], in its order.
+    buffers: Vec<AlignedBuf>,
 }
 
 impl ModelInputs {
@@ -124,25 +120,26 @@ impl ModelInputs {
         };
         Ok(ModelInputs {
             dir: dir.to_path_buf(),
-            buffers: [
-                read(INPUTS[0])?,
-                read(INPUTS[1])?,
-                read(INPUTS[2])?,
-                read(INPUTS[3])?,
-            ],
+            buffers: INPUTS
+                .iter()
+                .map(|&id| read(id))
+                .collect::<Result<_, _>>()?,
         })
     }
 
     /// Validates the four files as the runtime's table set.
     pub fn parse(&self) -> Result<TableSet<'_>, BuildError> {
-        let [t1, t2, t5, t3] = &self.buffers;
-        TableSet::from_bytes(TableBytes {
-            smith: t1.bytes(),
-            sigma_ratio: t2.bytes(),
-            convolution: t3.bytes(),
-            diffuse_fresnel: t5.bytes(),
-        })
-        .map_err(|e| BuildError::Input {
+        let bytes = TableBytes::try_from_fn(|id| {
+            let k = INPUTS.iter().position(|&input| input == id);
+            k.and_then(|k| self.buffers.get(k))
+                .map(AlignedBuf::bytes)
+                .ok_or(())
+        });
+        let bytes = bytes.map_err(|()| BuildError::Input {
+            path: self.dir.display().to_string(),
+            message: "a table of the set is missing".to_string(),
+        })?;
+        TableSet::from_bytes(bytes).map_err(|e| BuildError::Input {
             path: self.dir.display().to_string(),
             message: e.to_string(),
         })
@@ -375,8 +372,8 @@ impl TableKind for ShBrdf {
         Ok(encode(&TableSpec {
             table_id: TableId::ShBrdf,
             channels: channels as u32,
-            kernel: Kernel::Multilinear,
-            value_type: twoscale::format::ValueType::F32,
+            kernel: TableId::ShBrdf.descriptor().kernel,
+            value_type: TableId::ShBrdf.descriptor().value_type,
             axes: &[axis],
             params: &params.to_values(),
             grid: &grid,
