@@ -1528,6 +1528,32 @@ mod tests {
         }
     }
 
+    /// A table whose header names another kernel than its descriptor's is
+    /// refused: T3 written with kernel 1 (`Multilinear`, what T3 files said
+    /// before tag 3) names the kernel it needs.
+    #[cfg(all(feature = "embedded", feature = "std"))]
+    #[test]
+    fn a_table_with_another_kernel_is_refused() {
+        let t3 = embedded_bytes(TableId::Convolution).unwrap_or(&[]);
+        let mut file = aligned_copy(t3);
+        let at = offset_of!(Header, kernel);
+        file.bytes_mut()[at..at + 4].copy_from_slice(&(Kernel::Multilinear as u32).to_le_bytes());
+        let sum = checksum(file.bytes());
+        file.bytes_mut()[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
+        let table = Table::from_bytes(file.bytes()).expect("still a valid file");
+        let error = table.expecting(TableId::Convolution).err();
+        assert_eq!(
+            error,
+            Some(FormatError::WrongKernel {
+                table: TableId::Convolution,
+                found: Kernel::Multilinear,
+            })
+        );
+        let message = std::format!("{}", error.unwrap_or(FormatError::Shape("")));
+        assert!(message.contains("CatmullRom"), "{message}");
+        assert!(crate::conv::ConvTable::from_bytes(file.bytes()).is_err());
+    }
+
     /// T3's parameters nest its angle constants: slot order is format 3's
     /// (angles, τ_max, u_floor, λ, Y, g_offset, value_floor, κ, w_h, w_e,
     /// s_e, τ_f, m) and a header round-trips.
