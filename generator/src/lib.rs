@@ -11,13 +11,18 @@
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
 //! - [`export`]: `generator export`, the tables as `.npy` or C headers;
 //! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
+//! - [`build`], [`verify`](mod@verify), [`inspect`](mod@inspect): the
+//!   bodies of `generator build`/`merge`/`spot-check`, `verify`, `inspect`;
+//! - [`table_source`]: where they read tables (embedded, or a directory);
 //! - [`rng`]: deterministic random points for verification.
 
 pub mod analytic;
 pub mod bspline;
+pub mod build;
 pub mod error;
 pub mod export;
 pub mod fit;
+pub mod inspect;
 pub mod materials;
 pub mod plot;
 pub mod quad;
@@ -26,4 +31,6 @@ pub mod reference;
 pub mod report;
 pub mod rng;
 pub mod sh;
+pub mod table_source;
 pub mod tables;
+pub mod verify;

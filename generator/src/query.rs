@@ -11,8 +11,11 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use std::path::Path;
-use twoscale::{Convolution, TableSet, TableSetError};
+use twoscale::{
+    ConvTable, Convolution, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId, TableSet,
+};
+
+use crate::table_source::{TableFile, TableFileError, TableSource};
 
 use crate::reference::{brdf, conv, epd, fresnel, kcorr};
 
@@ -84,30 +87,36 @@ impl Quantity {
         }
     }
 
-    /// Whether the evaluation reads the table files.
-    pub const fn uses_tables(self) -> bool {
-        !matches!(self, Quantity::Fresnel)
+    /// The tables the evaluation reads (only these are opened).
+    pub const fn tables(self) -> &'static [TableId] {
+        match self {
+            Quantity::G1 => &[TableId::SmithG1],
+            Quantity::SigmaRatio => &[TableId::SigmaRatio],
+            Quantity::Fresnel => &[],
+            Quantity::Conv => &[TableId::Convolution],
+            Quantity::Brdf => &twoscale::table_set::TABLES,
+        }
     }
 
     /// The output values for inputs `x` (in the order of [`Self::columns`]),
-    /// with the runtime reading `set` (`None` only if not
-    /// [`Self::uses_tables`]), or why there are none.
-    fn evaluate(self, set: Option<&TableSet>, x: &[f64]) -> Result<Vec<String>, RowError> {
-        let set = || set.ok_or(RowError::NoTables);
+    /// with the runtime reading `tables` (those of [`Self::tables`]), or why
+    /// there are none.
+    fn evaluate(self, tables: &Tables<'_>, x: &[f64]) -> Result<Vec<String>, RowError> {
         let reference = |e: &dyn fmt::Display| RowError::Reference(e.to_string());
         Ok(match self {
             Quantity::G1 => {
                 let (p, a) = (x[0], x[1]);
                 let reference = epd::g1(p, a).map_err(|e| reference(&e))?;
-                let table = set()?.smith.g1(p as f32, a as f32);
+                let table = tables.smith()?.g1(p as f32, a as f32);
                 vec![table.to_string(), reference.to_string()]
             }
             Quantity::SigmaRatio => {
                 let (theta_i, big_b, c) = (x[0], x[1], x[2]);
                 let reference = kcorr::sigma_ratio(theta_i, big_b, c).map_err(|e| reference(&e))?;
-                let table = set()?
-                    .sigma_ratio
-                    .sigma_ratio(theta_i as f32, big_b as f32, c as f32);
+                let table =
+                    tables
+                        .sigma_ratio()?
+                        .sigma_ratio(theta_i as f32, big_b as f32, c as f32);
                 vec![table.to_string(), reference.to_string()]
             }
             Quantity::Fresnel => {
@@ -126,7 +135,7 @@ impl Quantity {
                 let (u, c, beta, p, theta_h) = (x[0], x[1], x[2], x[3], x[4]);
                 let reference =
                     conv::convolution(theta_h, u, c, beta, p).map_err(|e| reference(&e))?;
-                let table = &set()?.convolution;
+                let table = tables.convolution()?;
                 let (sin, cos) = (theta_h.sin() as f32, theta_h.cos() as f32);
                 let (u, c, beta, p) = (u as f32, c as f32, beta as f32, p as f32);
                 vec![
@@ -172,8 +181,9 @@ impl Quantity {
                     base: twoscale::brdf::BaseLayer::Conductor,
                     lambertian: 0.0,
                 };
+                let set = tables.set()?;
                 let model = twoscale::TwoScale::new(
-                    &set()?.brdf_tables(),
+                    &set.brdf_tables(),
                     layer,
                     f(params.lambda),
                     twoscale::Complex::new(f(params.n), f(params.k)),
@@ -202,8 +212,8 @@ pub enum QueryError {
         /// The quantity's input columns.
         needs: &'static [&'static str],
     },
-    /// The table files could not be opened.
-    Tables(TableSetError),
+    /// A table file could not be opened or is malformed.
+    Tables(TableFileError),
     /// The output could not be written.
     Write(std::io::Error),
 }
@@ -224,7 +234,7 @@ impl fmt::Display for QueryError {
                     needs.join(",")
                 )
             }
-            QueryError::Tables(e) => write!(f, "{e} (build the tables with `generator build`)"),
+            QueryError::Tables(e) => write!(f, "{e}"),
             QueryError::Write(e) => write!(f, "writing output: {e}"),
         }
     }
@@ -237,6 +247,68 @@ impl std::error::Error for QueryError {
             QueryError::Tables(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+/// The validated views of the table files a quantity reads.
+#[derive(Default)]
+pub struct Tables<'a> {
+    smith: Option<SmithG1Table<'a>>,
+    sigma_ratio: Option<SigmaRatioTable<'a>>,
+    convolution: Option<ConvTable<'a>>,
+    diffuse_fresnel: Option<DiffuseFresnelTable<'a>>,
+}
+
+impl<'a> Tables<'a> {
+    /// Validates `files` (read from `source`, named in the errors).
+    fn parse(
+        files: &'a [(TableId, TableFile)],
+        source: &TableSource,
+    ) -> Result<Self, TableFileError> {
+        let mut tables = Tables::default();
+        for (id, file) in files {
+            let bytes = file.bytes();
+            let error = || source.format_error(id.name());
+            match id {
+                TableId::SmithG1 => {
+                    tables.smith = Some(SmithG1Table::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::SigmaRatio => {
+                    tables.sigma_ratio = Some(SigmaRatioTable::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::Convolution => {
+                    tables.convolution = Some(ConvTable::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::DiffuseFresnel => {
+                    tables.diffuse_fresnel =
+                        Some(DiffuseFresnelTable::from_bytes(bytes).map_err(error())?);
+                }
+                _ => {}
+            }
+        }
+        Ok(tables)
+    }
+
+    fn smith(&self) -> Result<SmithG1Table<'a>, RowError> {
+        self.smith.ok_or(RowError::NoTables)
+    }
+
+    fn sigma_ratio(&self) -> Result<SigmaRatioTable<'a>, RowError> {
+        self.sigma_ratio.ok_or(RowError::NoTables)
+    }
+
+    fn convolution(&self) -> Result<&ConvTable<'a>, RowError> {
+        self.convolution.as_ref().ok_or(RowError::NoTables)
+    }
+
+    /// The four tables as the runtime's set (`brdf`).
+    fn set(&self) -> Result<TableSet<'a>, RowError> {
+        Ok(TableSet {
+            smith: self.smith()?,
+            sigma_ratio: self.sigma_ratio()?,
+            convolution: *self.convolution()?,
+            diffuse_fresnel: self.diffuse_fresnel.ok_or(RowError::NoTables)?,
+        })
     }
 }
 
@@ -292,6 +364,14 @@ impl fmt::Display for RowError {
 
 impl std::error::Error for RowError {}
 
+/// How `run` treats rows outside a table's domain.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Answer them at the clamped point (as the renderer-facing lookups
+    /// do) and add the column `in_domain`, instead of reporting them.
+    pub clamp: bool,
+}
+
 /// Outcome of a query run.
 #[derive(Debug, Default, PartialEq, Eq)]
 pub struct Summary {
@@ -301,12 +381,15 @@ pub struct Summary {
     pub bad: usize,
 }
 
-/// Runs query `quantity` over CSV `input`, writing CSV to `output` and one line
-/// per bad row to `errors`. Fails (before reading rows) on an unknown quantity,
-/// a missing table file, or a header without the required columns.
+/// Runs query `quantity` over CSV `input` with the tables of `tables`,
+/// writing CSV to `output` and one line per bad row to `errors`. Fails
+/// (before reading rows) on an unknown quantity, a missing or malformed
+/// table file (of those the quantity reads), or a header without the
+/// required columns.
 pub fn run(
     quantity: &str,
-    tables: &Path,
+    tables: &TableSource,
+    options: &Options,
     input: impl BufRead,
     mut output: impl Write,
     mut errors: impl Write,
@@ -339,13 +422,15 @@ pub fn run(
         })
         .collect::<Result<Vec<usize>, QueryError>>()?;
 
-    // Load the tables before reading rows, so a missing file fails fast.
-    // (`TableSet::open` keeps its maps for the process: one set per run.)
-    let set = if quantity.uses_tables() {
-        Some(TableSet::open(tables).map_err(QueryError::Tables)?)
-    } else {
-        None
-    };
+    // Open the tables the quantity reads before reading rows, so a missing
+    // or malformed file fails fast.
+    let files = quantity
+        .tables()
+        .iter()
+        .map(|&id| tables.open(id).map(|file| (id, file)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(QueryError::Tables)?;
+    let views = Tables::parse(&files, tables).map_err(QueryError::Tables)?;
 
     let rows: Vec<(usize, String)> = lines
         .map(|(n, line)| (n + 1, line.unwrap_or_default()))
@@ -372,7 +457,7 @@ pub fn run(
         if let Some((&column, &value)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(RowError::NotFinite { column, value });
         }
-        let out = quantity.evaluate(set.as_ref(), &values)?;
+        let out = quantity.evaluate(&views, &values)?;
         Ok(format!("{},{}", fields.join(","), out.join(",")))
     };
     let results: Vec<(usize, Result<String, RowError>)> = rows
