@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use twoscale::Table;
 use twoscale::format::{HEADER_SIZE, Header, MAGIC, TableId, checksum};
 use twoscale::interp::node_value;
+use twoscale::validate::{Shortest, Shortest32};
 use zerocopy::TryFromBytes;
 
 use crate::error::{Error, FileAction};
@@ -146,7 +147,7 @@ fn describe(name: &str, bytes: &[u8], out: &mut impl Write) -> std::io::Result<b
             twoscale::sh::coefficient_count(table.band_limit())
         )?;
         for (aux, value) in twoscale::sh::AUX_NAMES.iter().zip(table.aux()) {
-            writeln!(out, "  aux {aux:<20} {}", number(f64::from(*value)))?;
+            writeln!(out, "  aux {aux:<20} {}", Shortest32(*value))?;
         }
     }
     writeln!(
@@ -178,7 +179,8 @@ fn describe(name: &str, bytes: &[u8], out: &mut impl Write) -> std::io::Result<b
 }
 
 /// A header value as printed: integers as integers, others in the
-/// shortest form that round-trips.
+/// shortest form that round-trips (exponent form only for very small or
+/// large magnitudes).
 fn number(value: f64) -> String {
-    format!("{value}")
+    Shortest(value).to_string()
 }
