@@ -12,16 +12,23 @@
 //! - [`error`]: what a `generator` subcommand can fail with;
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
 //! - [`export`]: `generator export`, the tables as `.npy` or C headers;
-//! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`.
+//! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
+//! - [`build`], [`verify`](mod@verify), [`inspect`](mod@inspect): the
+//!   bodies of `generator build`/`merge`/`spot-check`, `verify`, `inspect`;
+//! - [`table_source`]: where they read tables (embedded, or a directory).
 
 pub use twoscale_reference::{bspline, fit, quad, reference, rng};
 
 pub mod analytic;
+pub mod build;
 pub mod error;
 pub mod export;
+pub mod inspect;
 pub mod materials;
 pub mod plot;
 pub mod query;
 pub mod report;
 pub mod sh;
+pub mod table_source;
 pub mod tables;
+pub mod verify;

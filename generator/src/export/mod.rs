@@ -18,6 +18,7 @@
 //! is refused with both figures.
 
 pub mod c;
+pub mod cli;
 pub mod npy;
 
 use std::fmt::Write as _;

@@ -19,7 +19,8 @@
 //!
 //! **Where the input tables come from** ([`input_dir`]): the directory the
 //! T4 files are written to (`build --out`) or read from (`verify DIR`) when it
-//! holds all four input files, else the workspace's `tables/`. `build` writes
+//! holds all four input files, else the tables compiled into the binary
+//! (feature `embedded`: the committed ones). `build` writes
 //! T1, T2, T5, T3 before T4 (the order of [`super::all`], then the materials),
 //! so a full build into an empty directory projects the tables just built.
 //!
@@ -48,7 +49,8 @@ use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
 use crate::sh::{IsotropicBrdf, default_quadrature, project};
 
-/// The workspace's table directory, where T4 falls back to for its inputs.
+/// The workspace's table directory (the studies and tests read it; the
+/// generator's defaults never do).
 pub const WORKSPACE_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
 
 /// The tables the two-scale model reads: the runtime's set.
@@ -86,21 +88,19 @@ impl Projected {
     }
 }
 
-/// `preferred` if it holds all of [`INPUTS`], else [`WORKSPACE_TABLES`].
-pub fn input_dir(preferred: &Path) -> PathBuf {
-    if INPUTS
+/// `preferred` if it holds all of [`INPUTS`], else `None`: the tables
+/// compiled into the binary ([`ModelInputs::embedded`]).
+pub fn input_dir(preferred: &Path) -> Option<PathBuf> {
+    INPUTS
         .iter()
         .all(|&id| preferred.join(file_name(id)).is_file())
-    {
-        preferred.to_path_buf()
-    } else {
-        PathBuf::from(WORKSPACE_TABLES)
-    }
+        .then(|| preferred.to_path_buf())
 }
 
-/// T1, T2, T5 and T3 read from a directory (owned, 64-byte aligned).
+/// T1, T2, T5 and T3 read from a directory or the binary (owned, 64-byte
+/// aligned).
 pub struct ModelInputs {
-    /// Where they were read from.
+    /// Where they were read from (a directory, or "the embedded tables").
     pub dir: PathBuf,
     /// The files of [`INPUTS`], in its order.
     buffers: Vec<AlignedBuf>,
@@ -125,6 +125,36 @@ impl ModelInputs {
                 .map(|&id| read(id))
                 .collect::<Result<_, _>>()?,
         })
+    }
+
+    /// Copies of the tables compiled into the binary (feature `embedded`).
+    pub fn embedded() -> Result<ModelInputs, BuildError> {
+        let read = |id: TableId| {
+            crate::table_source::embedded(id)
+                .map(aligned_copy)
+                .ok_or_else(|| BuildError::Input {
+                    path: file_name(id),
+                    message: "not in the output directory, and this generator has no \
+                              embedded tables (T4 projects the two-scale model, which reads it)"
+                        .into(),
+                })
+        };
+        Ok(ModelInputs {
+            dir: PathBuf::from("the embedded tables"),
+            buffers: INPUTS
+                .iter()
+                .map(|&id| read(id))
+                .collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// The inputs of [`Projected::TwoScale`] for directory `preferred`:
+    /// read from [`input_dir`]`(preferred)`, else the embedded tables.
+    pub fn for_dir(preferred: &Path) -> Result<ModelInputs, BuildError> {
+        match input_dir(preferred) {
+            Some(dir) => ModelInputs::load(&dir),
+            None => ModelInputs::embedded(),
+        }
     }
 
     /// Validates the four files as the runtime's table set.
@@ -265,7 +295,7 @@ fn with_source<T>(
 ) -> Result<T, BuildError> {
     match projected {
         Projected::TwoScale { dir } => {
-            let inputs = ModelInputs::load(&input_dir(dir))?;
+            let inputs = ModelInputs::for_dir(dir)?;
             let parsed = inputs.parse()?;
             f(Some(&parsed.brdf_tables()))
         }
