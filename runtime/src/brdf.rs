@@ -314,7 +314,7 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// quantile 8 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
 ///
 /// All zeros is a valid (empty) value, so storage can be allocated zeroed on
-/// the heap ([`ChannelBake::boxed`], feature `std`) or provided by the caller
+/// the heap (`ChannelBake::boxed`, feature `std`) or provided by the caller
 /// (`&mut ChannelBake`, e.g. a `static`); [`TwoScale::new_in`] and
 /// [`Rgb::new_in`] fill it in place, and construction then needs no stack
 /// beyond a few KB (the test `construction_fits_a_64_kib_stack`).
@@ -362,7 +362,7 @@ impl ChannelBake {
 /// Construction bakes what depends only on the material and wavelength into
 /// a [`ChannelBake`] (so that `eval` reads small tables), held as `B`: by
 /// value (the default, 45 KB; [`TwoScale::new`]), boxed
-/// ([`TwoScale::boxed`], feature `std`) or borrowed (`&mut ChannelBake`),
+/// (`TwoScale::boxed`, feature `std`) or borrowed (`&mut ChannelBake`),
 /// any `B: Borrow<ChannelBake>`; [`Rgb`] is three of them. `Clone` (when `B`
 /// is), not `Copy`.
 #[derive(Clone)]
@@ -471,7 +471,7 @@ impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
     /// [`ChannelBake`] (cost: `cargo bench --bench brdf -- construct`). The
-    /// value is 45 KB: on small stacks use [`TwoScale::boxed`] or
+    /// value is 45 KB: on small stacks use `TwoScale::boxed` or
     /// [`TwoScale::new_in`].
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
@@ -500,7 +500,7 @@ impl<'a> TwoScale<'a> {
 
 #[cfg(feature = "std")]
 impl<'a> TwoScale<'a, std::boxed::Box<ChannelBake>> {
-    /// [`TwoScale::new`] with the bakes on the heap ([`ChannelBake::boxed`],
+    /// [`TwoScale::new`] with the bakes on the heap (`ChannelBake::boxed`,
     /// filled in place): the value is a few hundred bytes, and construction
     /// runs on a 64 KiB stack.
     pub fn boxed(
@@ -1152,7 +1152,7 @@ fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
 /// The channels share the geometry, D and G of each evaluation (they must
 /// share the surface, as [`Rgb::new`] makes them). The bakes are held as `B`,
-/// as [`TwoScale`]'s: by value ([`Rgb::new`], 136 KB), boxed ([`Rgb::boxed`])
+/// as [`TwoScale`]'s: by value ([`Rgb::new`], 136 KB), boxed (`Rgb::boxed`)
 /// or in caller-provided storage ([`Rgb::new_in`]).
 #[derive(Clone)]
 pub struct Rgb<'a, B = ChannelBake> {
@@ -1173,7 +1173,7 @@ pub struct RgbSample {
 
 impl<'a> Rgb<'a> {
     /// The three channels of `material` at [`RGB_WAVELENGTHS`]. The value is
-    /// 136 KB: on small stacks use [`Rgb::boxed`] or [`Rgb::new_in`].
+    /// 136 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
         let bakes = [
             ChannelBake::zeroed(),
@@ -1186,7 +1186,7 @@ impl<'a> Rgb<'a> {
 
 #[cfg(feature = "std")]
 impl<'a> Rgb<'a, std::boxed::Box<ChannelBake>> {
-    /// [`Rgb::new`] with the bakes on the heap ([`ChannelBake::boxed`],
+    /// [`Rgb::new`] with the bakes on the heap (`ChannelBake::boxed`,
     /// filled in place): construction runs on a 64 KiB stack.
     pub fn boxed(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
         let bakes = [

@@ -229,3 +229,114 @@ impl Bxdf for ShBrdfTable<'_> {
         })
     }
 }
+
+#[cfg(all(test, feature = "embedded"))]
+mod tests {
+    use super::*;
+    use crate::TableSet;
+    use crate::brdf::Options;
+    use crate::hp15::{Energy, Hp15Params};
+    use crate::materials::PRESETS;
+    use crate::test_rng::Lcg;
+
+    /// A direction in the upper hemisphere from two uniforms.
+    fn direction(rng: &mut Lcg) -> [f32; 3] {
+        let (z, phi) = (
+            rng.next() as f32,
+            core::f32::consts::TAU * rng.next() as f32,
+        );
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        [r * phi.cos(), r * phi.sin(), z]
+    }
+
+    /// Through the trait: eval and pdf are the inherent ones, a sample's
+    /// pdf and value are `pdf` and `eval` at its direction.
+    fn check<T: Bxdf>(
+        model: &T,
+        eval: impl Fn([f32; 3], [f32; 3]) -> T::Value,
+        pdf: impl Fn([f32; 3], [f32; 3]) -> f32,
+    ) where
+        T::Value: PartialEq + core::fmt::Debug,
+    {
+        let mut rng = Lcg(9);
+        let mut sampled = 0;
+        for _ in 0..200 {
+            let (i, o) = (direction(&mut rng), direction(&mut rng));
+            assert_eq!(model.eval(i, o), eval(i, o));
+            assert_eq!(model.pdf(i, o), pdf(i, o));
+            let u = [0, 1, 2].map(|_| rng.next() as f32);
+            if let Some(s) = model.sample(i, u) {
+                sampled += 1;
+                assert!(s.pdf > 0.0 && s.o[2] > 0.0);
+                assert_eq!(s.pdf, model.pdf(i, s.o));
+                assert_eq!(s.value, model.eval(i, s.o));
+            }
+        }
+        assert!(sampled > 100, "{sampled} of 200 sampled");
+        let below = [0.3, 0.0, -0.5];
+        assert_eq!(model.pdf(below, [0.0, 0.0, 1.0]), 0.0);
+        assert!(model.sample(below, [0.5; 3]).is_none());
+    }
+
+    #[test]
+    fn every_model_forwards_to_its_own_methods() {
+        let set = TableSet::embedded();
+        let tables = set.brdf_tables();
+        for (_, material) in PRESETS {
+            let rgb = Rgb::new(&tables, &material, Options::default());
+            check(&rgb, |i, o| rgb.eval(i, o), |i, o| rgb.pdf(i, o));
+            let one = &rgb.channels[1];
+            check(one, |i, o| one.eval(i, o), |i, o| one.pdf(i, o));
+        }
+        let params = Hp15Params {
+            beta: 0.2,
+            p: 1.3,
+            a: 2.0,
+            kd: 0.1,
+            ks: 0.6,
+            kw: 0.02,
+            f0: 0.9,
+        };
+        let hp15 = Hp15::new(&set.smith, params, 0.526, Energy::Exact);
+        check(&hp15, |i, o| hp15.eval(i, o), |i, o| hp15.pdf(i, o));
+        let sh = ShBrdfTable::from_bytes(crate::include_table!("../tables/t4-gold-rough.tbl"))
+            .expect("T4");
+        // cos θo / π of the renormalised direction.
+        let cosine = |_: [f32; 3], o: [f32; 3]| {
+            let w = o.map(f64::from);
+            (w[2] / (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt() / PI) as f32
+        };
+        check(&sh, |i, o| sh.eval_rgb(i, o), cosine);
+    }
+
+    #[test]
+    fn flags_say_which_lobes_a_model_has() {
+        let set = TableSet::embedded();
+        let tables = set.brdf_tables();
+        for (name, material) in PRESETS {
+            let flags = Rgb::new(&tables, &material, Options::default()).flags();
+            let s = material.layer.surface;
+            assert!(flags.contains(BxdfFlags::GLOSSY), "{name}");
+            assert_eq!(
+                flags.contains(BxdfFlags::DIFFRACTION),
+                s.sigma_s > 0.0 && s.b > 0.0 && s.c > 1.0,
+                "{name}"
+            );
+            let diffuse = material.layer.base != crate::brdf::BaseLayer::Conductor
+                || material.layer.lambertian > 0.0;
+            assert_eq!(flags.contains(BxdfFlags::DIFFUSE), diffuse, "{name}");
+        }
+        let mirror_like = Hp15Params {
+            beta: 0.2,
+            p: 1.0,
+            a: 1.0,
+            kd: 0.0,
+            ks: 1.0,
+            kw: 0.0,
+            f0: 1.0,
+        };
+        let hp15 = Hp15::new(&set.smith, mirror_like, 0.5, Energy::Exact);
+        assert_eq!(hp15.flags(), BxdfFlags::GLOSSY);
+        assert_eq!((BxdfFlags::GLOSSY | BxdfFlags::DIFFUSE).bits(), 3);
+    }
+}
