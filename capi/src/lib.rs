@@ -157,7 +157,7 @@ impl Default for ts_material_desc {
     /// A conductor with the paper's options, every number 0, `size` set.
     fn default() -> Self {
         ts_material_desc {
-            size: DESC_SIZE,
+            size: desc_size(),
             beta: 0.0,
             p: 0.0,
             sigma_s: 0.0,
@@ -176,8 +176,11 @@ impl Default for ts_material_desc {
     }
 }
 
-/// `sizeof(ts_material_desc)` of this library (the only size accepted).
-const DESC_SIZE: u32 = size_of::<ts_material_desc>() as u32;
+/// `sizeof(ts_material_desc)` of this library (the only size accepted). A
+/// function, not a `const`: cbindgen would try to export the constant.
+fn desc_size() -> u32 {
+    size_of::<ts_material_desc>() as u32
+}
 
 /// A sampled direction. `pdf == 0` means no direction was sampled (e.g. `wi`
 /// below the horizon); `wo` and `value` are then zero.
@@ -531,7 +534,7 @@ impl ts_material_desc {
         };
         let s = material.layer.surface;
         ts_material_desc {
-            size: DESC_SIZE,
+            size: desc_size(),
             beta: s.beta,
             p: s.p,
             sigma_s: s.sigma_s,
@@ -826,12 +829,13 @@ pub unsafe extern "C" fn ts_material_new(
         // SAFETY: non-null, aligned, and by the caller's contract readable
         // for at least the `size` field, which every layout starts with.
         let size = unsafe { std::ptr::addr_of!((*desc).size).read() };
-        if size != DESC_SIZE {
+        if size != desc_size() {
             return Err(Fail::new(
                 TS_ERR_INVALID,
                 format!(
-                    "ts_material_desc.size = {size} is not sizeof(ts_material_desc) = {DESC_SIZE} \
-                     of this library (set it to sizeof(ts_material_desc))"
+                    "ts_material_desc.size = {size} is not sizeof(ts_material_desc) = {} \
+                     of this library (set it to sizeof(ts_material_desc))",
+                    desc_size()
                 ),
             ));
         }
