@@ -20,13 +20,14 @@ use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, Options, RGB_WAVELENGTHS, Rgb,
-    SigmaRelMode, Surface,
+    BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
+    RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
 };
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
 use twoscale::table_set::TABLES;
-use twoscale::{Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
+use twoscale::validate::{self, Domain, Invalid};
+use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
 
 /// Success.
 pub const TS_OK: c_int = 0;
@@ -75,10 +76,11 @@ pub struct ts_tables {
     inner: Arc<OwnedTableSet>,
 }
 
-/// An RGB material built from a `ts_tables`. Opaque; about 136 KB.
+/// An RGB material built from a `ts_tables`. Opaque; about 136 KB, on the heap.
 pub struct ts_material {
-    /// Borrows `_tables` (declared after it, so dropped before it).
-    rgb: Rgb<'static>,
+    /// Borrows `_tables` (declared after it, so dropped before it); its
+    /// bakes are allocated zeroed on the heap and filled in place.
+    rgb: Rgb<'static, Box<ChannelBake>>,
     _tables: Arc<OwnedTableSet>,
 }
 
@@ -104,13 +106,20 @@ pub struct ts_table_bytes {
 }
 
 /// Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
-/// `twoscale::brdf::Options`). All-zero enumeration fields are the defaults
-/// (conductor, the paper's options). Lengths are in µm. Out-of-range finite
-/// values are clamped as `TwoScale::new` documents (e.g. albedos to [0, 1]);
-/// NaN or infinite values are rejected.
+/// `twoscale::brdf::Options`). Set `size` to `sizeof(ts_material_desc)`
+/// (`ts_material_desc_preset` does); other sizes are rejected. All-zero
+/// enumeration fields are the defaults (conductor, the paper's options).
+/// Lengths are in µm. Values outside the model's domain (`Material::validate`
+/// of the runtime: β and p in the EPD's domain, σs ≥ 0, b > 0 when σs > 0,
+/// c > 1, albedos in [0, 1], n > 0, k ≥ 0, no albedo on a conductor) and NaN
+/// or infinite values are rejected with `TS_ERR_INVALID` and a message naming
+/// the field, its value and its domain.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ts_material_desc {
+    /// `sizeof(ts_material_desc)`, set by the caller: the layout the caller
+    /// was compiled with.
+    pub size: u32,
     /// EPD width β (HP17 35).
     pub beta: f32,
     /// EPD shape p (HP17 35), in [0.2, 5].
@@ -141,6 +150,35 @@ pub struct ts_material_desc {
     pub colour: i32,
     /// `TS_HALO_*`.
     pub halo_weight: i32,
+}
+
+impl Default for ts_material_desc {
+    /// A conductor with the paper's options, every number 0, `size` set.
+    fn default() -> Self {
+        ts_material_desc {
+            size: desc_size(),
+            beta: 0.0,
+            p: 0.0,
+            sigma_s: 0.0,
+            b: 0.0,
+            c: 0.0,
+            base: TS_BASE_CONDUCTOR,
+            base_albedo: 0.0,
+            lambertian: 0.0,
+            eta_re: [0.0; 3],
+            eta_im: [0.0; 3],
+            masking: TS_MASKING_SEPARABLE,
+            sigma_rel: TS_SIGMA_REL_INCIDENT,
+            colour: TS_COLOUR_PHYSICAL,
+            halo_weight: TS_HALO_PRINTED,
+        }
+    }
+}
+
+/// `sizeof(ts_material_desc)` of this library (the only size accepted). A
+/// function, not a `const`: cbindgen would try to export the constant.
+fn desc_size() -> u32 {
+    size_of::<ts_material_desc>() as u32
 }
 
 /// A sampled direction. `pdf == 0` means no direction was sampled (e.g. `wi`
@@ -278,77 +316,128 @@ fn utf8<'s>(s: *const c_char, what: &str) -> Result<&'s str, Fail> {
         .map_err(|e| Fail::new(TS_ERR_INVALID, format!("{what} is not UTF-8: {e}")))
 }
 
-fn enum_value<T: Copy>(value: i32, field: &str, values: &[T]) -> Result<T, Fail> {
-    usize::try_from(value)
-        .ok()
-        .and_then(|k| values.get(k).copied())
-        .ok_or_else(|| {
-            Fail::new(
-                TS_ERR_INVALID,
-                format!(
-                    "{field} = {value} is not one of 0..={}",
-                    values.len().saturating_sub(1)
-                ),
-            )
-        })
+/// `TS_ERR_INVALID` with the runtime validation's message, the parameter
+/// named as the field of `ts_material_desc` that holds it.
+fn invalid(error: Invalid) -> Fail {
+    let field = match error.name {
+        "albedo" => "base_albedo",
+        "eta[0].n" => "eta_re[0]",
+        "eta[1].n" => "eta_re[1]",
+        "eta[2].n" => "eta_re[2]",
+        "eta[0].k" => "eta_im[0]",
+        "eta[1].k" => "eta_im[1]",
+        "eta[2].k" => "eta_im[2]",
+        name => name,
+    };
+    Fail::new(
+        TS_ERR_INVALID,
+        format!(
+            "ts_material_desc.{}",
+            Invalid {
+                name: field,
+                ..error
+            }
+        ),
+    )
+}
+
+/// `TS_ERR_INVALID` for an enumeration field holding none of its constants
+/// (`names`: each constant's name and value).
+fn unknown_constant(field: &str, value: i32, names: &[(&str, i32)]) -> Fail {
+    let mut accepted = String::new();
+    for (k, (name, v)) in names.iter().enumerate() {
+        let sep = if k == 0 { "" } else { ", " };
+        accepted.push_str(&format!("{sep}{name} ({v})"));
+    }
+    Fail::new(
+        TS_ERR_INVALID,
+        format!("ts_material_desc.{field} = {value} is not one of {accepted}"),
+    )
 }
 
 impl ts_material_desc {
-    /// The runtime's material and options; rejects non-finite numbers and
-    /// unknown enumeration values, naming the field.
+    /// The runtime's material and options: unknown enumeration values and
+    /// what `Material::validate` rejects (non-finite numbers among them) are
+    /// `TS_ERR_INVALID`, naming the field.
     fn to_model(self) -> Result<(Material, Options), Fail> {
-        let numbers = [
-            ("beta", self.beta),
-            ("p", self.p),
-            ("sigma_s", self.sigma_s),
-            ("b", self.b),
-            ("c", self.c),
-            ("base_albedo", self.base_albedo),
-            ("lambertian", self.lambertian),
-            ("eta_re[0]", self.eta_re[0]),
-            ("eta_re[1]", self.eta_re[1]),
-            ("eta_re[2]", self.eta_re[2]),
-            ("eta_im[0]", self.eta_im[0]),
-            ("eta_im[1]", self.eta_im[1]),
-            ("eta_im[2]", self.eta_im[2]),
-        ];
-        if let Some((name, value)) = numbers.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(Fail::new(
-                TS_ERR_INVALID,
-                format!("ts_material_desc.{name} is not finite: {value}"),
-            ));
-        }
         let albedo = self.base_albedo;
-        let base = enum_value(
-            self.base,
-            "ts_material_desc.base",
-            &[
-                BaseLayer::Conductor,
-                BaseLayer::Plastic { albedo },
-                BaseLayer::Subsurface { albedo },
-            ],
-        )?;
+        let base = match self.base {
+            TS_BASE_CONDUCTOR => BaseLayer::Conductor,
+            TS_BASE_PLASTIC => BaseLayer::Plastic { albedo },
+            TS_BASE_SUBSURFACE => BaseLayer::Subsurface { albedo },
+            other => {
+                return Err(unknown_constant(
+                    "base",
+                    other,
+                    &[
+                        ("TS_BASE_CONDUCTOR", TS_BASE_CONDUCTOR),
+                        ("TS_BASE_PLASTIC", TS_BASE_PLASTIC),
+                        ("TS_BASE_SUBSURFACE", TS_BASE_SUBSURFACE),
+                    ],
+                ));
+            }
+        };
+        let masking = match self.masking {
+            TS_MASKING_SEPARABLE => Masking::Separable,
+            TS_MASKING_HEIGHT_CORRELATED => Masking::HeightCorrelated,
+            other => {
+                return Err(unknown_constant(
+                    "masking",
+                    other,
+                    &[
+                        ("TS_MASKING_SEPARABLE", TS_MASKING_SEPARABLE),
+                        ("TS_MASKING_HEIGHT_CORRELATED", TS_MASKING_HEIGHT_CORRELATED),
+                    ],
+                ));
+            }
+        };
+        let sigma_rel = match self.sigma_rel {
+            TS_SIGMA_REL_INCIDENT => SigmaRelMode::Incident,
+            TS_SIGMA_REL_SYMMETRISED => SigmaRelMode::Symmetrised,
+            other => {
+                return Err(unknown_constant(
+                    "sigma_rel",
+                    other,
+                    &[
+                        ("TS_SIGMA_REL_INCIDENT", TS_SIGMA_REL_INCIDENT),
+                        ("TS_SIGMA_REL_SYMMETRISED", TS_SIGMA_REL_SYMMETRISED),
+                    ],
+                ));
+            }
+        };
+        let colour = match self.colour {
+            TS_COLOUR_PHYSICAL => ColourTerms::Physical,
+            TS_COLOUR_WHITE => ColourTerms::White,
+            other => {
+                return Err(unknown_constant(
+                    "colour",
+                    other,
+                    &[
+                        ("TS_COLOUR_PHYSICAL", TS_COLOUR_PHYSICAL),
+                        ("TS_COLOUR_WHITE", TS_COLOUR_WHITE),
+                    ],
+                ));
+            }
+        };
+        let halo_weight = match self.halo_weight {
+            TS_HALO_PRINTED => HaloWeight::Printed,
+            TS_HALO_INCIDENT => HaloWeight::Incident,
+            other => {
+                return Err(unknown_constant(
+                    "halo_weight",
+                    other,
+                    &[
+                        ("TS_HALO_PRINTED", TS_HALO_PRINTED),
+                        ("TS_HALO_INCIDENT", TS_HALO_INCIDENT),
+                    ],
+                ));
+            }
+        };
         let options = Options {
-            masking: enum_value(
-                self.masking,
-                "ts_material_desc.masking",
-                &[Masking::Separable, Masking::HeightCorrelated],
-            )?,
-            sigma_rel: enum_value(
-                self.sigma_rel,
-                "ts_material_desc.sigma_rel",
-                &[SigmaRelMode::Incident, SigmaRelMode::Symmetrised],
-            )?,
-            colour: enum_value(
-                self.colour,
-                "ts_material_desc.colour",
-                &[ColourTerms::Physical, ColourTerms::White],
-            )?,
-            halo_weight: enum_value(
-                self.halo_weight,
-                "ts_material_desc.halo_weight",
-                &[HaloWeight::Printed, HaloWeight::Incident],
-            )?,
+            masking,
+            sigma_rel,
+            colour,
+            halo_weight,
         };
         let material = Material {
             layer: Layer {
@@ -364,6 +453,17 @@ impl ts_material_desc {
             },
             eta_rgb: [0, 1, 2].map(|k| Complex::new(self.eta_re[k], self.eta_im[k])),
         };
+        if material.layer.base == BaseLayer::Conductor {
+            // A conductor has no base layer: its albedo field must stay 0.
+            validate::check(
+                "albedo",
+                validate::widen(albedo),
+                Domain::Closed(0.0, 0.0),
+                "a conductor has no base layer",
+            )
+            .map_err(invalid)?;
+        }
+        material.validate().map_err(invalid)?;
         Ok((material, options))
     }
 
@@ -376,6 +476,7 @@ impl ts_material_desc {
         };
         let s = material.layer.surface;
         ts_material_desc {
+            size: desc_size(),
             beta: s.beta,
             p: s.p,
             sigma_s: s.sigma_s,
@@ -414,16 +515,29 @@ fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
 
 /// Builds the material handle of `material` from the set behind `t`.
 fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
-    let rgb: Rgb<'_> = t.inner.set().rgb(material, options);
+    let rgb = Rgb::boxed(&t.inner.set().brdf_tables(), material, options);
     // SAFETY: `rgb` borrows only the `TableSet` inside the `Arc` allocation
     // (which never moves) and, through it, the table storage it owns. The
     // handle keeps a clone of that `Arc` in `_tables`, dropped after `rgb`
     // (field order), so the borrow never dangles.
-    let rgb = unsafe { std::mem::transmute::<Rgb<'_>, Rgb<'static>>(rgb) };
+    let rgb = unsafe {
+        std::mem::transmute::<Rgb<'_, Box<ChannelBake>>, Rgb<'static, Box<ChannelBake>>>(rgb)
+    };
     Box::new(ts_material {
         rgb,
         _tables: Arc::clone(&t.inner),
     })
+}
+
+/// The library's version, `"MAJOR.MINOR.PATCH"` (static storage).
+#[unsafe(no_mangle)]
+pub extern "C" fn ts_version() -> *const c_char {
+    const VERSION: &CStr =
+        match CStr::from_bytes_with_nul(concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes()) {
+            Ok(version) => version,
+            Err(_) => panic!("the package version holds a NUL"),
+        };
+    VERSION.as_ptr()
 }
 
 /// The message of this thread's last failure (an empty string if none). The
@@ -584,8 +698,9 @@ pub unsafe extern "C" fn ts_rgb_wavelengths(out: *mut f32) -> c_int {
     })
 }
 
-/// Fills `out` with preset `name`'s parameters and the default options (a
-/// starting point for `ts_material_new`).
+/// Fills `out` with preset `name`'s parameters and the default options, and
+/// `out->size` with `sizeof(ts_material_desc)` (a starting point for
+/// `ts_material_new`).
 ///
 /// # Safety
 ///
@@ -635,10 +750,12 @@ pub unsafe extern "C" fn ts_material_preset(
 }
 
 /// The material `desc` describes. Construction bakes per-material tables
-/// (milliseconds): build once per material, not per evaluation. The model
-/// (~136 KB) is built on the calling thread's stack before it moves to the
-/// heap, so call `ts_material_*` from a thread whose stack is well above
-/// that. NULL on failure (`TS_ERR_INVALID` names the field).
+/// (milliseconds): build once per material, not per evaluation. The tables
+/// (~136 KB) are allocated on the heap and filled in place: any thread may
+/// build materials (a 64 KiB stack is enough). NULL on failure
+/// (`TS_ERR_INVALID`: `desc->size` is not `sizeof(ts_material_desc)`, an
+/// unknown enumeration value, or a number outside its domain; the message
+/// names the field, its value and its domain).
 ///
 /// # Safety
 ///
@@ -654,8 +771,22 @@ pub unsafe extern "C" fn ts_material_new(
         if !desc.is_aligned() {
             return Err(Fail::new(TS_ERR_MISALIGNED, "desc is misaligned"));
         }
-        // SAFETY: non-null, aligned, readable by the caller's contract; every
-        // field is a plain number, so any bit pattern is a valid value.
+        // SAFETY: non-null, aligned, and by the caller's contract readable
+        // for at least the `size` field, which every layout starts with.
+        let size = unsafe { std::ptr::addr_of!((*desc).size).read() };
+        if size != desc_size() {
+            return Err(Fail::new(
+                TS_ERR_INVALID,
+                format!(
+                    "ts_material_desc.size = {size} is not sizeof(ts_material_desc) = {} \
+                     of this library (set it to sizeof(ts_material_desc))",
+                    desc_size()
+                ),
+            ));
+        }
+        // SAFETY: as above, and `size` says the caller's struct is this
+        // layout; every field is a plain number, so any bit pattern is a
+        // valid value.
         let desc = unsafe { desc.read() };
         let (material, options) = desc.to_model()?;
         // SAFETY: non-null, a live handle by the caller's contract.
@@ -767,7 +898,7 @@ pub unsafe extern "C" fn ts_eval_rgb_batch(
         for j in 0..n {
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, o) = unsafe { (read3(wi, j, "wi")?, read3(wo, j, "wo")?) };
-            let value = m.rgb.eval(i, o);
+            let value = Bxdf::eval(&m.rgb, i, o);
             for (k, v) in value.iter().enumerate() {
                 // SAFETY: as above; element-wise writes allow aliasing.
                 unsafe { out.add(3 * j + k).write(*v) };
@@ -803,7 +934,7 @@ pub unsafe extern "C" fn ts_pdf_batch(
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, o) = unsafe { (read3(wi, j, "wi")?, read3(wo, j, "wo")?) };
             // SAFETY: checked pointer; the caller gives n floats.
-            unsafe { pdf.add(j).write(m.rgb.pdf(i, o)) };
+            unsafe { pdf.add(j).write(Bxdf::pdf(&m.rgb, i, o)) };
         }
         Ok(())
     })
@@ -837,7 +968,7 @@ pub unsafe extern "C" fn ts_sample_rgb_batch(
         for j in 0..n {
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, u) = unsafe { (read3(wi, j, "wi")?, read3(u, j, "u")?) };
-            let sample = match m.rgb.sample(i, u) {
+            let sample = match Bxdf::sample(&m.rgb, i, u) {
                 Some(s) => ts_sample {
                     wo: s.o,
                     pdf: s.pdf,
@@ -889,9 +1020,79 @@ mod tests {
                 assert_eq!((back, back_options), (material, *options), "{name}");
             }
         }
-        let zero = ts_material_desc::default().to_model().ok().expect("zeroed");
-        assert_eq!(zero.1, Options::default());
-        assert_eq!(zero.0.layer.base, BaseLayer::Conductor);
+        // Zeroed enumeration fields are the defaults; zeroed numbers are not
+        // a surface (β = 0 is outside the EPD's domain).
+        let zero = ts_material_desc {
+            beta: 0.3,
+            p: 1.0,
+            c: 2.0,
+            eta_re: [1.5; 3],
+            ..ts_material_desc::default()
+        };
+        let (material, options) = zero.to_model().ok().expect("zeroed enumerations");
+        assert_eq!(options, Options::default());
+        assert_eq!(material.layer.base, BaseLayer::Conductor);
+        let Err(Fail(code, message)) = ts_material_desc::default().to_model() else {
+            panic!("β = 0 accepted");
+        };
+        assert_eq!(code, TS_ERR_INVALID);
+        assert!(
+            message.starts_with("ts_material_desc.beta = 0: must be in"),
+            "{message}"
+        );
+    }
+
+    /// Each parameter outside the runtime's domain is rejected with the
+    /// runtime validation's message, naming the description's field.
+    #[test]
+    fn out_of_domain_descriptions_are_rejected() {
+        let gold = twoscale::materials::preset("gold-rough").expect("preset");
+        let base = ts_material_desc::from_model(&gold, Options::default());
+        type Edit = fn(&mut ts_material_desc);
+        let cases: [(Edit, &str); 9] = [
+            (
+                |d| d.beta = -0.1,
+                "ts_material_desc.beta = -0.1: must be in",
+            ),
+            (
+                |d| d.p = 100.0,
+                "ts_material_desc.p = 100: must be in [0.2, 5]",
+            ),
+            (
+                |d| d.c = 0.5,
+                "ts_material_desc.c = 0.5: must be finite and > 1",
+            ),
+            (
+                |d| d.sigma_s = -1.0,
+                "ts_material_desc.sigma_s = -1: must be finite and ≥ 0",
+            ),
+            (
+                |d| d.b = -5.0,
+                "ts_material_desc.b = -5: must be finite and ≥ 0",
+            ),
+            (
+                |d| d.base_albedo = 0.5,
+                "ts_material_desc.base_albedo = 0.5",
+            ),
+            (|d| d.eta_im[1] = -1.0, "ts_material_desc.eta_im[1] = -1"),
+            (
+                |d| d.eta_re[2] = f32::NAN,
+                "ts_material_desc.eta_re[2] = NaN",
+            ),
+            (|d| d.lambertian = 2.0, "ts_material_desc.lambertian = 2"),
+        ];
+        assert_eq!(base.base, TS_BASE_CONDUCTOR);
+        for (edit, want) in cases {
+            let mut desc = base;
+            edit(&mut desc);
+            match desc.to_model() {
+                Err(Fail(code, message)) => {
+                    assert_eq!(code, TS_ERR_INVALID, "{message}");
+                    assert!(message.starts_with(want), "{message} (want {want})");
+                }
+                Ok(_) => panic!("accepted: {desc:?} (want {want})"),
+            }
+        }
     }
 
     #[test]

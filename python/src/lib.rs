@@ -19,7 +19,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
+    BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
 };
 use twoscale::epd::{BETA_RANGE, P_RANGE};
 use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
@@ -214,15 +214,18 @@ type SampleArrays<'py> = (
 /// arrays of directions.
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
-    model: Box<Rgb<'static>>,
+    model: Box<Rgb<'static, Box<ChannelBake>>>,
     material: twoscale::brdf::Material,
     options: Options,
 }
 
 impl Material {
+    /// The model of `material`, its bakes allocated zeroed on the heap and
+    /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
+    /// is enough (`tests/test_small_stack.py`).
     fn build(material: twoscale::brdf::Material, options: Options) -> Self {
         Material {
-            model: Box::new(TABLES.rgb(&material, options)),
+            model: Box::new(Rgb::boxed(&TABLES.brdf_tables(), &material, options)),
             material,
             options,
         }

@@ -16,6 +16,7 @@
 
 mod bake;
 pub mod brdf;
+pub mod bxdf;
 pub mod conv;
 pub mod epd;
 pub mod format;
@@ -36,6 +37,7 @@ mod test_rng;
 pub mod validate;
 
 pub use brdf::{Rgb, TwoScale};
+pub use bxdf::{Bxdf, BxdfFlags, BxdfSample};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};

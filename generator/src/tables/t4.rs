@@ -47,7 +47,7 @@ use crate::analytic::{BeckmannCt, StandIn};
 use crate::materials::{Base, Material, Materials};
 use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
-use crate::sh::{IsotropicBrdf, default_quadrature, project};
+use crate::sh::{IsotropicBrdf, Runtime, default_quadrature, project};
 
 /// The workspace's table directory (the studies and tests read it; the
 /// generator's defaults never do).
@@ -176,16 +176,9 @@ impl ModelInputs {
     }
 }
 
-/// The runtime two-scale model as an [`IsotropicBrdf`]: `ρ(wi, wo)` =
-/// `TwoScale::eval` at the directions rounded to f32, widened to f64.
-#[derive(Clone)]
-pub struct TwoScaleBrdf<'a>(pub TwoScale<'a>);
-
-impl IsotropicBrdf for TwoScaleBrdf<'_> {
-    fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
-        f64::from(self.0.eval(wi.map(|v| v as f32), wo.map(|v| v as f32)))
-    }
-}
+/// The runtime two-scale model as an [`IsotropicBrdf`] (through its
+/// [`twoscale::Bxdf`] interface).
+pub type TwoScaleBrdf<'a> = Runtime<TwoScale<'a>>;
 
 /// The runtime layer of `material` at `channel`: the surface, the base with
 /// that channel's albedo, the Lambertian term.
@@ -218,7 +211,7 @@ pub fn two_scale_brdf<'a>(
     tables: &Tables<'a>,
 ) -> TwoScaleBrdf<'a> {
     let eta = Complex::new(material.n[channel] as f32, material.k[channel] as f32);
-    TwoScaleBrdf(TwoScale::new(
+    Runtime(TwoScale::new(
         tables,
         runtime_layer(material, channel),
         wavelength as f32,
