@@ -10,6 +10,8 @@
 //! evaluated; batches of 2048 rows or more (`PARALLEL_ROWS`) are split over
 //! rayon's threads.
 
+mod merl;
+
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
@@ -731,5 +733,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(conv, m)?)?;
     m.add_function(wrap_pyfunction!(fresnel, m)?)?;
     m.add_function(wrap_pyfunction!(brdf, m)?)?;
+    merl::register(m)?;
     Ok(())
 }
