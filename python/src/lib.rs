@@ -247,7 +247,7 @@ impl Material {
     fn new(
         beta: f32,
         p: f32,
-        eta: Vec<(f32, f32)>,
+        eta: Vec<[f32; 2]>, // any sequence of (n, k) sequences: tuples, or lists from TOML
         sigma_s: f32,
         b: f32,
         c: f32,
@@ -260,12 +260,17 @@ impl Material {
         halo_weight: &str,
     ) -> PyResult<Self> {
         let surface = surface(beta, p, sigma_s, b, c)?;
-        let [r, g, bl]: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
-            value_error(format!(
-                "eta must be three (n, k) pairs (red, green, blue), got {}",
-                e.len()
-            ))
-        })?;
+        let [r, g, bl]: [(f32, f32); 3] = eta
+            .into_iter()
+            .map(|[n, k]| (n, k))
+            .collect::<Vec<_>>()
+            .try_into()
+            .map_err(|e: Vec<_>| {
+                value_error(format!(
+                    "eta must be three (n, k) pairs (red, green, blue), got {}",
+                    e.len()
+                ))
+            })?;
         let eta_rgb = [
             complex_index("eta[0]", r.0, r.1)?,
             complex_index("eta[1]", g.0, g.1)?,

@@ -4,7 +4,9 @@
 //! bin, θd bin, φd bin), the bin of direction pairs and the bin centres.
 
 use numpy::ndarray::{Array1, Array2, Array4};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray2, PyReadonlyArray4};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray4,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -107,25 +109,35 @@ fn merl_index<'py>(
     Ok(Array1::from_vec(index).into_pyarray(py))
 }
 
-/// merl_bin_centres(): (wi, wo), each (1 458 000, 3) float64, the incident
-/// and outgoing directions at every bin's centre (φh = 0), in bin order.
+/// merl_bin_centres(bins): (wi, wo), each (N, 3) float64, the incident and
+/// outgoing directions at the centre (φh = 0) of each bin of `bins`
+/// ((N,) int64), or of every bin in order when `bins` is None.
 #[pyfunction]
-fn merl_bin_centres(py: Python<'_>) -> (Bound<'_, PyArray2<f64>>, Bound<'_, PyArray2<f64>>) {
+#[pyo3(signature = (bins=None))]
+fn merl_bin_centres<'py>(
+    py: Python<'py>,
+    bins: Option<PyReadonlyArray1<'py, i64>>,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let bins: Vec<i64> = match bins {
+        Some(b) => b.as_array().to_vec(),
+        None => (0..merl::BINS as i64).collect(),
+    };
     let (mut wi, mut wo) = (
-        Array2::zeros((merl::BINS, 3)),
-        Array2::zeros((merl::BINS, 3)),
+        Array2::zeros((bins.len(), 3)),
+        Array2::zeros((bins.len(), 3)),
     );
-    for k in 0..merl::BINS {
-        // k < BINS: bin_centre is Some.
-        if let Some(centre) = merl::bin_centre(k) {
-            let (i, o) = merl::vectors_of_half_diff(centre);
-            for c in 0..3 {
-                wi[[k, c]] = i[c];
-                wo[[k, c]] = o[c];
-            }
+    for (row, &k) in bins.iter().enumerate() {
+        let centre = usize::try_from(k)
+            .ok()
+            .and_then(merl::bin_centre)
+            .ok_or_else(|| value_error(format!("bin {k} is outside 0..{}", merl::BINS)))?;
+        let (i, o) = merl::vectors_of_half_diff(centre);
+        for c in 0..3 {
+            wi[[row, c]] = i[c];
+            wo[[row, c]] = o[c];
         }
     }
-    (wi.into_pyarray(py), wo.into_pyarray(py))
+    Ok((wi.into_pyarray(py), wo.into_pyarray(py)))
 }
 
 /// Adds the MERL functions and constants to the extension module.

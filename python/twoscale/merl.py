@@ -104,12 +104,15 @@ def lookup(values, wi, wo) -> np.ndarray:
     return flat[:, index(wi, wo)].T
 
 
-def bin_centres() -> tuple[np.ndarray, np.ndarray]:
-    """``(wi, wo)``, each ``(BINS, 3)`` float64: the directions at every
-    bin's centre, θh = (π/2)((ih + ½)/90)², θd = (π/2)(id + ½)/90,
-    φd = π(iφ + ½)/180, φh = 0, in bin order. Some lie below the horizon
-    (``z < 0``); such bins hold no measurement."""
-    return _native.merl_bin_centres()
+def bin_centres(bins=None) -> tuple[np.ndarray, np.ndarray]:
+    """``(wi, wo)``, each ``(N, 3)`` float64: the directions at the centre
+    of each bin of ``bins`` (integers in ``[0, BINS)``; all bins in order
+    when None), θh = (π/2)((ih + ½)/90)², θd = (π/2)(id + ½)/90,
+    φd = π(iφ + ½)/180, φh = 0. Some lie below the horizon (``z < 0``);
+    such bins hold no measurement."""
+    if bins is None:
+        return _native.merl_bin_centres()
+    return _native.merl_bin_centres(np.ascontiguousarray(bins, dtype=np.int64))
 
 
 def tabulate(brdf, chunk: int = 1 << 18) -> np.ndarray:
