@@ -109,6 +109,9 @@ fn merl_index<'py>(
     Ok(Array1::from_vec(index).into_pyarray(py))
 }
 
+/// `(wi, wo)` arrays of directions.
+type DirectionPair<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// merl_bin_centres(bins): (wi, wo), each (N, 3) float64, the incident and
 /// outgoing directions at the centre (φh = 0) of each bin of `bins`
 /// ((N,) int64), or of every bin in order when `bins` is None.
@@ -117,7 +120,7 @@ fn merl_index<'py>(
 fn merl_bin_centres<'py>(
     py: Python<'py>,
     bins: Option<PyReadonlyArray1<'py, i64>>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<DirectionPair<'py>> {
     let bins: Vec<i64> = match bins {
         Some(b) => b.as_array().to_vec(),
         None => (0..merl::BINS as i64).collect(),
