@@ -221,7 +221,7 @@ def main():
     rng = np.random.default_rng(a.seed)
     log = lambda *x: print(*x, file=sys.stderr, flush=True)  # noqa: E731
     log(f"load average {os.getloadavg()}")
-    rows = recovery(a.materials, rng, log)
+    rows = recovery(a.materials, rng, log) if a.materials else []
     print("| material | file | β | p | σs | b | c | max η | rel. RMS (clean truth) | time (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for j, case, truth, r, err, rel, seconds in rows:

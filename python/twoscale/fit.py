@@ -28,8 +28,9 @@ c − 1, n, k; albedo and k_d linear in [0, 1]), on a stratified subsample of
 looked up with :func:`twoscale.merl.lookup`, missing ones dropped),
 started from a moment-based guess (β and p from the backscattering lobe,
 θd ≈ 0: ln(q0/q) = (tan²θh/β²)^p with q = ρ cos⁶θh; F0 from the peak) and
-from ``starts − 1`` variants of it (diffraction on/off, other n), each run
-briefly; the best is refined. Keywords of ``start`` (``beta=``, ``p=``,
+from ``starts − 1`` variants of it (diffraction off; β = 0.1, p = 1;
+diffraction on; other n), each run for ``START_NFEV`` iterations; the best
+is refined. Keywords of ``start`` (``beta=``, ``p=``,
 ``sigma_s=``, ``b=``, ``c=``, ``eta=``, ``albedo=``, ``lambertian=``) replace
 the guess; ``fixed=`` names parameters held at their start. ``epd=True`` is
 the plain EPD Cook–Torrance model (σs = 0), HP17 Table 1's "EPD" row.
@@ -408,7 +409,11 @@ def fit(
     # Starts: the guess, then diffraction off/on and other indices.
     variants = [{}]
     if not epd and "sigma_s" not in start:
-        variants += [{"sigma_s": 1e-4}, {"sigma_s": 0.05, "b": 5.0}]
+        variants += [{"sigma_s": 1e-4}]
+    if "beta" not in start and "p" not in start:
+        variants += [{"beta": 0.1, "p": 1.0}]
+    if not epd and "sigma_s" not in start:
+        variants += [{"sigma_s": 0.05, "b": 5.0}]
     if base == "conductor" and "eta" not in start:
         variants += [{f"n{j}": 1.5 for j in range(3)} | {f"k{j}": 3.0 for j in range(3)}]
     variants = variants[: max(1, starts)]

@@ -22,7 +22,7 @@
 //! works on angles or direction vectors, [`decode`] and [`encode`] read and
 //! write a whole file between a byte slice and a caller's `f64` buffer (the
 //! stored, unscaled values, so a decode/encode round trip is byte-exact).
-//! [`read_file`] and [`write_file`] (feature `std`) do the same on paths.
+//! `read_file` and `write_file` (feature `std`) do the same on paths.
 
 use crate::math::{acos, atan2, cos, sin, sqrt};
 use core::f64::consts::PI;
