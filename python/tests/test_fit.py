@@ -13,7 +13,7 @@ import pytest
 
 import twoscale
 from twoscale import merl
-from twoscale.fit import fit, grazing, stratified_directions
+from twoscale.fit import fit, grazing, load, stratified_directions
 
 TRUTH = dict(beta=0.12, p=1.4, sigma_s=0.02, b=3.0, c=2.5, eta=[(0.3, 3.0), (0.6, 2.4), (1.2, 1.8)])
 
@@ -75,7 +75,8 @@ def test_command_line_fits_a_file(tmp_path, model_file, writer):
     )
     data = tomllib.loads(out.read_text())
     assert abs(data["material"]["beta"] / TRUTH["beta"] - 1) < 0.1
-    twoscale.Material(**data["material"])
+    loaded = load(out)
+    assert loaded.beta == pytest.approx(data["material"]["beta"], rel=1e-6)
 
 
 def test_mitsuba_beckmann_comes_back_as_p_1_and_beta_alpha():

@@ -30,7 +30,10 @@ started from a moment-based guess (β and p from the backscattering lobe,
 θd ≈ 0: ln(q0/q) = (tan²θh/β²)^p with q = ρ cos⁶θh; F0 from the peak) and
 from ``starts − 1`` variants of it (diffraction off; β = 0.1, p = 1;
 diffraction on; other n), each run for ``START_NFEV`` iterations; the best
-is refined. Keywords of ``start`` (``beta=``, ``p=``,
+is refined. The two-scale fit from the guess alone (no ``start``) first
+fits the EPD model (its σs → 0 limit) and starts from that with
+diffraction off and on, then from the guess, so it is never worse than the
+EPD fit on its own samples. Keywords of ``start`` (``beta=``, ``p=``,
 ``sigma_s=``, ``b=``, ``c=``, ``eta=``, ``albedo=``, ``lambertian=``) replace
 the guess; ``fixed=`` names parameters held at their start. ``epd=True`` is
 the plain EPD Cook–Torrance model (σs = 0), HP17 Table 1's "EPD" row.
@@ -406,8 +409,15 @@ def fit(
     def x_of(flat):
         return np.clip([_to_x(n, flat[n], base) for n in names], lo + 1e-9, hi - 1e-9)
 
-    # Starts: the guess, then diffraction off/on and other indices.
+    # Starts: the guess, then diffraction off/on and other indices; for the
+    # two-scale model from the guess alone, the EPD fit (its σs → 0 limit)
+    # first, with diffraction off and on.
     variants = [{}]
+    if not epd and not start and starts > 1:
+        e = fit(measured, base, samples=samples, starts=starts, grazing_k=grazing_k, epd=True,
+                lambertian=lambertian, fixed=fixed, seed=seed, max_nfev=max_nfev, verbose=verbose)
+        from_epd = {k: v for k, v in _flat(e.keywords).items() if k in names}
+        variants = [from_epd | {"sigma_s": 1e-4}, from_epd | {"sigma_s": 0.02, "b": 2.0}, {}]
     if not epd and "sigma_s" not in start:
         variants += [{"sigma_s": 1e-4}]
     if "beta" not in start and "p" not in start:
@@ -440,6 +450,15 @@ def fit(
     seconds = time.perf_counter() - t0
     log(f"  done in {seconds:.1f} s: " + ", ".join(f"{k}={v:.4g}" for k, v in _flat(keywords).items()))
     return Fit(material, keywords, m, float(best.cost), seconds, len(s.wi))
+
+
+def load(path) -> Material:
+    """The material of a fit's TOML (its ``[material]`` table); for Mitsuba,
+    ``mi.load_dict(twoscale.mitsuba.bsdf_dict(load(path)))``."""
+    import tomllib
+
+    with open(path, "rb") as f:
+        return Material(**tomllib.load(f)["material"])
 
 
 def main(argv=None):
