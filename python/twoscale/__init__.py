@@ -12,6 +12,6 @@ towards the light and ``wo`` towards the viewer. Lengths are in µm.
 
 from . import lookup, merl, reference
 from ._native import RGB_WAVELENGTHS, Material
-from .fit import fit  # noqa: E402  (the function; ``twoscale.fit`` module: python -m)
+from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
 __all__ = ["Material", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference"]
