@@ -10,6 +10,8 @@
 //! evaluated; batches of 2048 rows or more (`PARALLEL_ROWS`) are split over
 //! rayon's threads.
 
+mod merl;
+
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
@@ -248,7 +250,7 @@ impl Material {
     fn new(
         beta: f32,
         p: f32,
-        eta: Vec<(f32, f32)>,
+        eta: Vec<[f32; 2]>, // any sequence of (n, k) sequences: tuples, or lists from TOML
         sigma_s: f32,
         b: f32,
         c: f32,
@@ -261,12 +263,17 @@ impl Material {
         halo_weight: &str,
     ) -> PyResult<Self> {
         let surface = surface(beta, p, sigma_s, b, c)?;
-        let [r, g, bl]: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
-            value_error(format!(
-                "eta must be three (n, k) pairs (red, green, blue), got {}",
-                e.len()
-            ))
-        })?;
+        let [r, g, bl]: [(f32, f32); 3] = eta
+            .into_iter()
+            .map(|[n, k]| (n, k))
+            .collect::<Vec<_>>()
+            .try_into()
+            .map_err(|e: Vec<_>| {
+                value_error(format!(
+                    "eta must be three (n, k) pairs (red, green, blue), got {}",
+                    e.len()
+                ))
+            })?;
         let eta_rgb = [
             complex_index("eta[0]", r.0, r.1)?,
             complex_index("eta[1]", g.0, g.1)?,
@@ -734,5 +741,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(conv, m)?)?;
     m.add_function(wrap_pyfunction!(fresnel, m)?)?;
     m.add_function(wrap_pyfunction!(brdf, m)?)?;
+    merl::register(m)?;
     Ok(())
 }

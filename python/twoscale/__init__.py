@@ -10,7 +10,8 @@ Directions are unit vectors in the local frame (normal +z); ``wi`` points
 towards the light and ``wo`` towards the viewer. Lengths are in µm.
 """
 
-from . import lookup, reference
+from . import lookup, merl, reference
 from ._native import RGB_WAVELENGTHS, Material
+from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
-__all__ = ["Material", "RGB_WAVELENGTHS", "lookup", "reference"]
+__all__ = ["Material", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference"]

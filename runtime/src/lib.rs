@@ -27,6 +27,7 @@ pub mod interp;
 pub mod kcorr;
 pub mod materials;
 pub mod math;
+pub mod merl;
 #[cfg(feature = "std")]
 pub mod mmap;
 pub mod sh;
