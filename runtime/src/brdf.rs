@@ -95,6 +95,41 @@ pub enum BaseLayer {
     },
 }
 
+/// The kind of a [`BaseLayer`], without its albedo (named by
+/// [`crate::validate::Named`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BaseKind {
+    /// [`BaseLayer::Conductor`] (the default).
+    #[default]
+    Conductor,
+    /// [`BaseLayer::Plastic`].
+    Plastic,
+    /// [`BaseLayer::Subsurface`].
+    Subsurface,
+}
+
+impl BaseKind {
+    /// The base layer of this kind with diffuse `albedo` (ignored by a conductor).
+    pub fn with_albedo(self, albedo: f32) -> BaseLayer {
+        match self {
+            BaseKind::Conductor => BaseLayer::Conductor,
+            BaseKind::Plastic => BaseLayer::Plastic { albedo },
+            BaseKind::Subsurface => BaseLayer::Subsurface { albedo },
+        }
+    }
+}
+
+impl BaseLayer {
+    /// Its kind.
+    pub fn kind(&self) -> BaseKind {
+        match self {
+            BaseLayer::Conductor => BaseKind::Conductor,
+            BaseLayer::Plastic { .. } => BaseKind::Plastic,
+            BaseLayer::Subsurface { .. } => BaseKind::Subsurface,
+        }
+    }
+}
+
 /// A layered material at one wavelength's worth of geometry: the surface, its
 /// base layer and an optional Lambertian term `k_d/π`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -98,6 +98,7 @@ use crate::format::{
 };
 use crate::interp::Axis;
 use crate::math::{self, Real};
+use crate::validate::{self, Domain, Invalid};
 
 /// A source of `C(θh; u, c, β, p)` (docs/model.md §2.5).
 ///
@@ -611,6 +612,20 @@ impl<'a> ConvTable<'a> {
         out.iter_mut().for_each(|v| *v += offsets);
     }
 
+    /// Checks a lookup point against T3's domain (from its header): `c`, `β`,
+    /// `p` within the table's axes, `u ∈ [u_min, ∞]` (beyond `u_max` the
+    /// narrow-kernel rule of the module documentation applies).
+    pub fn check(&self, u: f32, c: f32, beta: f32, p: f32) -> Result<(), Invalid> {
+        let [du, dc, db, dp] = self.domain;
+        let closed =
+            |(lo, hi): (f32, f32)| Domain::Closed(validate::widen(lo), validate::widen(hi));
+        let u_domain = Domain::Closed(validate::widen(du.0), f64::INFINITY);
+        validate::check("u", validate::widen(u), u_domain, "T3's domain")?;
+        validate::check("c", validate::widen(c), closed(dc), "T3's domain")?;
+        validate::check("beta", validate::widen(beta), closed(db), "T3's domain")?;
+        validate::check("p", validate::widen(p), closed(dp), "T3's domain")
+    }
+
     /// The paper's form (T3a) from the same file.
     pub fn fit(&self) -> ConvFitTable<'a> {
         ConvFitTable { table: *self }
@@ -914,6 +929,11 @@ impl ConvFitTable<'_> {
     /// `(s, g)` at the given parameters; see [`ConvTable::fit_parameters`].
     pub fn parameters(&self, u: f32, c: f32, beta: f32, p: f32) -> (f32, f32) {
         self.table.fit_parameters(u, c, beta, p)
+    }
+
+    /// Checks a lookup point against the file's domain ([`ConvTable::check`]).
+    pub fn check(&self, u: f32, c: f32, beta: f32, p: f32) -> Result<(), Invalid> {
+        self.table.check(u, c, beta, p)
     }
 }
 

@@ -27,6 +27,7 @@
 //! [`DiffuseFresnelTable`] reads T5: `F_dr,int(η) = 2 ∫₀¹ F(1/η, μ) μ dμ` for
 //! η ∈ [1, 3], a 1-D cubic B-spline (layout in its documentation).
 
+use crate::validate::{self, Domain, Invalid};
 use core::ops::{Add, Div, Mul, Sub};
 
 use crate::format::{FormatError, Kernel, Mapping, Table, TableId};
@@ -439,6 +440,12 @@ impl<'a> DiffuseFresnelTable<'a> {
         Ok(DiffuseFresnelTable {
             grid: Grid::new(header, table.grid())?,
         })
+    }
+
+    /// Checks `eta` against T5's domain, the table's η axis ([1, 3]).
+    pub fn check(&self, eta: f32) -> Result<(), Invalid> {
+        let domain = Domain::Closed(validate::widen(ETA_MIN), validate::widen(ETA_MAX));
+        validate::check("eta", validate::widen(eta), domain, "T5's domain")
     }
 
     /// `F_dr,int(η)` (see the type's documentation): the table, with η

@@ -46,6 +46,7 @@
 use crate::format::{FormatError, Kernel, Table, TableId};
 use crate::interp::Grid;
 use crate::math;
+use crate::validate::{self, Domain, Invalid};
 
 /// First B node of T2.
 const B_MIN: f32 = 0.05;
@@ -94,6 +95,24 @@ impl<'a> SigmaRatioTable<'a> {
     #[inline]
     fn ratio_to_normal(&self, cos_theta_i: f32, big_b: f32, c: f32) -> f32 {
         self.grid.interpolate([cos_theta_i, big_b, c], 0)
+    }
+
+    /// Checks a lookup point against T2's domain: `cos θi` and `c` within the
+    /// table's axes (`c > 1`), `B ∈ [0, ∞]` (the rules of the module
+    /// documentation extend the table below and above its B nodes).
+    pub fn check(&self, cos_theta_i: f32, b_over_lambda: f32, c: f32) -> Result<(), Invalid> {
+        let (cos, c_axis) = (self.grid.axis(0), self.grid.axis(2));
+        let cos_domain = Domain::Closed(validate::widen(cos.lo()), validate::widen(cos.hi()));
+        validate::check(
+            "cos_theta_i",
+            validate::widen(cos_theta_i),
+            cos_domain,
+            "T2's domain",
+        )?;
+        let b_domain = Domain::Closed(0.0, f64::INFINITY);
+        validate::check("B", validate::widen(b_over_lambda), b_domain, "T2's domain")?;
+        let c_domain = Domain::LeftOpen(validate::widen(c_axis.lo()), validate::widen(c_axis.hi()));
+        validate::check("c", validate::widen(c), c_domain, "T2's domain")
     }
 
     /// σrel/σs at incidence `theta_i` (radians); see [`Self::sigma_ratio_cos`].

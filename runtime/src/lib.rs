@@ -33,6 +33,7 @@ pub mod smith;
 pub mod table_set;
 #[cfg(test)]
 mod test_rng;
+pub mod validate;
 
 pub use brdf::{Rgb, TwoScale};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
@@ -42,3 +43,4 @@ pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};
 pub use table_set::{TableBytes, TableSet, TableSetError, UnknownMaterial};
+pub use validate::{Domain, Invalid, Named, Shortest, Shortest32};

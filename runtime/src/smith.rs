@@ -33,6 +33,7 @@
 
 use crate::format::{FormatError, Mapping, Table, TableId};
 use crate::interp::{Axis, Grid};
+use crate::validate::{self, Domain, Invalid};
 
 /// T1 viewed in place: `G1(p, ã)` and `k_p` per p node.
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +121,16 @@ impl<'a> SmithG1Table<'a> {
         let g1_last = shape.g1_in_table(shape.axis.hi());
         shape.lambda_last = lambda_from_g1(g1_last);
         shape
+    }
+
+    /// Checks a lookup point against T1's domain: `p` within the table's p
+    /// axis (from its header), `a ∈ [0, ∞]` ([`crate::validate`]).
+    pub fn check(&self, p: f32, a: f32) -> Result<(), Invalid> {
+        let axis = self.grid.axis(0);
+        let p_domain = Domain::Closed(validate::widen(axis.lo()), validate::widen(axis.hi()));
+        validate::check("p", validate::widen(p), p_domain, "T1's domain")?;
+        let a_domain = Domain::Closed(0.0, f64::INFINITY);
+        validate::check("a", validate::widen(a), a_domain, "T1's domain")
     }
 
     /// G1(p, a) with `a = β tan θ` (for repeated lookups at one p, keep a [`SmithShape`]).

@@ -1,0 +1,525 @@
+//! The domain of every parameter, and one validation that every front end
+//! calls (the C API, Python, `generator query`, the generator itself).
+//!
+//! The renderer-facing constructors and `eval`/`sample`/`pdf` clamp their
+//! inputs as each documents: that is their contract, and it keeps them
+//! panic-free. Whoever takes parameters from a user validates them first with
+//! [`Material::validate`] (or the
+//! [`Layer`] and [`Surface`] forms),
+//! [`wavelength`], [`eta`] and, for lookups of a single table, the table's own
+//! `check` ([`SmithG1Table::check`](crate::SmithG1Table::check),
+//! [`SigmaRatioTable::check`](crate::SigmaRatioTable::check),
+//! [`ConvTable::check`](crate::ConvTable::check),
+//! [`DiffuseFresnelTable::check`](crate::DiffuseFresnelTable::check)), whose
+//! domains are read from the table's header. An [`Invalid`] names the
+//! parameter, its value and its domain.
+//!
+//! [`Named`] gives each option's values their one spelling. [`Shortest`]
+//! and [`Shortest32`] print numbers for users in the shortest form
+//! that reads back to the same value.
+
+use crate::brdf::{
+    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, SigmaRelMode, Surface,
+};
+use crate::epd::{BETA_RANGE, P_RANGE};
+use crate::fresnel::Complex;
+use core::fmt;
+
+/// The set a parameter must lie in. NaN lies in none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Domain {
+    /// `lo ≤ x ≤ hi`; a bound may be infinite (`[0, inf]` admits `+∞`).
+    Closed(f64, f64),
+    /// Finite and `x ≥ lo`.
+    AtLeast(f64),
+    /// Finite and `x > lo`.
+    Above(f64),
+    /// Finite and `lo < x ≤ hi`.
+    LeftOpen(f64, f64),
+}
+
+impl Domain {
+    /// Whether `x` lies in the domain.
+    pub fn contains(self, x: f64) -> bool {
+        match self {
+            Domain::Closed(lo, hi) => lo <= x && x <= hi,
+            Domain::AtLeast(lo) => x.is_finite() && x >= lo,
+            Domain::Above(lo) => x.is_finite() && x > lo,
+            Domain::LeftOpen(lo, hi) => x.is_finite() && lo < x && x <= hi,
+        }
+    }
+}
+
+impl fmt::Display for Domain {
+    /// `in [0.2, 5]`, `finite and ≥ 0`, `finite and > 1`, `in (1, 100]`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Domain::Closed(lo, hi) => write!(f, "in [{}, {}]", Shortest(lo), Shortest(hi)),
+            Domain::AtLeast(lo) => write!(f, "finite and ≥ {}", Shortest(lo)),
+            Domain::Above(lo) => write!(f, "finite and > {}", Shortest(lo)),
+            Domain::LeftOpen(lo, hi) => write!(f, "in ({}, {}]", Shortest(lo), Shortest(hi)),
+        }
+    }
+}
+
+/// A parameter outside its domain.
+///
+/// Displays as `p = 0.15: must be in [0.2, 5] (T1's domain)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Invalid {
+    /// The parameter's name as the caller's interface spells it (`beta`,
+    /// `sigma_s`, `eta[1].k`, `lambda`, …).
+    pub name: &'static str,
+    /// The value given.
+    pub value: f64,
+    /// Where it must lie.
+    pub domain: Domain,
+    /// Unit or context appended in parentheses (`µm`, `T1's domain`); may be empty.
+    pub note: &'static str,
+}
+
+impl fmt::Display for Invalid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} = {}: must be {}",
+            self.name,
+            Shortest(self.value),
+            self.domain
+        )?;
+        if !self.note.is_empty() {
+            write!(f, " ({})", self.note)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Invalid {}
+
+/// `Ok(())` if `value` lies in `domain`, else the [`Invalid`] that says so.
+pub fn check(
+    name: &'static str,
+    value: f64,
+    domain: Domain,
+    note: &'static str,
+) -> Result<(), Invalid> {
+    if domain.contains(value) {
+        Ok(())
+    } else {
+        Err(Invalid {
+            name,
+            value,
+            domain,
+            note,
+        })
+    }
+}
+
+/// The wavelengths the model accepts, µm (those [`crate::brdf::TwoScale::new`]
+/// does not clamp).
+pub const WAVELENGTH_DOMAIN: Domain = Domain::Closed(0.01, 100.0);
+
+/// Checks a wavelength `lambda` in µm against [`WAVELENGTH_DOMAIN`].
+pub fn wavelength(lambda: f32) -> Result<(), Invalid> {
+    check("lambda", widen(lambda), WAVELENGTH_DOMAIN, "µm")
+}
+
+/// Checks a complex index of refraction `n + ik`: `n > 0`, `k ≥ 0`, both
+/// finite. `names` are the two parts' names (`("n", "k")`, `("eta[0].n",
+/// "eta[0].k")`).
+pub fn eta(names: (&'static str, &'static str), eta: Complex) -> Result<(), Invalid> {
+    check(names.0, widen(eta.re), Domain::Above(0.0), "")?;
+    check(names.1, widen(eta.im), Domain::AtLeast(0.0), "")
+}
+
+impl Surface {
+    /// Checks the surface against the model's domain: β in
+    /// [`BETA_RANGE`], p in [`P_RANGE`] (T1's), `σs ≥ 0`, `b ≥ 0` and
+    /// `b > 0` when `σs > 0` (the K-correlation spectrum needs a length,
+    /// HP17 16), `c > 1`; all finite.
+    pub fn validate(&self) -> Result<(), Invalid> {
+        let range = |(lo, hi): (f32, f32)| Domain::Closed(widen(lo), widen(hi));
+        check("beta", widen(self.beta), range(BETA_RANGE), "")?;
+        check("p", widen(self.p), range(P_RANGE), "")?;
+        check("sigma_s", widen(self.sigma_s), Domain::AtLeast(0.0), "µm")?;
+        check("b", widen(self.b), Domain::AtLeast(0.0), "µm")?;
+        if self.sigma_s > 0.0 {
+            check(
+                "b",
+                widen(self.b),
+                Domain::Above(0.0),
+                "µm, when sigma_s > 0",
+            )?;
+        }
+        check("c", widen(self.c), Domain::Above(1.0), "")
+    }
+}
+
+impl Layer {
+    /// [`Surface::validate`], and the base layer's albedo and the Lambertian
+    /// `k_d` in [0, 1].
+    pub fn validate(&self) -> Result<(), Invalid> {
+        self.surface.validate()?;
+        match self.base {
+            BaseLayer::Conductor => {}
+            BaseLayer::Plastic { albedo } | BaseLayer::Subsurface { albedo } => {
+                check("albedo", widen(albedo), Domain::Closed(0.0, 1.0), "")?;
+            }
+        }
+        check(
+            "lambertian",
+            widen(self.lambertian),
+            Domain::Closed(0.0, 1.0),
+            "",
+        )
+    }
+}
+
+impl Material {
+    /// [`Layer::validate`] and each channel's index ([`eta`], named
+    /// `eta[0].n` … `eta[2].k`, red, green, blue).
+    pub fn validate(&self) -> Result<(), Invalid> {
+        self.layer.validate()?;
+        const NAMES: [(&str, &str); 3] = [
+            ("eta[0].n", "eta[0].k"),
+            ("eta[1].n", "eta[1].k"),
+            ("eta[2].n", "eta[2].k"),
+        ];
+        for (names, &channel) in NAMES.iter().zip(&self.eta_rgb) {
+            eta(*names, channel)?;
+        }
+        Ok(())
+    }
+}
+
+/// An option whose values have names (the spelling Python keywords, C
+/// enumerator comments and `generator query` columns use): one list per
+/// option, here.
+pub trait Named: Copy + PartialEq + Sized + 'static {
+    /// The option's name (`masking`).
+    const OPTION: &'static str;
+    /// Every value with its name, the default first.
+    const NAMES: &'static [(&'static str, Self)];
+
+    /// The value's name.
+    fn name(self) -> &'static str {
+        Self::NAMES
+            .iter()
+            .find(|(_, v)| *v == self)
+            .map_or("", |(n, _)| n)
+    }
+
+    /// The value called `name` (exact match), if any.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| *v)
+    }
+
+    /// The names, for messages: `'separable' or 'height-correlated'`.
+    fn choices() -> Choices<Self> {
+        Choices(core::marker::PhantomData)
+    }
+}
+
+/// [`Named::choices`]: displays the names of `T`'s values.
+#[derive(Clone, Copy, Debug)]
+pub struct Choices<T>(core::marker::PhantomData<T>);
+
+impl<T: Named> fmt::Display for Choices<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = T::NAMES.len();
+        for (k, (name, _)) in T::NAMES.iter().enumerate() {
+            let sep = match k {
+                0 => "",
+                _ if k + 1 == n => " or ",
+                _ => ", ",
+            };
+            write!(f, "{sep}'{name}'")?;
+        }
+        Ok(())
+    }
+}
+
+impl Named for Masking {
+    const OPTION: &'static str = "masking";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("separable", Masking::Separable),
+        ("height-correlated", Masking::HeightCorrelated),
+    ];
+}
+
+impl Named for SigmaRelMode {
+    const OPTION: &'static str = "sigma_rel";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("incident", SigmaRelMode::Incident),
+        ("symmetrised", SigmaRelMode::Symmetrised),
+    ];
+}
+
+impl Named for ColourTerms {
+    const OPTION: &'static str = "colour";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("physical", ColourTerms::Physical),
+        ("white", ColourTerms::White),
+    ];
+}
+
+impl Named for HaloWeight {
+    const OPTION: &'static str = "halo_weight";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("printed", HaloWeight::Printed),
+        ("incident", HaloWeight::Incident),
+    ];
+}
+
+impl Named for BaseKind {
+    const OPTION: &'static str = "base";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("conductor", BaseKind::Conductor),
+        ("plastic", BaseKind::Plastic),
+        ("subsurface", BaseKind::Subsurface),
+    ];
+}
+
+/// `x` as the `f64` of its shortest decimal form (`0.15f32` → `0.15`, not
+/// `0.15000000596046448`), so that messages show the number the user gave.
+/// NaN and infinities are kept.
+pub fn widen(x: f32) -> f64 {
+    if !x.is_finite() {
+        return f64::from(x);
+    }
+    let mut buffer = Buffer::default();
+    // `{:e}` of an f32 is at most 15 bytes (`-1.1754944e-38`).
+    let written = fmt::Write::write_fmt(&mut buffer, format_args!("{x:e}"));
+    let text = buffer.bytes.get(..buffer.len).unwrap_or(&[]);
+    match (written, core::str::from_utf8(text).map(str::parse::<f64>)) {
+        (Ok(()), Ok(Ok(wide))) => wide,
+        _ => f64::from(x),
+    }
+}
+
+/// A small stack buffer for [`widen`].
+#[derive(Default)]
+struct Buffer {
+    bytes: [u8; 32],
+    len: usize,
+}
+
+impl fmt::Write for Buffer {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        let end = self.len + s.len();
+        let slot = self.bytes.get_mut(self.len..end).ok_or(fmt::Error)?;
+        slot.copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+/// Displays an `f64` in the shortest form that parses back to the same
+/// value: positional for magnitudes in `[1e-5, 1e16)`, else exponent form
+/// (`3.5449073e-30`). Integers print without a fraction (`32`), infinities
+/// as `inf` and `-inf` (what Rust and Python parse).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shortest(pub f64);
+
+/// [`Shortest`] for an `f32` (shortest form of the `f32` value: `0.0774`,
+/// not `0.07739999890327454`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shortest32(pub f32);
+
+/// Whether `x` is printed positionally (else in exponent form).
+fn positional(x: f64) -> bool {
+    let a = x.abs();
+    a == 0.0 || !a.is_finite() || (1e-5..1e16).contains(&a)
+}
+
+impl fmt::Display for Shortest {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x.is_infinite() {
+            f.write_str(if x > 0.0 { "inf" } else { "-inf" })
+        } else if positional(x) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
+impl fmt::Display for Shortest32 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x.is_infinite() {
+            f.write_str(if x > 0.0 { "inf" } else { "-inf" })
+        } else if positional(f64::from(x)) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::{BaseLayer, Layer, Material, Surface};
+
+    fn gold() -> Material {
+        Material {
+            layer: Layer {
+                surface: Surface {
+                    beta: 0.1,
+                    p: 1.0,
+                    sigma_s: 0.02,
+                    b: 3.0,
+                    c: 1.6,
+                },
+                base: BaseLayer::Conductor,
+                lambertian: 0.0,
+            },
+            eta_rgb: [Complex::new(0.2, 3.5); 3],
+        }
+    }
+
+    #[test]
+    fn a_valid_material_passes() {
+        assert_eq!(gold().validate(), Ok(()));
+    }
+
+    /// Each bad input the C API used to accept (issue 23) is refused, naming
+    /// the parameter.
+    #[test]
+    fn each_bad_parameter_is_named() {
+        type Spoil = fn(&mut Material);
+        let cases: [(&str, Spoil); 12] = [
+            ("beta", |m| m.layer.surface.beta = -0.1),
+            ("p", |m| m.layer.surface.p = 100.0),
+            ("p", |m| m.layer.surface.p = f32::NAN),
+            ("c", |m| m.layer.surface.c = 0.5),
+            ("c", |m| m.layer.surface.c = 1.0),
+            ("sigma_s", |m| m.layer.surface.sigma_s = -1.0),
+            ("b", |m| m.layer.surface.b = -5.0),
+            ("b", |m| m.layer.surface.b = 0.0),
+            ("albedo", |m| {
+                m.layer.base = BaseLayer::Plastic { albedo: 1.5 }
+            }),
+            ("lambertian", |m| m.layer.lambertian = -0.1),
+            ("eta[1].n", |m| m.eta_rgb[1] = Complex::new(-1.0, 0.0)),
+            ("eta[2].k", |m| {
+                m.eta_rgb[2] = Complex::new(1.5, f32::INFINITY)
+            }),
+        ];
+        for (name, spoil) in cases {
+            let mut m = gold();
+            spoil(&mut m);
+            let err = m.validate().expect_err(name);
+            assert_eq!(err.name, name, "{err}");
+        }
+    }
+
+    #[test]
+    fn b_zero_is_fine_without_diffraction() {
+        let mut m = gold();
+        m.layer.surface.sigma_s = 0.0;
+        m.layer.surface.b = 0.0;
+        assert_eq!(m.validate(), Ok(()));
+    }
+
+    #[test]
+    fn messages_name_value_and_domain() {
+        let err = check("p", 0.15, Domain::Closed(0.2, 5.0), "T1's domain").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "p = 0.15: must be in [0.2, 5] (T1's domain)"
+        );
+        let err = wavelength(-0.25).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "lambda = -0.25: must be in [0.01, 100] (µm)"
+        );
+        let err = check("a", f64::NAN, Domain::Closed(0.0, f64::INFINITY), "").unwrap_err();
+        assert_eq!(err.to_string(), "a = NaN: must be in [0, inf]");
+        assert!(Domain::Closed(0.0, f64::INFINITY).contains(f64::INFINITY));
+        assert!(!Domain::AtLeast(0.0).contains(f64::INFINITY));
+        assert!(!Domain::LeftOpen(1.0, 2.0).contains(1.0));
+    }
+
+    #[test]
+    fn names_round_trip() {
+        fn all<T: Named + core::fmt::Debug>() {
+            for &(name, value) in T::NAMES {
+                assert_eq!(value.name(), name);
+                assert_eq!(T::from_name(name), Some(value));
+            }
+            assert_eq!(T::from_name("no such value"), None);
+        }
+        all::<Masking>();
+        all::<SigmaRelMode>();
+        all::<ColourTerms>();
+        all::<HaloWeight>();
+        all::<BaseKind>();
+        assert_eq!(Masking::NAMES[0].1, Masking::default());
+        assert_eq!(
+            BaseKind::choices().to_string(),
+            "'conductor', 'plastic' or 'subsurface'"
+        );
+    }
+
+    #[test]
+    fn shortest_round_trips() {
+        let s = |x: f64| Shortest(x).to_string();
+        assert_eq!(s(3.5449073e-30), "3.5449073e-30");
+        assert_eq!(s(0.0774), "0.0774");
+        assert_eq!(s(32.0), "32");
+        assert_eq!(s(-1.5e20), "-1.5e20");
+        assert_eq!(s(0.0), "0");
+        assert_eq!(Shortest32(0.0774).to_string(), "0.0774");
+        assert_eq!(Shortest32(1.0e-30).to_string(), "1e-30");
+        for x in [0.15f32, 0.2, -1.1754944e-38, f32::MAX, 3.4e-45, 5.0] {
+            assert_eq!(widen(x) as f32, x);
+            assert_eq!(Shortest(widen(x)).to_string(), Shortest32(x).to_string());
+        }
+        let mut rng = crate::test_rng::Lcg(7);
+        for _ in 0..10_000 {
+            rng.next();
+            let x = f64::from_bits(rng.0);
+            if x.is_finite() {
+                assert_eq!(s(x).parse::<f64>().unwrap(), x);
+            }
+        }
+    }
+
+    /// Each table's `check` reads its domain from the file and names the
+    /// parameter (the silent clamps of issue 23: p = 0.15 and NaN in T1).
+    #[cfg(feature = "embedded")]
+    #[test]
+    fn table_checks_name_the_parameter() {
+        let set = crate::TableSet::embedded();
+        let t1 = set.smith;
+        assert_eq!(t1.check(1.0, 0.5), Ok(()));
+        assert_eq!(t1.check(0.2, f32::INFINITY), Ok(()));
+        let err = t1.check(0.15, 0.5).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "p = 0.15: must be in [0.2, 5] (T1's domain)"
+        );
+        assert_eq!(t1.check(f32::NAN, 0.5).unwrap_err().name, "p");
+        assert_eq!(t1.check(1.0, -0.1).unwrap_err().name, "a");
+        let t2 = set.sigma_ratio;
+        assert_eq!(t2.check(0.5, 1e4, 2.0), Ok(()));
+        assert_eq!(t2.check(1.5, 1.0, 2.0).unwrap_err().name, "cos_theta_i");
+        assert_eq!(t2.check(0.5, -4.0, 2.0).unwrap_err().name, "B");
+        assert_eq!(t2.check(0.5, 1.0, 1.0).unwrap_err().name, "c");
+        let t3 = set.convolution;
+        assert_eq!(t3.check(1e5, 2.0, 0.1, 1.0), Ok(()));
+        assert_eq!(t3.check(1.0, 2.0, 5.0, 1.0).unwrap_err().name, "beta");
+        assert_eq!(t3.check(1.0, 2.0, 0.1, 0.05).unwrap_err().name, "p");
+        assert_eq!(t3.fit().check(1.0, 20.0, 0.1, 1.0).unwrap_err().name, "c");
+        let t5 = set.diffuse_fresnel;
+        assert_eq!(t5.check(1.5), Ok(()));
+        assert_eq!(t5.check(0.5).unwrap_err().name, "eta");
+    }
+}
