@@ -19,11 +19,12 @@ use numpy::ndarray::{Array1, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 use rayon::prelude::*;
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
+    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
 };
-use twoscale::epd::{BETA_RANGE, P_RANGE};
+use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
 
 /// The committed tables, compiled into the extension.
@@ -183,50 +184,17 @@ fn shaped_vectors<'py, T: numpy::Element>(
     shaped(py, &full, values.into_iter().flatten().collect())
 }
 
-fn parse_choice<T: Copy>(what: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    choices
-        .iter()
-        .find(|(name, _)| *name == given)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<_> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
+/// The value of option `T` called `given` (None: the runtime's default).
+fn named<T: Named + Default>(given: Option<&str>) -> PyResult<T> {
+    match given {
+        None => Ok(T::default()),
+        Some(name) => T::from_name(name).ok_or_else(|| {
             value_error(format!(
-                "{what} must be one of {}, got '{given}'",
-                names.join(", ")
+                "{} must be one of {}, got '{name}'",
+                T::OPTION,
+                T::choices()
             ))
-        })
-}
-
-const MASKING: [(&str, Masking); 2] = [
-    ("separable", Masking::Separable),
-    ("height-correlated", Masking::HeightCorrelated),
-];
-const SIGMA_REL: [(&str, SigmaRelMode); 2] = [
-    ("incident", SigmaRelMode::Incident),
-    ("symmetrised", SigmaRelMode::Symmetrised),
-];
-const COLOUR: [(&str, ColourTerms); 2] = [
-    ("physical", ColourTerms::Physical),
-    ("white", ColourTerms::White),
-];
-const HALO_WEIGHT: [(&str, HaloWeight); 2] = [
-    ("printed", HaloWeight::Printed),
-    ("incident", HaloWeight::Incident),
-];
-
-fn name_of<T: PartialEq>(value: T, choices: &[(&'static str, T)]) -> &'static str {
-    choices
-        .iter()
-        .find(|(_, v)| *v == value)
-        .map_or("?", |(n, _)| n)
-}
-
-/// The keyword name of a base layer's kind.
-fn base_name(base: BaseLayer) -> &'static str {
-    match base {
-        BaseLayer::Conductor => "conductor",
-        BaseLayer::Plastic { .. } => "plastic",
-        BaseLayer::Subsurface { .. } => "subsurface",
+        }),
     }
 }
 
@@ -237,63 +205,23 @@ fn options(
     colour: Option<&str>,
     halo_weight: Option<&str>,
 ) -> PyResult<Options> {
-    let d = Options::default();
-    fn pick<T: Copy>(what: &str, given: Option<&str>, choices: &[(&str, T)], d: T) -> PyResult<T> {
-        given.map_or(Ok(d), |given| parse_choice(what, given, choices))
-    }
     Ok(Options {
-        masking: pick("masking", masking, &MASKING, d.masking)?,
-        sigma_rel: pick("sigma_rel", sigma_rel, &SIGMA_REL, d.sigma_rel)?,
-        colour: pick("colour", colour, &COLOUR, d.colour)?,
-        halo_weight: pick("halo_weight", halo_weight, &HALO_WEIGHT, d.halo_weight)?,
+        masking: named(masking)?,
+        sigma_rel: named(sigma_rel)?,
+        colour: named(colour)?,
+        halo_weight: named(halo_weight)?,
     })
 }
 
-/// Checks `lo ≤ x ≤ hi` (and that x is finite).
-fn in_range(name: &str, x: f32, lo: f32, hi: f32) -> PyResult<()> {
-    if x.is_finite() && (lo..=hi).contains(&x) {
-        Ok(())
-    } else {
-        Err(value_error(format!(
-            "{name} must be in [{lo}, {hi}], got {x}"
-        )))
-    }
+/// The names of option `T`'s values, the default first.
+fn names<T: Named>() -> Vec<&'static str> {
+    T::NAMES.iter().map(|(n, _)| *n).collect()
 }
 
-/// The surface parameters as the runtime's model accepts them without
-/// clamping: β and p in the EPD's domain, σs and b finite and ≥ 0, c > 1.
-fn surface(beta: f32, p: f32, sigma_s: f32, b: f32, c: f32) -> PyResult<Surface> {
-    in_range("beta", beta, BETA_RANGE.0, BETA_RANGE.1)?;
-    in_range("p", p, P_RANGE.0, P_RANGE.1)?;
-    for (name, x) in [("sigma_s", sigma_s), ("b", b)] {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(value_error(format!(
-                "{name} must be finite and ≥ 0 (µm), got {x}"
-            )));
-        }
-    }
-    if !(c > 1.0 && c.is_finite()) {
-        return Err(value_error(format!(
-            "c must be finite and > 1 (the K-correlation exponent), got {c}"
-        )));
-    }
-    Ok(Surface {
-        beta,
-        p,
-        sigma_s,
-        b,
-        c,
-    })
-}
-
-fn complex_index(name: &str, n: f32, k: f32) -> PyResult<Complex> {
-    if n.is_finite() && k.is_finite() && n > 0.0 && k >= 0.0 {
-        Ok(Complex::new(n, k))
-    } else {
-        Err(value_error(format!(
-            "{name} must be (n, k) with finite n > 0 and k ≥ 0, got ({n}, {k})"
-        )))
-    }
+/// A parameter outside the runtime's domain as a `ValueError` with the
+/// runtime's message.
+fn invalid(error: Invalid) -> PyErr {
+    value_error(error.to_string())
 }
 
 /// `(wo, pdf, weight)` of [`Material::sample`].
@@ -337,7 +265,7 @@ impl Material {
 #[pymethods]
 impl Material {
     #[new]
-    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base="conductor",
+    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base=None,
         albedo=None, lambertian=0.0, masking=None, sigma_rel=None, colour=None,
         halo_weight=None))]
     #[allow(clippy::too_many_arguments)]
@@ -348,7 +276,7 @@ impl Material {
         sigma_s: f32,
         b: f32,
         c: f32,
-        base: &str,
+        base: Option<&str>,
         albedo: Option<f32>,
         lambertian: f32,
         masking: Option<&str>,
@@ -356,53 +284,41 @@ impl Material {
         colour: Option<&str>,
         halo_weight: Option<&str>,
     ) -> PyResult<Self> {
-        let surface = surface(beta, p, sigma_s, b, c)?;
-        let [r, g, bl]: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
+        let eta_rgb: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
             value_error(format!(
                 "eta must be three (n, k) pairs (red, green, blue), got {}",
                 e.len()
             ))
         })?;
-        let eta_rgb = [
-            complex_index("eta[0]", r.0, r.1)?,
-            complex_index("eta[1]", g.0, g.1)?,
-            complex_index("eta[2]", bl.0, bl.1)?,
-        ];
-        let albedo_of = |albedo: Option<f32>| -> PyResult<f32> {
-            let a = albedo.ok_or_else(|| value_error(format!("base '{base}' needs albedo=")))?;
-            in_range("albedo", a, 0.0, 1.0)?;
-            Ok(a)
-        };
-        let base = match base {
-            "conductor" => match albedo {
-                None => BaseLayer::Conductor,
-                Some(_) => {
-                    return Err(value_error(
-                        "albedo= is for base 'plastic' or 'subsurface', not 'conductor'",
-                    ));
-                }
-            },
-            "plastic" => BaseLayer::Plastic {
-                albedo: albedo_of(albedo)?,
-            },
-            "subsurface" => BaseLayer::Subsurface {
-                albedo: albedo_of(albedo)?,
-            },
-            other => {
+        let kind: BaseKind = named(base)?;
+        let albedo = match (kind, albedo) {
+            (BaseKind::Conductor, None) => 0.0,
+            (BaseKind::Conductor, Some(_)) => {
                 return Err(value_error(format!(
-                    "base must be 'conductor', 'plastic' or 'subsurface', got '{other}'"
+                    "albedo= is for the base layers with a diffuse albedo, not '{}'",
+                    kind.name()
                 )));
             }
+            (_, Some(albedo)) => albedo,
+            (_, None) => {
+                return Err(value_error(format!("base '{}' needs albedo=", kind.name())));
+            }
         };
-        in_range("lambertian", lambertian, 0.0, 1.0)?;
         let material = twoscale::brdf::Material {
             layer: Layer {
-                surface,
-                base,
+                surface: Surface {
+                    beta,
+                    p,
+                    sigma_s,
+                    b,
+                    c,
+                },
+                base: kind.with_albedo(albedo),
                 lambertian,
             },
-            eta_rgb,
+            eta_rgb: eta_rgb.map(|(n, k)| Complex::new(n, k)),
         };
+        material.validate().map_err(invalid)?;
         let options = options(masking, sigma_rel, colour, halo_weight)?;
         Ok(Material::build(material, options))
     }
@@ -589,7 +505,7 @@ impl Material {
     /// The base layer: "conductor", "plastic" or "subsurface".
     #[getter]
     fn base(&self) -> &'static str {
-        base_name(self.material.layer.base)
+        self.material.layer.base.kind().name()
     }
     /// The base layer's albedo in [0, 1] (None for a conductor).
     #[getter]
@@ -610,10 +526,10 @@ impl Material {
     fn options(&self) -> BTreeMap<&'static str, &'static str> {
         let o = self.options;
         BTreeMap::from([
-            ("masking", name_of(o.masking, &MASKING)),
-            ("sigma_rel", name_of(o.sigma_rel, &SIGMA_REL)),
-            ("colour", name_of(o.colour, &COLOUR)),
-            ("halo_weight", name_of(o.halo_weight, &HALO_WEIGHT)),
+            (Masking::OPTION, o.masking.name()),
+            (SigmaRelMode::OPTION, o.sigma_rel.name()),
+            (ColourTerms::OPTION, o.colour.name()),
+            (HaloWeight::OPTION, o.halo_weight.name()),
         ])
     }
 
@@ -681,15 +597,28 @@ fn evaluate_rows<const K: usize>(
     out.map_err(value_error)
 }
 
-/// G1 of the EPD at shape `p` and `a = β tan θ` (HP17 36–38): table T1,
-/// or the f64 reference (Λ by quadrature) with `reference=True`.
+/// `Ok(())` unless `clamp` is false and `check` refuses the row.
+fn in_domain(clamp: bool, check: impl FnOnce() -> Result<(), Invalid>) -> Result<(), String> {
+    if clamp {
+        Ok(())
+    } else {
+        check().map_err(|e| e.to_string())
+    }
+}
+
+/// g1(p, a, *, reference, clamp=False): G1 of the EPD at shape `p` and
+/// `a = β tan θ` (HP17 36–38), both dimensionless, as float64 columns of
+/// equal length: table T1, or the f64 reference (Λ by quadrature) with
+/// `reference=True`. A row outside T1's domain raises `ValueError`
+/// (`SmithG1Table::check`) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (p, a, *, reference))]
+#[pyo3(signature = (p, a, *, reference, clamp=false))]
 fn g1<'py>(
     py: Python<'py>,
     p: PyReadonlyArray1<'py, f64>,
     a: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["p", "a"], [p, a])?;
     if reference {
@@ -699,20 +628,27 @@ fn g1<'py>(
     }
     let t = TABLES.smith;
     evaluate(py, rows_in, false, |[p, a]| {
-        Ok(t.g1(p as f32, a as f32).into())
+        let (p, a) = (p as f32, a as f32);
+        in_domain(clamp, || t.check(p, a))?;
+        Ok(t.g1(p, a).into())
     })
 }
 
-/// σrel/σs at incidence θi (radians), `B = b/λ` and exponent c (HP17 19):
-/// table T2, or the f64 reference (quadrature of the spectrum).
+/// sigma_ratio(theta_i, big_b, c, *, reference, clamp=False): σrel/σs at
+/// incidence `theta_i` (radians), `B = b/λ` and K-correlation exponent `c`
+/// (HP17 19), as float64 columns of equal length: table T2, or the f64
+/// reference (quadrature of the spectrum) with `reference=True`. A row
+/// outside T2's domain raises `ValueError` (`SigmaRatioTable::check`, on
+/// cos θi) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (theta_i, big_b, c, *, reference))]
+#[pyo3(signature = (theta_i, big_b, c, *, reference, clamp=false))]
 fn sigma_ratio<'py>(
     py: Python<'py>,
     theta_i: PyReadonlyArray1<'py, f64>,
     big_b: PyReadonlyArray1<'py, f64>,
     c: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["theta_i", "B", "c"], [theta_i, big_b, c])?;
     if reference {
@@ -722,18 +658,31 @@ fn sigma_ratio<'py>(
     }
     let t = TABLES.sigma_ratio;
     evaluate(py, rows_in, false, |[th, bb, c]| {
-        Ok(t.sigma_ratio(th as f32, bb as f32, c as f32).into())
+        let (th, bb, c) = (th as f32, bb as f32, c as f32);
+        let cos = twoscale::math::cosf(th);
+        // T2's axis is cos θi: name the angle the caller gave too.
+        let check = t.check(cos, bb, c).map_err(|e| match e.name {
+            "cos_theta_i" => format!("theta_i = {}: {e}", validate::Shortest32(th)),
+            _ => e.to_string(),
+        });
+        if !clamp {
+            check?;
+        }
+        Ok(t.sigma_ratio_cos(cos, bb, c).into())
     })
 }
 
-/// Which source of C [`conv`] reads.
+/// The sources of C that [`conv`] reads.
 const CONV_SOURCES: [&str; 3] = ["table", "fit", "reference"];
 
-/// The convolution `C(θh; u, c, β, p)` (HP17 40) from `source`: "table"
-/// (T3b), "fit" (the paper's fitted form, T3a) or "reference" (the f64
-/// direct 2-D quadrature).
+/// conv(theta_h, u, c, beta, p, *, source, clamp=False): the convolution
+/// `C(θh; u, c, β, p)` (HP17 40), `theta_h` in radians and the others
+/// dimensionless, as float64 columns of equal length, from `source`:
+/// "table" (T3b), "fit" (the paper's fitted form, T3a) or "reference" (the
+/// f64 direct 2-D quadrature). A row outside T3's domain raises `ValueError`
+/// (`ConvTable::check`) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (theta_h, u, c, beta, p, *, source))]
+#[pyo3(signature = (theta_h, u, c, beta, p, *, source, clamp=false))]
 #[allow(clippy::too_many_arguments)]
 fn conv<'py>(
     py: Python<'py>,
@@ -743,6 +692,7 @@ fn conv<'py>(
     beta: PyReadonlyArray1<'py, f64>,
     p: PyReadonlyArray1<'py, f64>,
     source: &str,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["theta_h", "u", "c", "beta", "p"], [theta_h, u, c, beta, p])?;
     let (t3b, t3a) = (TABLES.convolution, TABLES.convolution.fit());
@@ -762,23 +712,27 @@ fn conv<'py>(
         }
     };
     evaluate(py, rows_in, false, |[th, u, c, beta, p]| {
+        let [u, c, beta, p] = [u, c, beta, p].map(|x| x as f32);
+        in_domain(clamp, || t3b.check(u, c, beta, p))?;
         let (sin, cos) = (th.sin() as f32, th.cos() as f32);
-        Ok(table
-            .convolution_sin_cos(sin, cos, u as f32, c as f32, beta as f32, p as f32)
-            .into())
+        Ok(table.convolution_sin_cos(sin, cos, u, c, beta, p).into())
     })
 }
 
-/// The unpolarised Fresnel reflectance F(η = n + ik, cos θ): the runtime's
-/// (f32), or the f64 reference with `reference=True`.
+/// fresnel(n, k, cos_theta, *, reference, clamp=False): the unpolarised
+/// Fresnel reflectance F(η = n + ik, cos θ) as float64 columns of equal
+/// length: the runtime's (f32), or the f64 reference with `reference=True`.
+/// An index outside the runtime's domain (`validate::eta`: n > 0, k ≥ 0)
+/// raises `ValueError` unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (n, k, cos_theta, *, reference))]
+#[pyo3(signature = (n, k, cos_theta, *, reference, clamp=false))]
 fn fresnel<'py>(
     py: Python<'py>,
     n: PyReadonlyArray1<'py, f64>,
     k: PyReadonlyArray1<'py, f64>,
     cos_theta: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["n", "k", "cos_theta"], [n, k, cos_theta])?;
     evaluate(py, rows_in, false, |[n, k, cos]| {
@@ -786,16 +740,23 @@ fn fresnel<'py>(
             ref_fresnel::fresnel(ref_fresnel::Complex64::new(n, k), cos).map_err(|e| e.to_string())
         } else {
             let eta = Complex::new(n as f32, k as f32);
+            in_domain(clamp, || validate::eta(("n", "k"), eta))?;
             Ok(twoscale::fresnel::fresnel(eta, cos as f32).into())
         }
     })
 }
 
-/// The one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model of `query
-/// brdf`, docs/model.md §2.5), with the paper's options: the runtime (`TwoScale`, T3b)
-/// or, with `reference=True`, the f64 reference (exact Λ, σrel and C).
+/// brdf(wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference,
+/// clamp=False): the one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model
+/// of `query brdf`, docs/model.md §2.5) with the paper's options; σs, b and
+/// the wavelength `lam` in µm, η = n + ik. `wi`, `wo` are `(..., 3)` and
+/// broadcast together; the result has their leading shape. The runtime
+/// (`TwoScale`, T3b), or with `reference=True` the f64 reference (exact Λ,
+/// σrel and C). Parameters outside the runtime's domain
+/// (`Layer::validate`, `validate::eta`, `validate::wavelength`) raise
+/// `ValueError` unless `clamp=True` (then the runtime clamps them).
 #[pyfunction]
-#[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference))]
+#[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference, clamp=false))]
 #[allow(clippy::too_many_arguments)]
 fn brdf<'py>(
     py: Python<'py>,
@@ -810,6 +771,7 @@ fn brdf<'py>(
     k: f64,
     lam: f64,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let v = vectors([("wi", wi), ("wo", wo)])?;
     let [wi, wo] = &v.rows;
@@ -839,20 +801,46 @@ fn brdf<'py>(
     }
     let f = |v: f64| v as f32;
     let layer = Layer {
-        surface: surface(f(beta), f(p), f(sigma_s), f(b), f(c))?,
+        surface: Surface {
+            beta: f(beta),
+            p: f(p),
+            sigma_s: f(sigma_s),
+            b: f(b),
+            c: f(c),
+        },
         base: BaseLayer::Conductor,
         lambertian: 0.0,
     };
-    let eta = complex_index("(n, k)", f(n), f(k))?;
-    let model = TwoScale::new(&TABLES.brdf_tables(), layer, f(lam), eta, options);
+    let (eta, lam) = (Complex::new(f(n), f(k)), f(lam));
+    if !clamp {
+        layer.validate().map_err(invalid)?;
+        validate::eta(("n", "k"), eta).map_err(invalid)?;
+        validate::wavelength(lam).map_err(invalid)?;
+    }
+    let model = TwoScale::new(&TABLES.brdf_tables(), layer, lam, eta, options);
     let values = py.detach(|| rows(v.len(), |j| f64::from(model.eval(wi[j], wo[j]))));
     Ok(shaped(py, &v.shape, values))
 }
 
+/// The extension of the `twoscale` package: `Material` (the RGB model of a
+/// material), the names of its options (`OPTIONS`, `BASES`), the wavelengths
+/// of its channels (`RGB_WAVELENGTHS`, µm) and the row functions behind
+/// `twoscale.lookup` and `twoscale.reference`.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Material>()?;
     m.add("RGB_WAVELENGTHS", twoscale::brdf::RGB_WAVELENGTHS.to_vec())?;
+    let options = BTreeMap::from([
+        (Masking::OPTION, names::<Masking>()),
+        (SigmaRelMode::OPTION, names::<SigmaRelMode>()),
+        (ColourTerms::OPTION, names::<ColourTerms>()),
+        (HaloWeight::OPTION, names::<HaloWeight>()),
+    ]);
+    let options = options
+        .into_iter()
+        .map(|(k, v)| Ok((k, PyTuple::new(m.py(), v)?)));
+    m.add("OPTIONS", options.collect::<PyResult<BTreeMap<_, _>>>()?)?;
+    m.add("BASES", PyTuple::new(m.py(), names::<BaseKind>())?)?;
     m.add_function(wrap_pyfunction!(g1, m)?)?;
     m.add_function(wrap_pyfunction!(sigma_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(conv, m)?)?;

@@ -83,10 +83,10 @@ def test_shapes_that_do_not_broadcast_are_named():
 def public_callables():
     """(qualified name, object) of every public function, method and getter."""
     out = []
-    for module in (twoscale, lookup, reference):
+    for module in (twoscale, twoscale._native, lookup, reference):
         for name in getattr(module, "__all__", dir(module)):
             obj = getattr(module, name)
-            if not name.startswith("_") and inspect.isroutine(obj):
+            if not name.startswith("_") and (inspect.isroutine(obj) or inspect.isclass(obj)):
                 out.append((f"{module.__name__}.{name}", obj))
     for name, obj in vars(twoscale.Material).items():
         if not name.startswith("_"):
@@ -98,13 +98,18 @@ def public_callables():
 def test_public_names_are_documented_with_their_arguments_in_order(name, obj):
     doc = inspect.getdoc(obj)
     assert doc and len(doc) > 20, f"{name} has no docstring"
-    if inspect.isroutine(obj):
+    if inspect.isroutine(obj) or inspect.isclass(obj):
         params = [p for p in inspect.signature(obj).parameters if p not in ("self", "cls")]
-        # the docstring opens with the call: name(arguments in order)
-        head = doc.split(":")[0]
-        assert head.startswith(obj.__name__ + "("), f"{name}: {head!r}"
-        positions = [head.find(p) for p in params]
-        assert -1 not in positions and positions == sorted(positions), f"{name}: {head!r} vs {params}"
+        # the docstring opens with the call: name(the parameters in order)
+        assert doc.startswith(obj.__name__ + "("), f"{name}: {doc[:60]!r}"
+        listed = doc[len(obj.__name__) + 1 : doc.index(")")].replace("\n", " ").split(",")
+        listed = [a.split("=")[0].strip() for a in listed if a.strip() not in ("", "*", "/")]
+        assert listed == params, f"{name}: the docstring lists {listed}, the signature {params}"
+
+
+@pytest.mark.parametrize("module", [twoscale, twoscale._native, lookup, reference])
+def test_modules_are_documented(module):
+    assert module.__doc__ and len(module.__doc__) > 100
 
 
 def test_stubs_and_py_typed_ship_with_the_package():

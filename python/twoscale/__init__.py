@@ -6,11 +6,16 @@ lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
 registers a Mitsuba 3 BSDF (imported on demand: it needs the ``mitsuba``
 package).
 
-Directions are unit vectors in the local frame (normal +z); ``wi`` points
-towards the light and ``wo`` towards the viewer. Lengths are in µm.
+Directions are unit vectors in the local frame (normal +z), arrays of shape
+``(..., 3)`` that broadcast together as NumPy's do; ``wi`` points towards
+the light and ``wo`` towards the viewer. Lengths are in µm.
+
+``OPTIONS`` maps each option keyword of ``Material`` to the names of its
+values (the default first) and ``BASES`` lists the base layers: the
+runtime's one list of each (``twoscale::validate::Named``).
 """
 
 from . import lookup, reference
-from ._native import RGB_WAVELENGTHS, Material
+from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
 
-__all__ = ["Material", "RGB_WAVELENGTHS", "lookup", "reference"]
+__all__ = ["BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "lookup", "reference"]

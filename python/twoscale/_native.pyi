@@ -11,6 +11,18 @@ from typing import final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+__all__ = [
+    "Material",
+    "RGB_WAVELENGTHS",
+    "OPTIONS",
+    "BASES",
+    "g1",
+    "sigma_ratio",
+    "conv",
+    "fresnel",
+    "brdf",
+]
+
 RGB_WAVELENGTHS: list[float]
 OPTIONS: dict[str, tuple[str, ...]]
 BASES: tuple[str, ...]
@@ -26,22 +38,22 @@ class Material:
         sigma_s: float = 0.0,
         b: float = 1.0,
         c: float = 2.0,
-        base: str = "conductor",
+        base: str | None = None,
         albedo: float | None = None,
         lambertian: float = 0.0,
-        masking: str = ...,
-        sigma_rel: str = ...,
-        colour: str = ...,
-        halo_weight: str = ...,
+        masking: str | None = None,
+        sigma_rel: str | None = None,
+        colour: str | None = None,
+        halo_weight: str | None = None,
     ) -> Material: ...
     @staticmethod
     def preset(
         name: str,
         *,
-        masking: str = ...,
-        sigma_rel: str = ...,
-        colour: str = ...,
-        halo_weight: str = ...,
+        masking: str | None = None,
+        sigma_rel: str | None = None,
+        colour: str | None = None,
+        halo_weight: str | None = None,
     ) -> Material: ...
     @staticmethod
     def presets() -> list[str]: ...

@@ -17,6 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import _native
 from ._columns import broadcast_call
 
+__all__ = ["g1", "sigma_ratio", "conv", "fresnel", "brdf"]
+
 
 def g1(p: ArrayLike, a: ArrayLike, *, clamp: bool = False) -> float | NDArray[np.float64]:
     """g1(p, a, *, clamp=False): Smith G1 of the EPD from table T1, at shape

@@ -12,6 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import _native
 from ._columns import broadcast_call
 
+__all__ = ["g1", "sigma_ratio", "conv", "fresnel", "brdf"]
+
 
 def g1(p: ArrayLike, a: ArrayLike) -> float | NDArray[np.float64]:
     """g1(p, a): Smith G1 of the EPD at shape ``p`` and ``a = β tan θ``, Λ by
