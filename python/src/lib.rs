@@ -4,11 +4,14 @@
 //!
 //! Conventions are the runtime's (`twoscale::brdf`): unit vectors in the
 //! local frame (normal `+z`), `wi` towards the light, `wo` towards the
-//! viewer; lengths in µm. Arrays of directions are `(N, 3)`, float32 or
-//! float64; results are float32 (the runtime's precision) for the model and
-//! the lookups, float64 for the reference. The GIL is released while rows are
-//! evaluated; batches of 2048 rows or more (`PARALLEL_ROWS`) are split over
-//! rayon's threads.
+//! viewer; lengths in µm. Arrays of directions are `(…, 3)` and broadcast
+//! together as NumPy's do; results are float32 (the runtime's precision) for
+//! the model and the lookups, float64 for the reference. Parameters go
+//! through the runtime's validation (`twoscale::validate`) and raise
+//! `ValueError` with its message; the lookups check their table's domain
+//! unless `clamp=True`. The GIL is released while rows are evaluated;
+//! batches of 2048 rows or more (`PARALLEL_ROWS`) are split over rayon's
+//! threads. The types are in `twoscale/_native.pyi`.
 
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
@@ -658,17 +661,17 @@ fn sigma_ratio<'py>(
     }
     let t = TABLES.sigma_ratio;
     evaluate(py, rows_in, false, |[th, bb, c]| {
-        let (th, bb, c) = (th as f32, bb as f32, c as f32);
-        let cos = twoscale::math::cosf(th);
-        // T2's axis is cos θi: name the angle the caller gave too.
-        let check = t.check(cos, bb, c).map_err(|e| match e.name {
-            "cos_theta_i" => format!("theta_i = {}: {e}", validate::Shortest32(th)),
-            _ => e.to_string(),
-        });
+        // T2's axis is cos θi, checked on the cosine of the angle as given
+        // (f64: θi = π/2 is inside, although cos of its f32 is -4.4e-8), the
+        // angle named too.
+        let (cos_given, bb, c) = (th.cos() as f32, bb as f32, c as f32);
         if !clamp {
-            check?;
+            t.check(cos_given, bb, c).map_err(|e| match e.name {
+                "cos_theta_i" => format!("theta_i = {}: {e}", validate::Shortest(th)),
+                _ => e.to_string(),
+            })?;
         }
-        Ok(t.sigma_ratio_cos(cos, bb, c).into())
+        Ok(t.sigma_ratio(th as f32, bb, c).into())
     })
 }
 

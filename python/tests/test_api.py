@@ -143,14 +143,14 @@ def test_package_type_checks(tmp_path):
         "beta: float = m.beta\n"
     )
     done = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--no-incremental", script],
+        [sys.executable, "-m", "mypy", "--strict", script],
         capture_output=True, text=True, cwd=tmp_path,
     )
     assert done.returncode == 0, done.stdout + done.stderr
     bad = tmp_path / "bad.py"
     bad.write_text("import twoscale\nx: str = twoscale.Material.preset('gold-rough').beta\n")
     done = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--no-incremental", bad],
+        [sys.executable, "-m", "mypy", "--strict", bad],
         capture_output=True, text=True, cwd=tmp_path,
     )
     assert done.returncode == 1 and "Incompatible types" in done.stdout, done.stdout

@@ -273,6 +273,14 @@ def test_clamped_lookups_answer_at_the_edge_of_the_domain():
     np.testing.assert_array_equal(lookup.g1([0.15, 1.0], 0.5, clamp=True), [at_edge, lookup.g1(1.0, 0.5)])
 
 
+def test_grazing_incidence_is_inside_t2():
+    """θi = π/2 is T2's cos θi = 0 node, although the cosine of its f32 is
+    -4.4e-8: checked on the angle as given."""
+    assert lookup.sigma_ratio(np.pi / 2, 5.0, 2.0) == lookup.sigma_ratio(np.pi / 2, 5.0, 2.0, clamp=True)
+    with pytest.raises(ValueError, match="theta_i = 1.6: cos_theta_i = -0.0291995"):
+        lookup.sigma_ratio(1.6, 5.0, 2.0)
+
+
 @pytest.mark.parametrize("keywords,message", [
     (dict(sigma_s=-1.0), "sigma_s = -1: must be finite and ≥ 0 (µm)"),
     (dict(n=-0.5), "n = -0.5: must be finite and > 0"),

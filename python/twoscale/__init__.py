@@ -3,8 +3,8 @@
 ``Material`` is the RGB model of one material (at 0.645, 0.526, 0.444 µm)
 evaluated over NumPy arrays of directions; ``lookup`` holds the table
 lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
-registers a Mitsuba 3 BSDF (imported on demand: it needs the ``mitsuba``
-package).
+registers a Mitsuba 3 BSDF (imported on first use of ``twoscale.mitsuba``:
+it needs the ``mitsuba`` package).
 
 Directions are unit vectors in the local frame (normal +z), arrays of shape
 ``(..., 3)`` that broadcast together as NumPy's do; ``wi`` points towards
@@ -15,7 +15,17 @@ values (the default first) and ``BASES`` lists the base layers: the
 runtime's one list of each (``twoscale::validate::Named``).
 """
 
+import importlib
+from types import ModuleType
+
 from . import lookup, reference
 from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
 
 __all__ = ["BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "lookup", "reference"]
+
+
+def __getattr__(name: str) -> ModuleType:
+    """``twoscale.mitsuba`` without an explicit import (PEP 562)."""
+    if name == "mitsuba":
+        return importlib.import_module(".mitsuba", __name__)
+    raise AttributeError(f"module 'twoscale' has no attribute '{name}'")
