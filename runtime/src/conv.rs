@@ -74,7 +74,7 @@
 //!   keeps growing down to `τ ~ 1e-59`, so the first few angles of such
 //!   nodes hold `C(0)` (where `C` is flat): wasted, not wrong.
 //!
-//! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3`, `m = 0` were chosen with
+//! The shipped `w_h = ½`, `w_e = ½`, `s_e = 2`, `τ_f = 3` (and `m = 2`: t3-accuracy-candidates.md) were chosen with
 //! `studies t3-angle-forms` (docs/design/t3-normalised-angle.md). Everything is known at lookup
 //! time. `τ_max`, `u_floor`, `λ`, `Y`, `κ`, `w_h`, `w_e`, `s_e`, `τ_f` and `m` are
 //! stored in the header (`params`), so the file is self-describing.

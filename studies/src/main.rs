@@ -236,7 +236,7 @@ enum Study {
         compare: Option<PathBuf>,
     },
     /// The paper's thresholds for T3a's g (HP17 §4.4) read from the
-    /// committed table (docs/design/t3-paper-form.md).
+    /// committed table (docs/design/t3-forms.md).
     T3Thresholds,
     /// Instructions per call of the BRDF's eval, pdf, sample and
     /// construction against the GGX baseline of benches/brdf.rs, counted by

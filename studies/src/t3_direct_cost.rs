@@ -1,4 +1,4 @@
-//! The direct quadrature of the T3 build (docs/design/t3-build-speed.md §8):
+//! The direct quadrature of the T3 build (docs/design/t3-build-speed.md, passes 2–4):
 //! for every `stride`-th node that the build computes by direct quadrature,
 //! the 32 angles by [`convolution_direct`] (default options), with the lobe
 //! evaluations (`DirectResult::evaluations`, a load-independent cost figure)

@@ -1,7 +1,7 @@
 //! The paper's thresholds for its `s, g` form (HP17 §4.4), read from the
 //! committed T3 (T3a): `g ≈ u` while the kernel is wider than the NDF
 //! (`u β ≪ 1`), and `g` → a constant once it is narrower (`u β ≫ 1`)
-//! (`docs/design/t3-paper-form.md`).
+//! (`docs/design/t3-forms.md`).
 
 use crate::common::committed_t3;
 use twoscale::ConvTable;
