@@ -4,26 +4,31 @@
 //!
 //! Conventions are the runtime's (`twoscale::brdf`): unit vectors in the
 //! local frame (normal `+z`), `wi` towards the light, `wo` towards the
-//! viewer; lengths in µm. Arrays of directions are `(N, 3)`, float32 or
-//! float64; results are float32 (the runtime's precision) for the model and
-//! the lookups, float64 for the reference. The GIL is released while rows are
-//! evaluated; batches of 2048 rows or more (`PARALLEL_ROWS`) are split over
-//! rayon's threads.
+//! viewer; lengths in µm. Arrays of directions are `(…, 3)` and broadcast
+//! together as NumPy's do; results are float32 (the runtime's precision) for
+//! the model and the lookups, float64 for the reference. Parameters go
+//! through the runtime's validation (`twoscale::validate`) and raise
+//! `ValueError` with its message; the lookups check their table's domain
+//! unless `clamp=True`. The GIL is released while rows are evaluated;
+//! batches of 2048 rows or more (`PARALLEL_ROWS`) are split over rayon's
+//! threads. The types are in `twoscale/_native.pyi`.
 
 mod merl;
 
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
-use numpy::ndarray::{Array1, Array2, ArrayView2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::ndarray::{Array1, ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 use rayon::prelude::*;
 use twoscale::brdf::{
-    BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
+    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options,
+    SigmaRelMode, Surface,
 };
-use twoscale::epd::{BETA_RANGE, P_RANGE};
+use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
 use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
@@ -47,31 +52,91 @@ fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }
 
-/// An `(N, 3)` float32 or float64 array as rows of f32 vectors.
-fn directions(name: &str, array: &Bound<'_, PyAny>) -> PyResult<Vec<[f32; 3]>> {
-    fn collect<T: Copy>(view: ArrayView2<'_, T>, f: impl Fn(T) -> f32) -> Vec<[f32; 3]> {
-        view.rows()
-            .into_iter()
-            .map(|r| [f(r[0]), f(r[1]), f(r[2])])
-            .collect()
+/// A batch of 3-vectors (`(…, 3)` arrays broadcast together): the leading
+/// shape `…` and the rows in C order.
+struct Vectors<const K: usize> {
+    shape: Vec<usize>,
+    rows: [Vec<[f32; 3]>; K],
+}
+
+impl<const K: usize> Vectors<K> {
+    fn len(&self) -> usize {
+        self.rows[0].len()
     }
-    let shape_ok = |shape: &[usize]| shape.len() == 2 && shape[1] == 3;
-    let rows = if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f32>>() {
-        shape_ok(a.as_array().shape()).then(|| collect(a.as_array(), |x| x))
-    } else if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f64>>() {
-        shape_ok(a.as_array().shape()).then(|| collect(a.as_array(), |x| x as f32))
+}
+
+/// `array` as an f32 array of shape `(…, 3)`: float32 and float64 arrays as
+/// they are, anything else through `numpy.asarray(array, dtype=float64)`.
+fn vector_array(name: &str, array: &Bound<'_, PyAny>) -> PyResult<ArrayD<f32>> {
+    let values = if let Ok(a) = array.extract::<PyReadonlyArrayDyn<'_, f32>>() {
+        a.as_array().to_owned()
+    } else if let Ok(a) = array.extract::<PyReadonlyArrayDyn<'_, f64>>() {
+        a.as_array().mapv(|x| x as f32)
     } else {
-        let described = describe(array);
-        return Err(value_error(format!(
-            "{name} must be a float32 or float64 array of shape (N, 3), got {described}"
-        )));
+        let converted = PyModule::import(array.py(), "numpy")?
+            .call_method1("asarray", (array, "float64"))
+            .ok()
+            .and_then(|a| {
+                a.extract::<PyReadonlyArrayDyn<'_, f64>>()
+                    .ok()
+                    .map(|a| a.as_array().mapv(|x| x as f32))
+            });
+        converted.ok_or_else(|| {
+            value_error(format!(
+                "{name} must be an array of numbers of shape (..., 3), got {}",
+                describe(array)
+            ))
+        })?
     };
-    rows.ok_or_else(|| {
-        value_error(format!(
-            "{name} must have shape (N, 3), got {}",
+    if values.shape().last() == Some(&3) {
+        Ok(values)
+    } else {
+        Err(value_error(format!(
+            "{name} must have shape (..., 3), got {}",
             describe(array)
-        ))
-    })
+        )))
+    }
+}
+
+/// The arrays of shape `(…, 3)` broadcast together as NumPy does (the
+/// leading shapes aligned on the right, each axis of length 1 or the
+/// common length).
+fn vectors<const K: usize>(arrays: [(&str, &Bound<'_, PyAny>); K]) -> PyResult<Vectors<K>> {
+    let mut values = Vec::with_capacity(K);
+    for (name, array) in arrays {
+        values.push(vector_array(name, array)?);
+    }
+    let leading = |a: &ArrayD<f32>| a.shape()[..a.ndim() - 1].to_vec();
+    let ndim = values.iter().map(|a| a.ndim() - 1).max().unwrap_or(0);
+    let mut shape = vec![1; ndim];
+    for a in &values {
+        let lead = leading(a);
+        for (out, &n) in shape[ndim - lead.len()..].iter_mut().zip(&lead) {
+            if *out == 1 {
+                *out = n;
+            } else if n != 1 && n != *out {
+                let shapes: Vec<String> = arrays
+                    .iter()
+                    .zip(&values)
+                    .map(|((name, _), a)| format!("{name} of shape {:?}", a.shape()))
+                    .collect();
+                return Err(value_error(format!(
+                    "{} do not broadcast together",
+                    shapes.join(" and ")
+                )));
+            }
+        }
+    }
+    let mut full = shape.clone();
+    full.push(3);
+    let rows = std::array::from_fn(|j| {
+        let view = values[j]
+            .broadcast(IxDyn(&full))
+            .expect("the shapes broadcast (checked above)");
+        let flat: Vec<f32> = view.iter().copied().collect();
+        flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect()
+    });
+    Ok(Vectors { shape, rows })
 }
 
 /// "an array of dtype D and shape S" or the Python type's name.
@@ -102,118 +167,90 @@ fn same_rows(a: (&str, usize), b: (&str, usize)) -> PyResult<()> {
     }
 }
 
-fn matrix(py: Python<'_>, values: Vec<[f32; 3]>) -> Bound<'_, PyArray2<f32>> {
-    let n = values.len();
-    let flat: Vec<f32> = values.into_iter().flatten().collect();
-    Array2::from_shape_vec((n, 3), flat)
-        .expect("n rows of 3 values")
+/// Values of shape `shape` (one per row of a batch) as a NumPy array.
+fn shaped<'py, T: numpy::Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    values: Vec<T>,
+) -> Bound<'py, PyArrayDyn<T>> {
+    ArrayD::from_shape_vec(IxDyn(shape), values)
+        .expect("one value per element of the shape")
         .into_pyarray(py)
 }
 
-fn parse_choice<T: Copy>(what: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    choices
-        .iter()
-        .find(|(name, _)| *name == given)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<_> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
+/// 3-vectors, one per row of a batch of leading shape `shape`, as an array
+/// of shape `(*shape, 3)`.
+fn shaped_vectors<'py, T: numpy::Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    values: Vec<[T; 3]>,
+) -> Bound<'py, PyArrayDyn<T>> {
+    let mut full = shape.to_vec();
+    full.push(3);
+    shaped(py, &full, values.into_iter().flatten().collect())
+}
+
+/// The value of option `T` called `given` (None: the runtime's default).
+fn named<T: Named + Default>(given: Option<&str>) -> PyResult<T> {
+    match given {
+        None => Ok(T::default()),
+        Some(name) => T::from_name(name).ok_or_else(|| {
             value_error(format!(
-                "{what} must be one of {}, got '{given}'",
-                names.join(", ")
+                "{} must be one of {}, got '{name}'",
+                T::OPTION,
+                T::choices()
             ))
-        })
+        }),
+    }
 }
 
-const MASKING: [(&str, Masking); 2] = [
-    ("separable", Masking::Separable),
-    ("height-correlated", Masking::HeightCorrelated),
-];
-const SIGMA_REL: [(&str, SigmaRelMode); 2] = [
-    ("incident", SigmaRelMode::Incident),
-    ("symmetrised", SigmaRelMode::Symmetrised),
-];
-const COLOUR: [(&str, ColourTerms); 2] = [
-    ("physical", ColourTerms::Physical),
-    ("white", ColourTerms::White),
-];
-const HALO_WEIGHT: [(&str, HaloWeight); 2] = [
-    ("printed", HaloWeight::Printed),
-    ("incident", HaloWeight::Incident),
-];
-
-fn name_of<T: PartialEq>(value: T, choices: &[(&'static str, T)]) -> &'static str {
-    choices
-        .iter()
-        .find(|(_, v)| *v == value)
-        .map_or("?", |(n, _)| n)
-}
-
-fn options(masking: &str, sigma_rel: &str, colour: &str, halo_weight: &str) -> PyResult<Options> {
+/// The options named by the keywords; None keeps the runtime's default.
+fn options(
+    masking: Option<&str>,
+    sigma_rel: Option<&str>,
+    colour: Option<&str>,
+    halo_weight: Option<&str>,
+) -> PyResult<Options> {
     Ok(Options {
-        masking: parse_choice("masking", masking, &MASKING)?,
-        sigma_rel: parse_choice("sigma_rel", sigma_rel, &SIGMA_REL)?,
-        colour: parse_choice("colour", colour, &COLOUR)?,
-        halo_weight: parse_choice("halo_weight", halo_weight, &HALO_WEIGHT)?,
+        masking: named(masking)?,
+        sigma_rel: named(sigma_rel)?,
+        colour: named(colour)?,
+        halo_weight: named(halo_weight)?,
     })
 }
 
-/// Checks `lo ≤ x ≤ hi` (and that x is finite).
-fn in_range(name: &str, x: f32, lo: f32, hi: f32) -> PyResult<()> {
-    if x.is_finite() && (lo..=hi).contains(&x) {
-        Ok(())
-    } else {
-        Err(value_error(format!(
-            "{name} must be in [{lo}, {hi}], got {x}"
-        )))
-    }
+/// The names of option `T`'s values, the default first.
+fn names<T: Named>() -> Vec<&'static str> {
+    T::NAMES.iter().map(|(n, _)| *n).collect()
 }
 
-/// The surface parameters as the runtime's model accepts them without
-/// clamping: β and p in the EPD's domain, σs and b finite and ≥ 0, c > 1.
-fn surface(beta: f32, p: f32, sigma_s: f32, b: f32, c: f32) -> PyResult<Surface> {
-    in_range("beta", beta, BETA_RANGE.0, BETA_RANGE.1)?;
-    in_range("p", p, P_RANGE.0, P_RANGE.1)?;
-    for (name, x) in [("sigma_s", sigma_s), ("b", b)] {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(value_error(format!(
-                "{name} must be finite and ≥ 0 (µm), got {x}"
-            )));
-        }
-    }
-    if !(c > 1.0 && c.is_finite()) {
-        return Err(value_error(format!(
-            "c must be finite and > 1 (the K-correlation exponent), got {c}"
-        )));
-    }
-    Ok(Surface {
-        beta,
-        p,
-        sigma_s,
-        b,
-        c,
-    })
-}
-
-fn complex_index(name: &str, n: f32, k: f32) -> PyResult<Complex> {
-    if n.is_finite() && k.is_finite() && n > 0.0 && k >= 0.0 {
-        Ok(Complex::new(n, k))
-    } else {
-        Err(value_error(format!(
-            "{name} must be (n, k) with finite n > 0 and k ≥ 0, got ({n}, {k})"
-        )))
-    }
+/// A parameter outside the runtime's domain as a `ValueError` with the
+/// runtime's message.
+fn invalid(error: Invalid) -> PyErr {
+    value_error(error.to_string())
 }
 
 /// `(wo, pdf, weight)` of [`Material::sample`].
 type SampleArrays<'py> = (
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray1<f32>>,
-    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArrayDyn<f32>>,
+    Bound<'py, PyArrayDyn<f32>>,
+    Bound<'py, PyArrayDyn<f32>>,
 );
 
-/// The RGB two-scale model of one material (at 0.645, 0.526, 0.444 µm),
-/// built once (the runtime bakes its per-material tables) and evaluated over
-/// arrays of directions.
+/// Material(*, beta, p, eta, sigma_s=0, b=1, c=2, base="conductor",
+/// albedo=None, lambertian=0, masking=None, sigma_rel=None, colour=None,
+/// halo_weight=None): the RGB two-scale model of one material, built once
+/// (the runtime bakes its per-material tables) and evaluated over arrays of
+/// directions.
+///
+/// `beta`, `p`: the EPD's roughness and shape; `sigma_s`, `b` (µm), `c`: the
+/// nanoscale roughness's RMS height, lateral scale and exponent; `eta`: three
+/// (n, k) pairs, red, green, blue at `RGB_WAVELENGTHS` (0.645, 0.526,
+/// 0.444 µm); `base`: one of `BASES`; `albedo`: the base layer's, in [0, 1]
+/// (plastic or subsurface only); `lambertian`: the weight k_d in [0, 1] of a
+/// Lambertian term. The options take one of their names in `OPTIONS`; None
+/// is the runtime's default (the paper's model). Parameters outside their
+/// domain raise `ValueError` with the runtime's message.
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
     model: Box<Rgb<'static, Box<ChannelBake>>>,
@@ -236,16 +273,10 @@ impl Material {
 
 #[pymethods]
 impl Material {
-    /// Material(*, beta, p, sigma_s=0, b=1, c=2, eta, base="conductor",
-    /// albedo=0, lambertian=0, masking="separable", sigma_rel="incident",
-    /// colour="physical", halo_weight="printed")
-    ///
-    /// `eta` is three (n, k) pairs, at 0.645, 0.526 and 0.444 µm; σs and b
-    /// are in µm. `albedo` is the base layer's (plastic or subsurface).
     #[new]
-    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base="conductor",
-        albedo=None, lambertian=0.0, masking="separable", sigma_rel="incident",
-        colour="physical", halo_weight="printed"))]
+    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base=None,
+        albedo=None, lambertian=0.0, masking=None, sigma_rel=None, colour=None,
+        halo_weight=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         beta: f32,
@@ -254,81 +285,65 @@ impl Material {
         sigma_s: f32,
         b: f32,
         c: f32,
-        base: &str,
+        base: Option<&str>,
         albedo: Option<f32>,
         lambertian: f32,
-        masking: &str,
-        sigma_rel: &str,
-        colour: &str,
-        halo_weight: &str,
+        masking: Option<&str>,
+        sigma_rel: Option<&str>,
+        colour: Option<&str>,
+        halo_weight: Option<&str>,
     ) -> PyResult<Self> {
-        let surface = surface(beta, p, sigma_s, b, c)?;
-        let [r, g, bl]: [(f32, f32); 3] = eta
-            .into_iter()
-            .map(|[n, k]| (n, k))
-            .collect::<Vec<_>>()
-            .try_into()
-            .map_err(|e: Vec<_>| {
-                value_error(format!(
-                    "eta must be three (n, k) pairs (red, green, blue), got {}",
-                    e.len()
-                ))
-            })?;
-        let eta_rgb = [
-            complex_index("eta[0]", r.0, r.1)?,
-            complex_index("eta[1]", g.0, g.1)?,
-            complex_index("eta[2]", bl.0, bl.1)?,
-        ];
-        let albedo_of = |albedo: Option<f32>| -> PyResult<f32> {
-            let a = albedo.ok_or_else(|| value_error(format!("base '{base}' needs albedo=")))?;
-            in_range("albedo", a, 0.0, 1.0)?;
-            Ok(a)
-        };
-        let base = match base {
-            "conductor" => match albedo {
-                None => BaseLayer::Conductor,
-                Some(_) => {
-                    return Err(value_error(
-                        "albedo= is for base 'plastic' or 'subsurface', not 'conductor'",
-                    ));
-                }
-            },
-            "plastic" => BaseLayer::Plastic {
-                albedo: albedo_of(albedo)?,
-            },
-            "subsurface" => BaseLayer::Subsurface {
-                albedo: albedo_of(albedo)?,
-            },
-            other => {
+        let eta_rgb: [[f32; 2]; 3] = eta.try_into().map_err(|e: Vec<_>| {
+            value_error(format!(
+                "eta must be three (n, k) pairs (red, green, blue), got {}",
+                e.len()
+            ))
+        })?;
+        let kind: BaseKind = named(base)?;
+        let albedo = match (kind, albedo) {
+            (BaseKind::Conductor, None) => 0.0,
+            (BaseKind::Conductor, Some(_)) => {
                 return Err(value_error(format!(
-                    "base must be 'conductor', 'plastic' or 'subsurface', got '{other}'"
+                    "albedo= is for the base layers with a diffuse albedo, not '{}'",
+                    kind.name()
                 )));
             }
+            (_, Some(albedo)) => albedo,
+            (_, None) => {
+                return Err(value_error(format!("base '{}' needs albedo=", kind.name())));
+            }
         };
-        in_range("lambertian", lambertian, 0.0, 1.0)?;
         let material = twoscale::brdf::Material {
             layer: Layer {
-                surface,
-                base,
+                surface: Surface {
+                    beta,
+                    p,
+                    sigma_s,
+                    b,
+                    c,
+                },
+                base: kind.with_albedo(albedo),
                 lambertian,
             },
-            eta_rgb,
+            eta_rgb: eta_rgb.map(|[n, k]| Complex::new(n, k)),
         };
+        material.validate().map_err(invalid)?;
         let options = options(masking, sigma_rel, colour, halo_weight)?;
         Ok(Material::build(material, options))
     }
 
-    /// Material.preset(name, *, masking=..., ...): a shipped preset
-    /// (`Material.presets()` lists them) with the given options.
+    /// preset(name, *, masking=None, sigma_rel=None, colour=None,
+    /// halo_weight=None): the shipped preset `name` (`Material.presets()`
+    /// lists them) with the given options (names as in `OPTIONS`; None: the
+    /// runtime's default).
     #[staticmethod]
-    #[pyo3(signature = (name, *, masking="separable", sigma_rel="incident",
-        colour="physical", halo_weight="printed"))]
+    #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None))]
     fn preset(
         name: &str,
-        masking: &str,
-        sigma_rel: &str,
-        colour: &str,
-        halo_weight: &str,
+        masking: Option<&str>,
+        sigma_rel: Option<&str>,
+        colour: Option<&str>,
+        halo_weight: Option<&str>,
     ) -> PyResult<Self> {
         let material = twoscale::materials::preset(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
@@ -336,7 +351,7 @@ impl Material {
         Ok(Material::build(material, options))
     }
 
-    /// The names of the shipped presets.
+    /// presets(): the names of the shipped presets, for `Material.preset`.
     #[staticmethod]
     fn presets() -> Vec<&'static str> {
         twoscale::materials::PRESETS
@@ -345,51 +360,58 @@ impl Material {
             .collect()
     }
 
-    /// ρ(wi, wo) per channel, sr⁻¹: (N, 3) float32. `wi` towards the light,
-    /// `wo` towards the viewer; 0 below the horizon.
+    /// eval(wi, wo): ρ(wi, wo) per RGB channel in sr⁻¹ (red, green, blue at
+    /// `RGB_WAVELENGTHS`), float32 of shape `(..., 3)`.
+    ///
+    /// `wi` (towards the light) and `wo` (towards the viewer) are unit
+    /// vectors in the local frame (normal +z), arrays of shape `(..., 3)`
+    /// that broadcast together as NumPy's do; a single direction `(3,)`
+    /// gives `(3,)`. 0 where either is below the horizon.
     fn eval<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
-        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
-        let model = &*self.model;
-        let values = py.detach(|| rows(wi.len(), |k| model.eval(wi[k], wo[k])));
-        Ok(matrix(py, values))
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let ([wi, wo], model) = (&v.rows, &*self.model);
+        let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k])));
+        Ok(shaped_vectors(py, &v.shape, values))
     }
 
-    /// The solid-angle density of `sample(wi, ·)` at `wo`: (N,) float32.
+    /// pdf(wi, wo): the solid-angle density (sr⁻¹) of `sample(wi, ·)` at
+    /// `wo`, float32 of the broadcast leading shape of `wi` and `wo` (both
+    /// `(..., 3)`; a 0-d array for two single directions).
     fn pdf<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
-        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
-        let model = &*self.model;
-        let values = py.detach(|| rows(wi.len(), |k| model.pdf(wi[k], wo[k])));
-        Ok(values.into_pyarray(py))
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let ([wi, wo], model) = (&v.rows, &*self.model);
+        let values = py.detach(|| rows(v.len(), |k| model.pdf(wi[k], wo[k])));
+        Ok(shaped(py, &v.shape, values))
     }
 
-    /// Samples `wo` given `wi` with three uniform numbers per row `u` (N, 3).
-    /// Returns `(wo, pdf, weight)`: (N, 3), (N,), (N, 3) float32 with
-    /// `weight = ρ(wi, wo) cos θo / pdf`; rows where sampling fails (below
-    /// the horizon) are all zeros.
+    /// sample(wi, u) -> (wo, pdf, weight): samples `wo` given `wi` (towards
+    /// the light) with three uniform numbers in [0, 1) per row `u`; `wi` and
+    /// `u` are `(..., 3)` and broadcast together.
+    ///
+    /// Returns `wo` `(..., 3)`, its density `pdf` `(...)` in sr⁻¹ and
+    /// `weight = ρ(wi, wo) cos θo / pdf` `(..., 3)`, float32; rows where
+    /// sampling fails (below the horizon) are all zeros.
     fn sample<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<SampleArrays<'py>> {
-        let (wi, u) = (directions("wi", wi)?, directions("u", u)?);
-        same_rows(("wi", wi.len()), ("u", u.len()))?;
-        let model = &*self.model;
+        let v = vectors([("wi", wi), ("u", u)])?;
+        let ([wi, u], model) = (&v.rows, &*self.model);
         let samples = py.detach(|| {
-            rows(wi.len(), |k| match model.sample(wi[k], u[k]) {
-                Some(s) => (s.o, s.pdf, s.value.map(|v| v * s.o[2] / s.pdf)),
+            rows(v.len(), |k| match model.sample(wi[k], u[k]) {
+                Some(s) => (s.o, s.pdf, s.value.map(|x| x * s.o[2] / s.pdf)),
                 None => ([0.0; 3], 0.0, [0.0; 3]),
             })
         });
@@ -404,26 +426,31 @@ impl Material {
             pdf.push(p);
             weight.push(w);
         }
-        Ok((matrix(py, dirs), pdf.into_pyarray(py), matrix(py, weight)))
+        Ok((
+            shaped_vectors(py, &v.shape, dirs),
+            shaped(py, &v.shape, pdf),
+            shaped_vectors(py, &v.shape, weight),
+        ))
     }
 
-    /// The f64 reference ρ(wi, wo) per channel (exact Λ, σrel, C;
-    /// `twoscale_reference::reference::brdf`), for conductors without a Lambertian
-    /// term: (N, 3) float64. Costs 1–30 ms per row and channel.
+    /// eval_reference(wi, wo): the f64 reference ρ(wi, wo) per RGB channel
+    /// in sr⁻¹ (exact Λ, σrel and C; the reference crate's `brdf`), float64 of
+    /// shape `(..., 3)`, for conductors without a Lambertian term. Arguments
+    /// as `eval`'s. Costs 1–30 ms per row and channel (on all cores).
     fn eval_reference<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let layer = self.material.layer;
         if layer.base != BaseLayer::Conductor || layer.lambertian != 0.0 {
             return Err(value_error(
                 "the f64 reference covers conductors without a Lambertian term",
             ));
         }
-        let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
-        same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let [wi, wo] = &v.rows;
         let s = layer.surface;
         let params: [ref_brdf::Params; 3] = std::array::from_fn(|ch| ref_brdf::Params {
             beta: s.beta.into(),
@@ -437,7 +464,7 @@ impl Material {
         });
         let options = self.options;
         let values = py.detach(|| {
-            (0..wi.len() * 3)
+            (0..v.len() * 3)
                 .into_par_iter()
                 .map(|j| {
                     let (k, ch) = (j / 3, j % 3);
@@ -448,47 +475,48 @@ impl Material {
                 })
                 .collect::<Result<Vec<f64>, String>>()
         });
-        let values = values.map_err(value_error)?;
-        Ok(Array2::from_shape_vec((wi.len(), 3), values)
-            .expect("n rows of 3 values")
-            .into_pyarray(py))
+        let mut full = v.shape.clone();
+        full.push(3);
+        Ok(shaped(py, &full, values.map_err(value_error)?))
     }
 
+    /// β, the EPD's roughness (slope scale), dimensionless.
     #[getter]
     fn beta(&self) -> f32 {
         self.material.layer.surface.beta
     }
+    /// p, the EPD's shape exponent (1: Beckmann), dimensionless.
     #[getter]
     fn p(&self) -> f32 {
         self.material.layer.surface.p
     }
+    /// σs, the RMS height of the nanoscale roughness, in µm.
     #[getter]
     fn sigma_s(&self) -> f32 {
         self.material.layer.surface.sigma_s
     }
+    /// b, the K-correlation spectrum's lateral length scale, in µm.
     #[getter]
     fn b(&self) -> f32 {
         self.material.layer.surface.b
     }
+    /// c, the K-correlation spectrum's exponent (> 1), dimensionless.
     #[getter]
     fn c(&self) -> f32 {
         self.material.layer.surface.c
     }
-    /// The three (n, k) pairs, red, green, blue.
+    /// The complex indices of refraction as three (n, k) pairs: red, green,
+    /// blue (at `RGB_WAVELENGTHS`).
     #[getter]
     fn eta(&self) -> Vec<(f32, f32)> {
         self.material.eta_rgb.iter().map(|e| (e.re, e.im)).collect()
     }
-    /// "conductor", "plastic" or "subsurface".
+    /// The base layer: "conductor", "plastic" or "subsurface".
     #[getter]
     fn base(&self) -> &'static str {
-        match self.material.layer.base {
-            BaseLayer::Conductor => "conductor",
-            BaseLayer::Plastic { .. } => "plastic",
-            BaseLayer::Subsurface { .. } => "subsurface",
-        }
+        self.material.layer.base.kind().name()
     }
-    /// The base layer's albedo (None for a conductor).
+    /// The base layer's albedo in [0, 1] (None for a conductor).
     #[getter]
     fn albedo(&self) -> Option<f32> {
         match self.material.layer.base {
@@ -496,19 +524,21 @@ impl Material {
             BaseLayer::Plastic { albedo } | BaseLayer::Subsurface { albedo } => Some(albedo),
         }
     }
+    /// The weight k_d in [0, 1] of the Lambertian term.
     #[getter]
     fn lambertian(&self) -> f32 {
         self.material.layer.lambertian
     }
-    /// The options as a dict of keyword names to values.
+    /// The options as a dict of keyword names ("colour", "halo_weight",
+    /// "masking", "sigma_rel") to their values.
     #[getter]
     fn options(&self) -> BTreeMap<&'static str, &'static str> {
         let o = self.options;
         BTreeMap::from([
-            ("masking", name_of(o.masking, &MASKING)),
-            ("sigma_rel", name_of(o.sigma_rel, &SIGMA_REL)),
-            ("colour", name_of(o.colour, &COLOUR)),
-            ("halo_weight", name_of(o.halo_weight, &HALO_WEIGHT)),
+            (Masking::OPTION, o.masking.name()),
+            (SigmaRelMode::OPTION, o.sigma_rel.name()),
+            (ColourTerms::OPTION, o.colour.name()),
+            (HaloWeight::OPTION, o.halo_weight.name()),
         ])
     }
 
@@ -550,6 +580,17 @@ fn evaluate<'py, const K: usize>(
     parallel: bool,
     f: impl Fn([f64; K]) -> Result<f64, String> + Sync,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let values = evaluate_rows(py, rows_in, parallel, f)?;
+    Ok(Array1::from_vec(values).into_pyarray(py))
+}
+
+/// [`evaluate`] as a vector.
+fn evaluate_rows<const K: usize>(
+    py: Python<'_>,
+    rows_in: Vec<[f64; K]>,
+    parallel: bool,
+    f: impl Fn([f64; K]) -> Result<f64, String> + Sync,
+) -> PyResult<Vec<f64>> {
     let out = py.detach(|| {
         let row = |(k, x): (usize, &[f64; K])| f(*x).map_err(|e| format!("row {k}: {e}"));
         if parallel || rows_in.len() >= PARALLEL_ROWS {
@@ -562,18 +603,31 @@ fn evaluate<'py, const K: usize>(
                 .collect::<Result<Vec<f64>, String>>()
         }
     });
-    Ok(Array1::from_vec(out.map_err(value_error)?).into_pyarray(py))
+    out.map_err(value_error)
 }
 
-/// G1 of the EPD at shape `p` and `a = β tan θ` (HP17 36–38): table T1,
-/// or the f64 reference (Λ by quadrature) with `reference=True`.
+/// `Ok(())` unless `clamp` is false and `check` refuses the row.
+fn in_domain(clamp: bool, check: impl FnOnce() -> Result<(), Invalid>) -> Result<(), String> {
+    if clamp {
+        Ok(())
+    } else {
+        check().map_err(|e| e.to_string())
+    }
+}
+
+/// g1(p, a, *, reference, clamp=False): G1 of the EPD at shape `p` and
+/// `a = β tan θ` (HP17 36–38), both dimensionless, as float64 columns of
+/// equal length: table T1, or the f64 reference (Λ by quadrature) with
+/// `reference=True`. A row outside T1's domain raises `ValueError`
+/// (`SmithG1Table::check`) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (p, a, *, reference))]
+#[pyo3(signature = (p, a, *, reference, clamp=false))]
 fn g1<'py>(
     py: Python<'py>,
     p: PyReadonlyArray1<'py, f64>,
     a: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["p", "a"], [p, a])?;
     if reference {
@@ -583,20 +637,27 @@ fn g1<'py>(
     }
     let t = TABLES.smith;
     evaluate(py, rows_in, false, |[p, a]| {
-        Ok(t.g1(p as f32, a as f32).into())
+        let (p, a) = (p as f32, a as f32);
+        in_domain(clamp, || t.check(p, a))?;
+        Ok(t.g1(p, a).into())
     })
 }
 
-/// σrel/σs at incidence θi (radians), `B = b/λ` and exponent c (HP17 19):
-/// table T2, or the f64 reference (quadrature of the spectrum).
+/// sigma_ratio(theta_i, big_b, c, *, reference, clamp=False): σrel/σs at
+/// incidence `theta_i` (radians), `B = b/λ` and K-correlation exponent `c`
+/// (HP17 19), as float64 columns of equal length: table T2, or the f64
+/// reference (quadrature of the spectrum) with `reference=True`. A row
+/// outside T2's domain raises `ValueError` (`SigmaRatioTable::check`, on
+/// cos θi) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (theta_i, big_b, c, *, reference))]
+#[pyo3(signature = (theta_i, big_b, c, *, reference, clamp=false))]
 fn sigma_ratio<'py>(
     py: Python<'py>,
     theta_i: PyReadonlyArray1<'py, f64>,
     big_b: PyReadonlyArray1<'py, f64>,
     c: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["theta_i", "B", "c"], [theta_i, big_b, c])?;
     if reference {
@@ -606,18 +667,31 @@ fn sigma_ratio<'py>(
     }
     let t = TABLES.sigma_ratio;
     evaluate(py, rows_in, false, |[th, bb, c]| {
-        Ok(t.sigma_ratio(th as f32, bb as f32, c as f32).into())
+        // T2's axis is cos θi, checked on the cosine of the angle as given
+        // (f64: θi = π/2 is inside, although cos of its f32 is -4.4e-8), the
+        // angle named too.
+        let (cos_given, bb, c) = (th.cos() as f32, bb as f32, c as f32);
+        if !clamp {
+            t.check(cos_given, bb, c).map_err(|e| match e.name {
+                "cos_theta_i" => format!("theta_i = {}: {e}", validate::Shortest(th)),
+                _ => e.to_string(),
+            })?;
+        }
+        Ok(t.sigma_ratio(th as f32, bb, c).into())
     })
 }
 
-/// Which source of C [`conv`] reads.
+/// The sources of C that [`conv`] reads.
 const CONV_SOURCES: [&str; 3] = ["table", "fit", "reference"];
 
-/// The convolution `C(θh; u, c, β, p)` (HP17 40) from `source`: "table"
-/// (T3b), "fit" (the paper's fitted form, T3a) or "reference" (the f64
-/// direct 2-D quadrature).
+/// conv(theta_h, u, c, beta, p, *, source, clamp=False): the convolution
+/// `C(θh; u, c, β, p)` (HP17 40), `theta_h` in radians and the others
+/// dimensionless, as float64 columns of equal length, from `source`:
+/// "table" (T3b), "fit" (the paper's fitted form, T3a) or "reference" (the
+/// f64 direct 2-D quadrature). A row outside T3's domain raises `ValueError`
+/// (`ConvTable::check`) unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (theta_h, u, c, beta, p, *, source))]
+#[pyo3(signature = (theta_h, u, c, beta, p, *, source, clamp=false))]
 #[allow(clippy::too_many_arguments)]
 fn conv<'py>(
     py: Python<'py>,
@@ -627,6 +701,7 @@ fn conv<'py>(
     beta: PyReadonlyArray1<'py, f64>,
     p: PyReadonlyArray1<'py, f64>,
     source: &str,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["theta_h", "u", "c", "beta", "p"], [theta_h, u, c, beta, p])?;
     let (t3b, t3a) = (TABLES.convolution, TABLES.convolution.fit());
@@ -646,23 +721,27 @@ fn conv<'py>(
         }
     };
     evaluate(py, rows_in, false, |[th, u, c, beta, p]| {
+        let [u, c, beta, p] = [u, c, beta, p].map(|x| x as f32);
+        in_domain(clamp, || t3b.check(u, c, beta, p))?;
         let (sin, cos) = (th.sin() as f32, th.cos() as f32);
-        Ok(table
-            .convolution_sin_cos(sin, cos, u as f32, c as f32, beta as f32, p as f32)
-            .into())
+        Ok(table.convolution_sin_cos(sin, cos, u, c, beta, p).into())
     })
 }
 
-/// The unpolarised Fresnel reflectance F(η = n + ik, cos θ): the runtime's
-/// (f32), or the f64 reference with `reference=True`.
+/// fresnel(n, k, cos_theta, *, reference, clamp=False): the unpolarised
+/// Fresnel reflectance F(η = n + ik, cos θ) as float64 columns of equal
+/// length: the runtime's (f32), or the f64 reference with `reference=True`.
+/// An index outside the runtime's domain (`validate::eta`: n > 0, k ≥ 0)
+/// raises `ValueError` unless `clamp=True`.
 #[pyfunction]
-#[pyo3(signature = (n, k, cos_theta, *, reference))]
+#[pyo3(signature = (n, k, cos_theta, *, reference, clamp=false))]
 fn fresnel<'py>(
     py: Python<'py>,
     n: PyReadonlyArray1<'py, f64>,
     k: PyReadonlyArray1<'py, f64>,
     cos_theta: PyReadonlyArray1<'py, f64>,
     reference: bool,
+    clamp: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let rows_in = columns(["n", "k", "cos_theta"], [n, k, cos_theta])?;
     evaluate(py, rows_in, false, |[n, k, cos]| {
@@ -670,16 +749,23 @@ fn fresnel<'py>(
             ref_fresnel::fresnel(ref_fresnel::Complex64::new(n, k), cos).map_err(|e| e.to_string())
         } else {
             let eta = Complex::new(n as f32, k as f32);
+            in_domain(clamp, || validate::eta(("n", "k"), eta))?;
             Ok(twoscale::fresnel::fresnel(eta, cos as f32).into())
         }
     })
 }
 
-/// The one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model of `query
-/// brdf`, docs/model.md §2.5), with the paper's options: the runtime (`TwoScale`, T3b)
-/// or, with `reference=True`, the f64 reference (exact Λ, σrel and C).
+/// brdf(wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference,
+/// clamp=False): the one-wavelength conductor ρ(wi, wo) in sr⁻¹ (the model
+/// of `query brdf`, docs/model.md §2.5) with the paper's options; σs, b and
+/// the wavelength `lam` in µm, η = n + ik. `wi`, `wo` are `(..., 3)` and
+/// broadcast together; the result has their leading shape. The runtime
+/// (`TwoScale`, T3b), or with `reference=True` the f64 reference (exact Λ,
+/// σrel and C). Parameters outside the runtime's domain
+/// (`Layer::validate`, `validate::eta`, `validate::wavelength`) raise
+/// `ValueError` unless `clamp=True` (then the runtime clamps them).
 #[pyfunction]
-#[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference))]
+#[pyo3(signature = (wi, wo, *, beta, p, sigma_s, b, c, n, k, lam, reference, clamp=false))]
 #[allow(clippy::too_many_arguments)]
 fn brdf<'py>(
     py: Python<'py>,
@@ -694,9 +780,10 @@ fn brdf<'py>(
     k: f64,
     lam: f64,
     reference: bool,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (wi, wo) = (directions("wi", wi)?, directions("wo", wo)?);
-    same_rows(("wi", wi.len()), ("wo", wo.len()))?;
+    clamp: bool,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let v = vectors([("wi", wi), ("wo", wo)])?;
+    let [wi, wo] = &v.rows;
     let options = Options::default();
     if reference {
         let params = ref_brdf::Params {
@@ -711,31 +798,58 @@ fn brdf<'py>(
         };
         let rows_in: Vec<[f64; 6]> = wi
             .iter()
-            .zip(&wo)
+            .zip(wo)
             .map(|(i, o)| [i[0], i[1], i[2], o[0], o[1], o[2]].map(f64::from))
             .collect();
-        return evaluate(py, rows_in, true, |x| {
+        let values = evaluate_rows(py, rows_in, true, |x| {
             ref_brdf::two_scale(&params, [x[0], x[1], x[2]], [x[3], x[4], x[5]], &options)
                 .map(|v| v.total())
                 .map_err(|e| e.to_string())
-        });
+        })?;
+        return Ok(shaped(py, &v.shape, values));
     }
     let f = |v: f64| v as f32;
     let layer = Layer {
-        surface: surface(f(beta), f(p), f(sigma_s), f(b), f(c))?,
+        surface: Surface {
+            beta: f(beta),
+            p: f(p),
+            sigma_s: f(sigma_s),
+            b: f(b),
+            c: f(c),
+        },
         base: BaseLayer::Conductor,
         lambertian: 0.0,
     };
-    let eta = complex_index("(n, k)", f(n), f(k))?;
-    let model = TwoScale::new(&TABLES.brdf_tables(), layer, f(lam), eta, options);
-    let values = py.detach(|| rows(wi.len(), |j| f64::from(model.eval(wi[j], wo[j]))));
-    Ok(Array1::from_vec(values).into_pyarray(py))
+    let (eta, lam) = (Complex::new(f(n), f(k)), f(lam));
+    if !clamp {
+        layer.validate().map_err(invalid)?;
+        validate::eta(("n", "k"), eta).map_err(invalid)?;
+        validate::wavelength(lam).map_err(invalid)?;
+    }
+    let model = TwoScale::new(&TABLES.brdf_tables(), layer, lam, eta, options);
+    let values = py.detach(|| rows(v.len(), |j| f64::from(model.eval(wi[j], wo[j]))));
+    Ok(shaped(py, &v.shape, values))
 }
 
+/// The extension of the `twoscale` package: `Material` (the RGB model of a
+/// material), the names of its options (`OPTIONS`, `BASES`), the wavelengths
+/// of its channels (`RGB_WAVELENGTHS`, µm) and the row functions behind
+/// `twoscale.lookup` and `twoscale.reference`.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Material>()?;
     m.add("RGB_WAVELENGTHS", twoscale::brdf::RGB_WAVELENGTHS.to_vec())?;
+    let options = BTreeMap::from([
+        (Masking::OPTION, names::<Masking>()),
+        (SigmaRelMode::OPTION, names::<SigmaRelMode>()),
+        (ColourTerms::OPTION, names::<ColourTerms>()),
+        (HaloWeight::OPTION, names::<HaloWeight>()),
+    ]);
+    let options = options
+        .into_iter()
+        .map(|(k, v)| Ok((k, PyTuple::new(m.py(), v)?)));
+    m.add("OPTIONS", options.collect::<PyResult<BTreeMap<_, _>>>()?)?;
+    m.add("BASES", PyTuple::new(m.py(), names::<BaseKind>())?)?;
     m.add_function(wrap_pyfunction!(g1, m)?)?;
     m.add_function(wrap_pyfunction!(sigma_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(conv, m)?)?;

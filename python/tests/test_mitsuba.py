@@ -211,3 +211,29 @@ def test_context_without_glossy_component_gives_zero():
     ctx.type_mask = +mi.BSDFFlags.DiffuseReflection
     assert np.all(np.asarray(bsdf.eval(ctx, si, wo)) == 0)
     assert np.all(np.asarray(bsdf.pdf(ctx, si, wo)) == 0)
+
+
+def test_register_needs_a_variant_and_the_module_loads_on_first_use():
+    """In a fresh interpreter: ``twoscale.mitsuba`` without an explicit import,
+    ``register()`` before ``mi.set_variant`` says what to do, after it the
+    BSDF loads and evaluates."""
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np, mitsuba as mi, twoscale\n"
+        "try:\n"
+        "    twoscale.mitsuba.register()\n"
+        "    raise SystemExit('register() without a variant did not raise')\n"
+        "except RuntimeError as e:\n"
+        "    assert 'mi.set_variant' in str(e), e\n"
+        "mi.set_variant('scalar_rgb')\n"
+        "twoscale.mitsuba.register()\n"
+        "bsdf = mi.load_dict({'type': 'twoscale', 'material': 'gold-rough'})\n"
+        "si = mi.SurfaceInteraction3f()\n"
+        "si.wi = mi.Vector3f(0.5, 0.0, 0.866)\n"
+        "value = bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(-0.5, 0.0, 0.866))\n"
+        "assert np.all(np.asarray(value) > 0), value\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr

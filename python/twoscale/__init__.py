@@ -3,15 +3,39 @@
 ``Material`` is the RGB model of one material (at 0.645, 0.526, 0.444 µm)
 evaluated over NumPy arrays of directions; ``lookup`` holds the table
 lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
-registers a Mitsuba 3 BSDF (imported on demand: it needs the ``mitsuba``
-package).
+registers a Mitsuba 3 BSDF (imported on first use of ``twoscale.mitsuba``:
+it needs the ``mitsuba`` package).
 
-Directions are unit vectors in the local frame (normal +z); ``wi`` points
-towards the light and ``wo`` towards the viewer. Lengths are in µm.
+Directions are unit vectors in the local frame (normal +z), arrays of shape
+``(..., 3)`` that broadcast together as NumPy's do; ``wi`` points towards
+the light and ``wo`` towards the viewer. Lengths are in µm.
+
+``OPTIONS`` maps each option keyword of ``Material`` to the names of its
+values (the default first) and ``BASES`` lists the base layers: the
+runtime's one list of each (``twoscale::validate::Named``).
 """
 
+import importlib
+from types import ModuleType
+
 from . import lookup, merl, reference
-from ._native import RGB_WAVELENGTHS, Material
+from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
 from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
-__all__ = ["Material", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference"]
+__all__ = [
+    "BASES",
+    "Material",
+    "OPTIONS",
+    "RGB_WAVELENGTHS",
+    "fit",
+    "lookup",
+    "merl",
+    "reference",
+]
+
+
+def __getattr__(name: str) -> ModuleType:
+    """``twoscale.mitsuba`` without an explicit import (PEP 562)."""
+    if name == "mitsuba":
+        return importlib.import_module(".mitsuba", __name__)
+    raise AttributeError(f"module 'twoscale' has no attribute '{name}'")

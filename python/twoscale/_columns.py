@@ -1,9 +1,14 @@
 """Broadcasting of scalar-or-array arguments for the native row functions."""
 
+from typing import Any, Callable
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 
-def broadcast_call(native, *args, **keywords):
+def broadcast_call(
+    native: Callable[..., NDArray[np.float64]], *args: ArrayLike, **keywords: Any
+) -> float | NDArray[np.float64]:
     """``native`` over the broadcast of ``args`` (numbers or arrays), as one
     contiguous float64 column each; the result has the broadcast shape (a
     float for scalar arguments)."""

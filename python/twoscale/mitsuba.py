@@ -43,15 +43,16 @@ import twoscale
 NAME = "twoscale"
 
 #: Material keywords passed through as strings (the runtime's options).
-OPTION_KEYS = ("masking", "sigma_rel", "colour", "halo_weight")
+OPTION_KEYS = tuple(twoscale.OPTIONS)
 #: Material keywords passed through as floats.
 FLOAT_KEYS = ("beta", "p", "sigma_s", "b", "c", "albedo", "lambertian")
 
 
-def bsdf_dict(material):
-    """The ``mi.load_dict`` description of a :class:`twoscale.Material`
-    (explicit parameters; ``eta`` as the string ``"n k, n k, n k"``)."""
-    d = {"type": NAME, "base": material.base}
+def bsdf_dict(material: twoscale.Material) -> dict[str, str | float]:
+    """bsdf_dict(material): the ``mi.load_dict`` description of a
+    :class:`twoscale.Material` (explicit parameters, lengths in µm; ``eta``
+    as the string ``"n k, n k, n k"``, red, green, blue)."""
+    d: dict[str, str | float] = {"type": NAME, "base": material.base}
     for key in FLOAT_KEYS:
         value = getattr(material, key)
         if value is not None:
@@ -175,8 +176,8 @@ def _bsdf_class():
     return TwoScaleBSDF
 
 
-def register():
-    """Registers the ``twoscale`` BSDF with the current Mitsuba variant; in
+def register() -> None:
+    """register(): registers the ``twoscale`` BSDF with the current Mitsuba variant; in
     JIT variants, switches symbolic loops and calls off (the BSDF runs on
     NumPy arrays, so Mitsuba must hand it evaluated wavefronts)."""
     if not mi.variant():

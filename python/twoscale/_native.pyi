@@ -1,0 +1,130 @@
+"""Type stubs of the extension module ``twoscale._native`` (python/src/lib.rs).
+
+The docstrings are the extension's own (``help(twoscale.Material.eval)``);
+these stubs give the types. Arrays of directions are ``(..., 3)``: anything
+``numpy.asarray`` reads as numbers, float32 and float64 arrays without
+conversion.
+"""
+
+from typing import final
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "Material",
+    "RGB_WAVELENGTHS",
+    "OPTIONS",
+    "BASES",
+    "g1",
+    "sigma_ratio",
+    "conv",
+    "fresnel",
+    "brdf",
+]
+
+RGB_WAVELENGTHS: list[float]
+OPTIONS: dict[str, tuple[str, ...]]
+BASES: tuple[str, ...]
+
+@final
+class Material:
+    def __new__(
+        cls,
+        *,
+        beta: float,
+        p: float,
+        eta: list[tuple[float, float]],
+        sigma_s: float = 0.0,
+        b: float = 1.0,
+        c: float = 2.0,
+        base: str | None = None,
+        albedo: float | None = None,
+        lambertian: float = 0.0,
+        masking: str | None = None,
+        sigma_rel: str | None = None,
+        colour: str | None = None,
+        halo_weight: str | None = None,
+    ) -> Material: ...
+    @staticmethod
+    def preset(
+        name: str,
+        *,
+        masking: str | None = None,
+        sigma_rel: str | None = None,
+        colour: str | None = None,
+        halo_weight: str | None = None,
+    ) -> Material: ...
+    @staticmethod
+    def presets() -> list[str]: ...
+    def eval(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float32]: ...
+    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float32]: ...
+    def sample(
+        self, wi: ArrayLike, u: ArrayLike
+    ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...
+    def eval_reference(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]: ...
+    @property
+    def beta(self) -> float: ...
+    @property
+    def p(self) -> float: ...
+    @property
+    def sigma_s(self) -> float: ...
+    @property
+    def b(self) -> float: ...
+    @property
+    def c(self) -> float: ...
+    @property
+    def eta(self) -> list[tuple[float, float]]: ...
+    @property
+    def base(self) -> str: ...
+    @property
+    def albedo(self) -> float | None: ...
+    @property
+    def lambertian(self) -> float: ...
+    @property
+    def options(self) -> dict[str, str]: ...
+
+def g1(
+    p: NDArray[np.float64], a: NDArray[np.float64], *, reference: bool, clamp: bool = False
+) -> NDArray[np.float64]: ...
+def sigma_ratio(
+    theta_i: NDArray[np.float64],
+    big_b: NDArray[np.float64],
+    c: NDArray[np.float64],
+    *,
+    reference: bool,
+    clamp: bool = False,
+) -> NDArray[np.float64]: ...
+def conv(
+    theta_h: NDArray[np.float64],
+    u: NDArray[np.float64],
+    c: NDArray[np.float64],
+    beta: NDArray[np.float64],
+    p: NDArray[np.float64],
+    *,
+    source: str,
+    clamp: bool = False,
+) -> NDArray[np.float64]: ...
+def fresnel(
+    n: NDArray[np.float64],
+    k: NDArray[np.float64],
+    cos_theta: NDArray[np.float64],
+    *,
+    reference: bool,
+    clamp: bool = False,
+) -> NDArray[np.float64]: ...
+def brdf(
+    wi: ArrayLike,
+    wo: ArrayLike,
+    *,
+    beta: float,
+    p: float,
+    sigma_s: float,
+    b: float,
+    c: float,
+    n: float,
+    k: float,
+    lam: float,
+    reference: bool,
+    clamp: bool = False,
+) -> NDArray[np.float64]: ...
