@@ -117,3 +117,40 @@ fn answers_agree_with_an_independent_reference() {
         );
     }
 }
+
+/// Outside T1's domain a row is refused with the domain, unless `clamp`:
+/// then it is answered at the clamped point and marked `in_domain = false`.
+#[test]
+fn out_of_domain_rows_are_refused_or_clamped_and_marked() {
+    let input = "p,a\n0.15,0.5\n1,0.5\n";
+    let (result, out, err) = run(input);
+    assert_eq!(
+        result.unwrap(),
+        query::Summary {
+            answered: 1,
+            bad: 1
+        }
+    );
+    assert!(
+        err.contains("line 2: p = 0.15: must be in [0.2, 5]"),
+        "{err}"
+    );
+    assert!(!out.contains("0.15,"), "{out}");
+
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let summary = query::run(
+        "g1",
+        &TableSource::Dir(suite::tables_dir()),
+        &query::Options { clamp: true },
+        input.as_bytes(),
+        &mut out,
+        &mut err,
+    )
+    .unwrap();
+    assert_eq!(summary.bad, 0);
+    let out = String::from_utf8(out).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "p,a,table,reference,in_domain");
+    assert!(lines[1].starts_with("0.15,0.5,") && lines[1].ends_with(",false"));
+    assert!(lines[2].starts_with("1,0.5,") && lines[2].ends_with(",true"));
+}
