@@ -94,6 +94,27 @@ def public_callables():
     return out
 
 
+def call_arguments(text):
+    """The top-level comma-separated arguments of the call ``(…)`` that
+    ``text`` opens with (defaults may hold parentheses: ``fixed=()``)."""
+    depth, current, out = 0, "", []
+    for ch in text:
+        if ch in "([{":
+            depth += 1
+            if depth == 1:
+                continue
+        elif ch in ")]}":
+            depth -= 1
+            if depth == 0:
+                break
+        if ch == "," and depth == 1:
+            out.append(current.replace("\n", " "))
+            current = ""
+        else:
+            current += ch
+    return out + [current.replace("\n", " ")]
+
+
 @pytest.mark.parametrize("name,obj", public_callables(), ids=[n for n, _ in public_callables()])
 def test_public_names_are_documented_with_their_arguments_in_order(name, obj):
     doc = inspect.getdoc(obj)
@@ -102,8 +123,9 @@ def test_public_names_are_documented_with_their_arguments_in_order(name, obj):
         params = [p for p in inspect.signature(obj).parameters if p not in ("self", "cls")]
         # the docstring opens with the call: name(the parameters in order)
         assert doc.startswith(obj.__name__ + "("), f"{name}: {doc[:60]!r}"
-        listed = doc[len(obj.__name__) + 1 : doc.index(")")].replace("\n", " ").split(",")
-        listed = [a.split("=")[0].strip() for a in listed if a.strip() not in ("", "*", "/")]
+        listed = call_arguments(doc[len(obj.__name__) :])
+        listed = [a.split("=")[0].strip().lstrip("*") for a in listed]
+        listed = [a for a in listed if a not in ("", "/")]
         assert listed == params, f"{name}: the docstring lists {listed}, the signature {params}"
 
 

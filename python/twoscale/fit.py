@@ -368,7 +368,12 @@ def fit(
     verbose=True,
     **start,
 ) -> Fit:
-    """Fits the model to ``measured`` (see the module's documentation).
+    """fit(measured, base="conductor", *, samples=DEFAULT_SAMPLES, starts=3,
+    grazing_k=0.0, epd=False, lambertian=True, fixed=(), seed=0,
+    max_nfev=None, verbose=True, **start)
+
+    Fits the model to ``measured`` (a MERL file's path or array, or
+    ``(wi, wo, rgb)`` samples; see the module's documentation).
     ``base``: "conductor", "plastic" or "subsurface"; ``samples``: the
     subsample size; ``starts``: how many starts; ``lambertian``: fit a
     Lambertian term k_d (else 0); ``start``: Material keywords replacing
