@@ -272,7 +272,7 @@ impl Projection {
     /// not stored (`l + m` or `l' + m` even, or out of range).
     pub fn element(&self, m: usize, l: usize, lp: usize) -> f64 {
         let n = block_size(self.band_limit, m);
-        if l <= m || lp <= m || (l + m) % 2 == 0 || (lp + m) % 2 == 0 {
+        if l <= m || lp <= m || (l + m).is_multiple_of(2) || (lp + m).is_multiple_of(2) {
             return 0.0;
         }
         let (a, b) = ((l - m - 1) / 2, (lp - m - 1) / 2);

@@ -1216,7 +1216,7 @@ pub fn validate_header(header: &Header) -> Result<(), FormatError> {
     if !header.generator_version.is_ascii() {
         return Err(FormatError::BadHeader("generator version is not ASCII"));
     }
-    if header.payload_offset % PAYLOAD_ALIGN as u64 != 0
+    if !header.payload_offset.is_multiple_of(PAYLOAD_ALIGN as u64)
         || header.payload_offset < HEADER_SIZE as u64
     {
         return Err(FormatError::BadHeader(
@@ -1334,7 +1334,7 @@ pub mod write {
         generator_version[..version.len()].copy_from_slice(version);
         let payload_offset = HEADER_SIZE.next_multiple_of(PAYLOAD_ALIGN);
         let channels = spec.channels as usize;
-        if channels == 0 || spec.grid.len() % channels != 0 {
+        if channels == 0 || !spec.grid.len().is_multiple_of(channels) {
             return Err(FormatError::BadHeader(
                 "grid length is not a multiple of the channel count",
             ));

@@ -161,7 +161,7 @@ pub fn packed_coefficient_index(band_limit: usize, m: usize, l: usize, lp: usize
     if m > band_limit || l > band_limit || lp > band_limit || l <= m || lp <= m {
         return None;
     }
-    if (l + m) % 2 == 0 || (lp + m) % 2 == 0 {
+    if (l + m).is_multiple_of(2) || (lp + m).is_multiple_of(2) {
         return None;
     }
     let (a, b) = ((l - m - 1) / 2, (lp - m - 1) / 2);

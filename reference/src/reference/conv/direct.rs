@@ -700,10 +700,10 @@ fn ring(
     // Nearest arc first (the kernel's map runs from ψ_max at cuts[0] to
     // ψ = 0 at 1), so that `sum` can bound what the farther arcs may skip.
     for pair in cuts.windows(2).rev() {
-        if let Some(bound) = map.arc_bound(inner, pair[0], pair[1]) {
-            if bound * arcs as f64 <= NEGLIGIBLE * tol.abs.max(tol.rel * sum) {
-                continue;
-            }
+        if let Some(bound) = map.arc_bound(inner, pair[0], pair[1])
+            && bound * arcs as f64 <= NEGLIGIBLE * tol.abs.max(tol.rel * sum)
+        {
+            continue;
         }
         match integrate_with_rule(g, pair[0], pair[1], tol, DEFAULT_MAX_INTERVALS, rule) {
             Ok(est) => {
