@@ -272,7 +272,7 @@ fn encode_table(grid: &[f32]) -> Result<Vec<u8>, BuildError> {
 /// on every 7th node (`studies t3-direct-cost --stride 7`, 1 528 direct
 /// nodes with `u > 100`) as `634 000 (u/100)^0.056 β^0.103 p^(−0.358)`
 /// (half the nodes within 0.68–1.44× of it), at ≈ 76 ns per evaluation
-/// (docs/design/t3-build-speed.md §9, §10).
+/// (docs/design/t3-build-speed.md, passes 3 and 4).
 pub fn node_cost(index: usize) -> u64 {
     let [u, _, beta, p] = node_params(index);
     if node_tries_zonal_harmonics(index) {
