@@ -9,7 +9,7 @@ use generator::tables::t3;
 use twoscale::TableId;
 use twoscale::conv::{ConvTable, Convolution, normalised_angle, tan_of_normalised_angle};
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, aligned_copy};
+use twoscale::format::{AxisHeader, aligned_copy};
 use twoscale::interp::{coordinate_f64, node_value};
 
 fn small_axis(nodes: u32, base: &AxisHeader) -> AxisHeader {
@@ -58,8 +58,8 @@ fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f
     let bytes = encode(&TableSpec {
         table_id: TableId::Convolution,
         channels: (2 + angles) as u32,
-        kernel: Kernel::Multilinear,
-        value_type: twoscale::format::ValueType::U16,
+        kernel: TableId::Convolution.descriptor().kernel,
+        value_type: TableId::Convolution.descriptor().value_type,
         axes: &axes,
         params: &t3::header_params(
             angles,

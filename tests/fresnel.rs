@@ -7,6 +7,7 @@ use generator::query;
 use generator::reference::fresnel as reference;
 use generator::reference::fresnel::Complex64;
 use generator::rng::SplitMix64;
+use generator::table_source::TableSource;
 use twoscale::fresnel::{fresnel, q_bar};
 use twoscale::{Complex, DiffuseFresnelTable, FormatError, TableId};
 
@@ -264,7 +265,8 @@ fn run_query(input: &str) -> (query::Summary, String, String) {
     let (mut out, mut err) = (Vec::new(), Vec::new());
     let summary = query::run(
         "fresnel",
-        &suite::tables_dir(),
+        &TableSource::Dir(suite::tables_dir()),
+        &query::Options::default(),
         input.as_bytes(),
         &mut out,
         &mut err,

@@ -4,13 +4,15 @@
 use generator::query;
 use generator::reference::epd;
 use generator::rng::SplitMix64;
+use generator::table_source::TableSource;
 
 fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
     let mut out = Vec::new();
     let mut err = Vec::new();
     let result = query::run(
         "g1",
-        &suite::tables_dir(),
+        &TableSource::Dir(suite::tables_dir()),
+        &query::Options::default(),
         input.as_bytes(),
         &mut out,
         &mut err,
@@ -66,7 +68,8 @@ fn header_and_quantity_errors_fail_fast() {
     let mut sink = Vec::new();
     let unknown = query::run(
         "nope",
-        &suite::tables_dir(),
+        &TableSource::Dir(suite::tables_dir()),
+        &query::Options::default(),
         "x\n".as_bytes(),
         &mut sink,
         &mut Vec::new(),

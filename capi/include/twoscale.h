@@ -132,7 +132,7 @@
 #define TS_HALO_INCIDENT 1
 
 /**
- * An RGB material built from a `ts_tables`. Opaque; about 136 KB.
+ * An RGB material built from a `ts_tables`. Opaque; about 136 KB, on the heap.
  */
 typedef struct ts_material ts_material;
 
@@ -181,12 +181,21 @@ typedef struct {
 
 /**
  * Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
- * `twoscale::brdf::Options`). All-zero enumeration fields are the defaults
- * (conductor, the paper's options). Lengths are in µm. Out-of-range finite
- * values are clamped as `TwoScale::new` documents (e.g. albedos to [0, 1]);
- * NaN or infinite values are rejected.
+ * `twoscale::brdf::Options`). Set `size` to `sizeof(ts_material_desc)`
+ * (`ts_material_desc_preset` does); other sizes are rejected. All-zero
+ * enumeration fields are the defaults (conductor, the paper's options).
+ * Lengths are in µm. Values outside the model's domain (`Material::validate`
+ * of the runtime: β and p in the EPD's domain, σs ≥ 0, b > 0 when σs > 0,
+ * c > 1, albedos in [0, 1], n > 0, k ≥ 0, no albedo on a conductor) and NaN
+ * or infinite values are rejected with `TS_ERR_INVALID` and a message naming
+ * the field, its value and its domain.
  */
 typedef struct {
+  /**
+   * `sizeof(ts_material_desc)`, set by the caller: the layout the caller
+   * was compiled with.
+   */
+  uint32_t size;
   /**
    * EPD width β (HP17 35).
    */
@@ -271,6 +280,11 @@ extern "C" {
 #endif // __cplusplus
 
 /**
+ * The library's version, `"MAJOR.MINOR.PATCH"` (static storage).
+ */
+const char *ts_version(void);
+
+/**
  * The message of this thread's last failure (an empty string if none). The
  * pointer stays valid until the next failing call on this thread.
  */
@@ -345,8 +359,9 @@ const char *ts_preset_name(uintptr_t index);
 int ts_rgb_wavelengths(float *out);
 
 /**
- * Fills `out` with preset `name`'s parameters and the default options (a
- * starting point for `ts_material_new`).
+ * Fills `out` with preset `name`'s parameters and the default options, and
+ * `out->size` with `sizeof(ts_material_desc)` (a starting point for
+ * `ts_material_new`).
  *
  * # Safety
  *
@@ -368,10 +383,12 @@ ts_material *ts_material_preset(const ts_tables *t,
 
 /**
  * The material `desc` describes. Construction bakes per-material tables
- * (milliseconds): build once per material, not per evaluation. The model
- * (~136 KB) is built on the calling thread's stack before it moves to the
- * heap, so call `ts_material_*` from a thread whose stack is well above
- * that. NULL on failure (`TS_ERR_INVALID` names the field).
+ * (milliseconds): build once per material, not per evaluation. The tables
+ * (~136 KB) are allocated on the heap and filled in place: any thread may
+ * build materials (a 64 KiB stack is enough). NULL on failure
+ * (`TS_ERR_INVALID`: `desc->size` is not `sizeof(ts_material_desc)`, an
+ * unknown enumeration value, or a number outside its domain; the message
+ * names the field, its value and its domain).
  *
  * # Safety
  *

@@ -20,14 +20,14 @@ use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, Options, RGB_WAVELENGTHS, Rgb,
-    SigmaRelMode, Surface,
+    BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
+    RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
 };
-use twoscale::format::{AlignedBuf, aligned_copy};
+use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
-use twoscale::mmap::MappedFile;
 use twoscale::table_set::TABLES;
-use twoscale::{Complex, TableBytes, TableSet, TableSetError};
+use twoscale::validate::{self, Domain, Invalid};
+use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
 
 /// Success.
 pub const TS_OK: c_int = 0;
@@ -73,14 +73,15 @@ pub const TS_HALO_INCIDENT: i32 = 1;
 
 /// A validated set of the four tables (T1, T2, T3, T5). Opaque.
 pub struct ts_tables {
-    inner: Arc<Tables>,
+    inner: Arc<OwnedTableSet>,
 }
 
-/// An RGB material built from a `ts_tables`. Opaque; about 136 KB.
+/// An RGB material built from a `ts_tables`. Opaque; about 136 KB, on the heap.
 pub struct ts_material {
-    /// Borrows `_tables` (declared after it, so dropped before it).
-    rgb: Rgb<'static>,
-    _tables: Arc<Tables>,
+    /// Borrows `_tables` (declared after it, so dropped before it); its
+    /// bakes are allocated zeroed on the heap and filled in place.
+    rgb: Rgb<'static, Box<ChannelBake>>,
+    _tables: Arc<OwnedTableSet>,
 }
 
 /// The bytes of the four table files, for `ts_tables_from_bytes`.
@@ -105,13 +106,20 @@ pub struct ts_table_bytes {
 }
 
 /// Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
-/// `twoscale::brdf::Options`). All-zero enumeration fields are the defaults
-/// (conductor, the paper's options). Lengths are in µm. Out-of-range finite
-/// values are clamped as `TwoScale::new` documents (e.g. albedos to [0, 1]);
-/// NaN or infinite values are rejected.
+/// `twoscale::brdf::Options`). Set `size` to `sizeof(ts_material_desc)`
+/// (`ts_material_desc_preset` does); other sizes are rejected. All-zero
+/// enumeration fields are the defaults (conductor, the paper's options).
+/// Lengths are in µm. Values outside the model's domain (`Material::validate`
+/// of the runtime: β and p in the EPD's domain, σs ≥ 0, b > 0 when σs > 0,
+/// c > 1, albedos in [0, 1], n > 0, k ≥ 0, no albedo on a conductor) and NaN
+/// or infinite values are rejected with `TS_ERR_INVALID` and a message naming
+/// the field, its value and its domain.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ts_material_desc {
+    /// `sizeof(ts_material_desc)`, set by the caller: the layout the caller
+    /// was compiled with.
+    pub size: u32,
     /// EPD width β (HP17 35).
     pub beta: f32,
     /// EPD shape p (HP17 35), in [0.2, 5].
@@ -144,6 +152,35 @@ pub struct ts_material_desc {
     pub halo_weight: i32,
 }
 
+impl Default for ts_material_desc {
+    /// A conductor with the paper's options, every number 0, `size` set.
+    fn default() -> Self {
+        ts_material_desc {
+            size: desc_size(),
+            beta: 0.0,
+            p: 0.0,
+            sigma_s: 0.0,
+            b: 0.0,
+            c: 0.0,
+            base: TS_BASE_CONDUCTOR,
+            base_albedo: 0.0,
+            lambertian: 0.0,
+            eta_re: [0.0; 3],
+            eta_im: [0.0; 3],
+            masking: TS_MASKING_SEPARABLE,
+            sigma_rel: TS_SIGMA_REL_INCIDENT,
+            colour: TS_COLOUR_PHYSICAL,
+            halo_weight: TS_HALO_PRINTED,
+        }
+    }
+}
+
+/// `sizeof(ts_material_desc)` of this library (the only size accepted). A
+/// function, not a `const`: cbindgen would try to export the constant.
+fn desc_size() -> u32 {
+    size_of::<ts_material_desc>() as u32
+}
+
 /// A sampled direction. `pdf == 0` means no direction was sampled (e.g. `wi`
 /// below the horizon); `wo` and `value` are then zero.
 #[repr(C)]
@@ -155,63 +192,6 @@ pub struct ts_sample {
     pub pdf: f32,
     /// ρ(wi, wo) per channel, as `ts_eval_rgb`.
     pub value: [f32; 3],
-}
-
-/// Where a handle's table bytes live; the set borrows them.
-enum Storage {
-    Copied(AlignedBuf),
-    Mapped(MappedFile),
-}
-
-impl Storage {
-    fn bytes(&self) -> &[u8] {
-        match self {
-            Storage::Copied(buf) => buf.bytes(),
-            Storage::Mapped(map) => map.bytes(),
-        }
-    }
-}
-
-/// A table set and the storage it borrows.
-struct Tables {
-    /// Borrows `_storage` (declared after it, so dropped before it), or the
-    /// embedded tables (truly `'static`).
-    set: TableSet<'static>,
-    _storage: Vec<Storage>,
-}
-
-impl Tables {
-    fn embedded() -> Result<Tables, TableSetError> {
-        Ok(Tables {
-            set: TableSet::from_bytes(TableSet::embedded_bytes())?,
-            _storage: Vec::new(),
-        })
-    }
-
-    /// Validates the four files held by `storage` (in the order of `TABLES`).
-    fn from_storage(storage: Vec<Storage>) -> Result<Tables, TableSetError> {
-        let bytes = |k: usize| -> &'static [u8] {
-            let slice: *const [u8] = storage[k].bytes();
-            // SAFETY: the slice lies in a heap buffer (`AlignedBuf`) or a
-            // memory map owned by `storage[k]`; neither moves when `storage`
-            // moves into the returned `Tables`, neither is ever written, and
-            // both live until `Tables::_storage` is dropped, which happens
-            // after `Tables::set` (field order). The set, and every `Rgb`
-            // made from it, is reachable only through the `Arc<Tables>` that
-            // keeps the storage alive.
-            unsafe { &*slice }
-        };
-        let set = TableSet::from_bytes(TableBytes {
-            smith: bytes(0),
-            sigma_ratio: bytes(1),
-            convolution: bytes(2),
-            diffuse_fresnel: bytes(3),
-        })?;
-        Ok(Tables {
-            set,
-            _storage: storage,
-        })
-    }
 }
 
 /// A failure: a status code and its message.
@@ -336,77 +316,128 @@ fn utf8<'s>(s: *const c_char, what: &str) -> Result<&'s str, Fail> {
         .map_err(|e| Fail::new(TS_ERR_INVALID, format!("{what} is not UTF-8: {e}")))
 }
 
-fn enum_value<T: Copy>(value: i32, field: &str, values: &[T]) -> Result<T, Fail> {
-    usize::try_from(value)
-        .ok()
-        .and_then(|k| values.get(k).copied())
-        .ok_or_else(|| {
-            Fail::new(
-                TS_ERR_INVALID,
-                format!(
-                    "{field} = {value} is not one of 0..={}",
-                    values.len().saturating_sub(1)
-                ),
-            )
-        })
+/// `TS_ERR_INVALID` with the runtime validation's message, the parameter
+/// named as the field of `ts_material_desc` that holds it.
+fn invalid(error: Invalid) -> Fail {
+    let field = match error.name {
+        "albedo" => "base_albedo",
+        "eta[0].n" => "eta_re[0]",
+        "eta[1].n" => "eta_re[1]",
+        "eta[2].n" => "eta_re[2]",
+        "eta[0].k" => "eta_im[0]",
+        "eta[1].k" => "eta_im[1]",
+        "eta[2].k" => "eta_im[2]",
+        name => name,
+    };
+    Fail::new(
+        TS_ERR_INVALID,
+        format!(
+            "ts_material_desc.{}",
+            Invalid {
+                name: field,
+                ..error
+            }
+        ),
+    )
+}
+
+/// `TS_ERR_INVALID` for an enumeration field holding none of its constants
+/// (`names`: each constant's name and value).
+fn unknown_constant(field: &str, value: i32, names: &[(&str, i32)]) -> Fail {
+    let mut accepted = String::new();
+    for (k, (name, v)) in names.iter().enumerate() {
+        let sep = if k == 0 { "" } else { ", " };
+        accepted.push_str(&format!("{sep}{name} ({v})"));
+    }
+    Fail::new(
+        TS_ERR_INVALID,
+        format!("ts_material_desc.{field} = {value} is not one of {accepted}"),
+    )
 }
 
 impl ts_material_desc {
-    /// The runtime's material and options; rejects non-finite numbers and
-    /// unknown enumeration values, naming the field.
+    /// The runtime's material and options: unknown enumeration values and
+    /// what `Material::validate` rejects (non-finite numbers among them) are
+    /// `TS_ERR_INVALID`, naming the field.
     fn to_model(self) -> Result<(Material, Options), Fail> {
-        let numbers = [
-            ("beta", self.beta),
-            ("p", self.p),
-            ("sigma_s", self.sigma_s),
-            ("b", self.b),
-            ("c", self.c),
-            ("base_albedo", self.base_albedo),
-            ("lambertian", self.lambertian),
-            ("eta_re[0]", self.eta_re[0]),
-            ("eta_re[1]", self.eta_re[1]),
-            ("eta_re[2]", self.eta_re[2]),
-            ("eta_im[0]", self.eta_im[0]),
-            ("eta_im[1]", self.eta_im[1]),
-            ("eta_im[2]", self.eta_im[2]),
-        ];
-        if let Some((name, value)) = numbers.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(Fail::new(
-                TS_ERR_INVALID,
-                format!("ts_material_desc.{name} is not finite: {value}"),
-            ));
-        }
         let albedo = self.base_albedo;
-        let base = enum_value(
-            self.base,
-            "ts_material_desc.base",
-            &[
-                BaseLayer::Conductor,
-                BaseLayer::Plastic { albedo },
-                BaseLayer::Subsurface { albedo },
-            ],
-        )?;
+        let base = match self.base {
+            TS_BASE_CONDUCTOR => BaseLayer::Conductor,
+            TS_BASE_PLASTIC => BaseLayer::Plastic { albedo },
+            TS_BASE_SUBSURFACE => BaseLayer::Subsurface { albedo },
+            other => {
+                return Err(unknown_constant(
+                    "base",
+                    other,
+                    &[
+                        ("TS_BASE_CONDUCTOR", TS_BASE_CONDUCTOR),
+                        ("TS_BASE_PLASTIC", TS_BASE_PLASTIC),
+                        ("TS_BASE_SUBSURFACE", TS_BASE_SUBSURFACE),
+                    ],
+                ));
+            }
+        };
+        let masking = match self.masking {
+            TS_MASKING_SEPARABLE => Masking::Separable,
+            TS_MASKING_HEIGHT_CORRELATED => Masking::HeightCorrelated,
+            other => {
+                return Err(unknown_constant(
+                    "masking",
+                    other,
+                    &[
+                        ("TS_MASKING_SEPARABLE", TS_MASKING_SEPARABLE),
+                        ("TS_MASKING_HEIGHT_CORRELATED", TS_MASKING_HEIGHT_CORRELATED),
+                    ],
+                ));
+            }
+        };
+        let sigma_rel = match self.sigma_rel {
+            TS_SIGMA_REL_INCIDENT => SigmaRelMode::Incident,
+            TS_SIGMA_REL_SYMMETRISED => SigmaRelMode::Symmetrised,
+            other => {
+                return Err(unknown_constant(
+                    "sigma_rel",
+                    other,
+                    &[
+                        ("TS_SIGMA_REL_INCIDENT", TS_SIGMA_REL_INCIDENT),
+                        ("TS_SIGMA_REL_SYMMETRISED", TS_SIGMA_REL_SYMMETRISED),
+                    ],
+                ));
+            }
+        };
+        let colour = match self.colour {
+            TS_COLOUR_PHYSICAL => ColourTerms::Physical,
+            TS_COLOUR_WHITE => ColourTerms::White,
+            other => {
+                return Err(unknown_constant(
+                    "colour",
+                    other,
+                    &[
+                        ("TS_COLOUR_PHYSICAL", TS_COLOUR_PHYSICAL),
+                        ("TS_COLOUR_WHITE", TS_COLOUR_WHITE),
+                    ],
+                ));
+            }
+        };
+        let halo_weight = match self.halo_weight {
+            TS_HALO_PRINTED => HaloWeight::Printed,
+            TS_HALO_INCIDENT => HaloWeight::Incident,
+            other => {
+                return Err(unknown_constant(
+                    "halo_weight",
+                    other,
+                    &[
+                        ("TS_HALO_PRINTED", TS_HALO_PRINTED),
+                        ("TS_HALO_INCIDENT", TS_HALO_INCIDENT),
+                    ],
+                ));
+            }
+        };
         let options = Options {
-            masking: enum_value(
-                self.masking,
-                "ts_material_desc.masking",
-                &[Masking::Separable, Masking::HeightCorrelated],
-            )?,
-            sigma_rel: enum_value(
-                self.sigma_rel,
-                "ts_material_desc.sigma_rel",
-                &[SigmaRelMode::Incident, SigmaRelMode::Symmetrised],
-            )?,
-            colour: enum_value(
-                self.colour,
-                "ts_material_desc.colour",
-                &[ColourTerms::Physical, ColourTerms::White],
-            )?,
-            halo_weight: enum_value(
-                self.halo_weight,
-                "ts_material_desc.halo_weight",
-                &[HaloWeight::Printed, HaloWeight::Incident],
-            )?,
+            masking,
+            sigma_rel,
+            colour,
+            halo_weight,
         };
         let material = Material {
             layer: Layer {
@@ -422,6 +453,17 @@ impl ts_material_desc {
             },
             eta_rgb: [0, 1, 2].map(|k| Complex::new(self.eta_re[k], self.eta_im[k])),
         };
+        if material.layer.base == BaseLayer::Conductor {
+            // A conductor has no base layer: its albedo field must stay 0.
+            validate::check(
+                "albedo",
+                validate::widen(albedo),
+                Domain::Closed(0.0, 0.0),
+                "a conductor has no base layer",
+            )
+            .map_err(invalid)?;
+        }
+        material.validate().map_err(invalid)?;
         Ok((material, options))
     }
 
@@ -434,6 +476,7 @@ impl ts_material_desc {
         };
         let s = material.layer.surface;
         ts_material_desc {
+            size: desc_size(),
             beta: s.beta,
             p: s.p,
             sigma_s: s.sigma_s,
@@ -464,7 +507,7 @@ impl ts_material_desc {
     }
 }
 
-fn new_tables(tables: Tables) -> Box<ts_tables> {
+fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
     Box::new(ts_tables {
         inner: Arc::new(tables),
     })
@@ -472,16 +515,29 @@ fn new_tables(tables: Tables) -> Box<ts_tables> {
 
 /// Builds the material handle of `material` from the set behind `t`.
 fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
-    let rgb: Rgb<'_> = t.inner.set.rgb(material, options);
+    let rgb = Rgb::boxed(&t.inner.set().brdf_tables(), material, options);
     // SAFETY: `rgb` borrows only the `TableSet` inside the `Arc` allocation
     // (which never moves) and, through it, the table storage it owns. The
     // handle keeps a clone of that `Arc` in `_tables`, dropped after `rgb`
     // (field order), so the borrow never dangles.
-    let rgb = unsafe { std::mem::transmute::<Rgb<'_>, Rgb<'static>>(rgb) };
+    let rgb = unsafe {
+        std::mem::transmute::<Rgb<'_, Box<ChannelBake>>, Rgb<'static, Box<ChannelBake>>>(rgb)
+    };
     Box::new(ts_material {
         rgb,
         _tables: Arc::clone(&t.inner),
     })
+}
+
+/// The library's version, `"MAJOR.MINOR.PATCH"` (static storage).
+#[unsafe(no_mangle)]
+pub extern "C" fn ts_version() -> *const c_char {
+    const VERSION: &CStr =
+        match CStr::from_bytes_with_nul(concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes()) {
+            Ok(version) => version,
+            Err(_) => panic!("the package version holds a NUL"),
+        };
+    VERSION.as_ptr()
 }
 
 /// The message of this thread's last failure (an empty string if none). The
@@ -504,7 +560,10 @@ pub extern "C" fn ts_last_status() -> c_int {
 /// The tables compiled into the library (no files needed). NULL on failure.
 #[unsafe(no_mangle)]
 pub extern "C" fn ts_tables_embedded() -> *mut ts_tables {
-    handle(|| Ok(new_tables(Tables::embedded()?)))
+    handle(|| {
+        let set = TableSet::from_bytes(TableSet::embedded_bytes())?;
+        Ok(new_tables(OwnedTableSet::from_static(set)))
+    })
 }
 
 /// Memory-maps and validates the four table files of directory `dir`
@@ -531,17 +590,7 @@ pub unsafe extern "C" fn ts_tables_open(dir: *const c_char) -> *mut ts_tables {
             dir.to_str()
                 .map_err(|e| Fail::new(TS_ERR_INVALID, format!("dir is not UTF-8: {e}")))?,
         );
-        let storage = TABLES
-            .iter()
-            .map(|id| {
-                let path = dir.join(format!("{}.tbl", id.name()));
-                match MappedFile::open(&path) {
-                    Ok(map) => Ok(Storage::Mapped(map)),
-                    Err(error) => Err(TableSetError::Io { path, error }),
-                }
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(new_tables(Tables::from_storage(storage)?))
+        Ok(new_tables(TableSet::open(dir)?))
     })
 }
 
@@ -560,30 +609,40 @@ pub unsafe extern "C" fn ts_tables_from_bytes(bytes: *const ts_table_bytes) -> *
         non_null(bytes, "bytes")?;
         // SAFETY: non-null; the caller passes a valid `ts_table_bytes`.
         let b = unsafe { &*bytes };
-        let files = [
-            (b.smith, b.smith_len),
-            (b.sigma_ratio, b.sigma_ratio_len),
-            (b.convolution, b.convolution_len),
-            (b.diffuse_fresnel, b.diffuse_fresnel_len),
-        ];
-        let storage = files
+        let file = |id: TableId| match id {
+            TableId::SmithG1 => (b.smith, b.smith_len),
+            TableId::SigmaRatio => (b.sigma_ratio, b.sigma_ratio_len),
+            TableId::Convolution => (b.convolution, b.convolution_len),
+            TableId::DiffuseFresnel => (b.diffuse_fresnel, b.diffuse_fresnel_len),
+            TableId::ShBrdf => (std::ptr::null(), 0),
+        };
+        let mut copies = TABLES
             .iter()
-            .zip(TABLES)
-            .map(|(&(ptr, len), id)| {
-                non_null(ptr, &format!("the bytes of {}.tbl", id.name()))?;
+            .map(|&id| {
+                let (ptr, len) = file(id);
+                let name = id.file_name();
+                non_null(ptr, &format!("the bytes of {name}"))?;
                 if len > isize::MAX as usize {
                     return Err(Fail::new(
                         TS_ERR_INVALID,
-                        format!("{}.tbl: length {len} is too large", id.name()),
+                        format!("{name}: length {len} is too large"),
                     ));
                 }
                 // SAFETY: non-null, `len` ≤ isize::MAX, and the caller
                 // guarantees `len` readable bytes; `u8` needs no alignment.
                 let slice = unsafe { std::slice::from_raw_parts(ptr, len) };
-                Ok(Storage::Copied(aligned_copy(slice)))
+                Ok(Some(TableStorage::Copied(aligned_copy(slice))))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(new_tables(Tables::from_storage(storage)?))
+        let set = OwnedTableSet::from_storage(|id| {
+            let k = TABLES.iter().position(|&t| t == id);
+            k.and_then(|k| copies.get_mut(k)?.take())
+                .ok_or(TableSetError::Format {
+                    table: id,
+                    error: FormatError::BadHeader("no bytes given"),
+                })
+        })?;
+        Ok(new_tables(set))
     })
 }
 
@@ -639,8 +698,9 @@ pub unsafe extern "C" fn ts_rgb_wavelengths(out: *mut f32) -> c_int {
     })
 }
 
-/// Fills `out` with preset `name`'s parameters and the default options (a
-/// starting point for `ts_material_new`).
+/// Fills `out` with preset `name`'s parameters and the default options, and
+/// `out->size` with `sizeof(ts_material_desc)` (a starting point for
+/// `ts_material_new`).
 ///
 /// # Safety
 ///
@@ -690,10 +750,12 @@ pub unsafe extern "C" fn ts_material_preset(
 }
 
 /// The material `desc` describes. Construction bakes per-material tables
-/// (milliseconds): build once per material, not per evaluation. The model
-/// (~136 KB) is built on the calling thread's stack before it moves to the
-/// heap, so call `ts_material_*` from a thread whose stack is well above
-/// that. NULL on failure (`TS_ERR_INVALID` names the field).
+/// (milliseconds): build once per material, not per evaluation. The tables
+/// (~136 KB) are allocated on the heap and filled in place: any thread may
+/// build materials (a 64 KiB stack is enough). NULL on failure
+/// (`TS_ERR_INVALID`: `desc->size` is not `sizeof(ts_material_desc)`, an
+/// unknown enumeration value, or a number outside its domain; the message
+/// names the field, its value and its domain).
 ///
 /// # Safety
 ///
@@ -709,8 +771,22 @@ pub unsafe extern "C" fn ts_material_new(
         if !desc.is_aligned() {
             return Err(Fail::new(TS_ERR_MISALIGNED, "desc is misaligned"));
         }
-        // SAFETY: non-null, aligned, readable by the caller's contract; every
-        // field is a plain number, so any bit pattern is a valid value.
+        // SAFETY: non-null, aligned, and by the caller's contract readable
+        // for at least the `size` field, which every layout starts with.
+        let size = unsafe { std::ptr::addr_of!((*desc).size).read() };
+        if size != desc_size() {
+            return Err(Fail::new(
+                TS_ERR_INVALID,
+                format!(
+                    "ts_material_desc.size = {size} is not sizeof(ts_material_desc) = {} \
+                     of this library (set it to sizeof(ts_material_desc))",
+                    desc_size()
+                ),
+            ));
+        }
+        // SAFETY: as above, and `size` says the caller's struct is this
+        // layout; every field is a plain number, so any bit pattern is a
+        // valid value.
         let desc = unsafe { desc.read() };
         let (material, options) = desc.to_model()?;
         // SAFETY: non-null, a live handle by the caller's contract.
@@ -822,7 +898,7 @@ pub unsafe extern "C" fn ts_eval_rgb_batch(
         for j in 0..n {
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, o) = unsafe { (read3(wi, j, "wi")?, read3(wo, j, "wo")?) };
-            let value = m.rgb.eval(i, o);
+            let value = Bxdf::eval(&m.rgb, i, o);
             for (k, v) in value.iter().enumerate() {
                 // SAFETY: as above; element-wise writes allow aliasing.
                 unsafe { out.add(3 * j + k).write(*v) };
@@ -858,7 +934,7 @@ pub unsafe extern "C" fn ts_pdf_batch(
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, o) = unsafe { (read3(wi, j, "wi")?, read3(wo, j, "wo")?) };
             // SAFETY: checked pointer; the caller gives n floats.
-            unsafe { pdf.add(j).write(m.rgb.pdf(i, o)) };
+            unsafe { pdf.add(j).write(Bxdf::pdf(&m.rgb, i, o)) };
         }
         Ok(())
     })
@@ -892,7 +968,7 @@ pub unsafe extern "C" fn ts_sample_rgb_batch(
         for j in 0..n {
             // SAFETY: checked pointers; the caller gives 3 n floats each.
             let (i, u) = unsafe { (read3(wi, j, "wi")?, read3(u, j, "u")?) };
-            let sample = match m.rgb.sample(i, u) {
+            let sample = match Bxdf::sample(&m.rgb, i, u) {
                 Some(s) => ts_sample {
                     wo: s.o,
                     pdf: s.pdf,
@@ -944,9 +1020,79 @@ mod tests {
                 assert_eq!((back, back_options), (material, *options), "{name}");
             }
         }
-        let zero = ts_material_desc::default().to_model().ok().expect("zeroed");
-        assert_eq!(zero.1, Options::default());
-        assert_eq!(zero.0.layer.base, BaseLayer::Conductor);
+        // Zeroed enumeration fields are the defaults; zeroed numbers are not
+        // a surface (β = 0 is outside the EPD's domain).
+        let zero = ts_material_desc {
+            beta: 0.3,
+            p: 1.0,
+            c: 2.0,
+            eta_re: [1.5; 3],
+            ..ts_material_desc::default()
+        };
+        let (material, options) = zero.to_model().ok().expect("zeroed enumerations");
+        assert_eq!(options, Options::default());
+        assert_eq!(material.layer.base, BaseLayer::Conductor);
+        let Err(Fail(code, message)) = ts_material_desc::default().to_model() else {
+            panic!("β = 0 accepted");
+        };
+        assert_eq!(code, TS_ERR_INVALID);
+        assert!(
+            message.starts_with("ts_material_desc.beta = 0: must be in"),
+            "{message}"
+        );
+    }
+
+    /// Each parameter outside the runtime's domain is rejected with the
+    /// runtime validation's message, naming the description's field.
+    #[test]
+    fn out_of_domain_descriptions_are_rejected() {
+        let gold = twoscale::materials::preset("gold-rough").expect("preset");
+        let base = ts_material_desc::from_model(&gold, Options::default());
+        type Edit = fn(&mut ts_material_desc);
+        let cases: [(Edit, &str); 9] = [
+            (
+                |d| d.beta = -0.1,
+                "ts_material_desc.beta = -0.1: must be in",
+            ),
+            (
+                |d| d.p = 100.0,
+                "ts_material_desc.p = 100: must be in [0.2, 5]",
+            ),
+            (
+                |d| d.c = 0.5,
+                "ts_material_desc.c = 0.5: must be finite and > 1",
+            ),
+            (
+                |d| d.sigma_s = -1.0,
+                "ts_material_desc.sigma_s = -1: must be finite and ≥ 0",
+            ),
+            (
+                |d| d.b = -5.0,
+                "ts_material_desc.b = -5: must be finite and ≥ 0",
+            ),
+            (
+                |d| d.base_albedo = 0.5,
+                "ts_material_desc.base_albedo = 0.5",
+            ),
+            (|d| d.eta_im[1] = -1.0, "ts_material_desc.eta_im[1] = -1"),
+            (
+                |d| d.eta_re[2] = f32::NAN,
+                "ts_material_desc.eta_re[2] = NaN",
+            ),
+            (|d| d.lambertian = 2.0, "ts_material_desc.lambertian = 2"),
+        ];
+        assert_eq!(base.base, TS_BASE_CONDUCTOR);
+        for (edit, want) in cases {
+            let mut desc = base;
+            edit(&mut desc);
+            match desc.to_model() {
+                Err(Fail(code, message)) => {
+                    assert_eq!(code, TS_ERR_INVALID, "{message}");
+                    assert!(message.starts_with(want), "{message} (want {want})");
+                }
+                Ok(_) => panic!("accepted: {desc:?} (want {want})"),
+            }
+        }
     }
 
     #[test]

@@ -5,11 +5,11 @@
 
 use std::fmt;
 use std::path::PathBuf;
-use twoscale::FormatError;
 
 use crate::materials::MaterialsError;
 use crate::plot::PlotError;
 use crate::query::QueryError;
+use crate::table_source::TableFileError;
 use crate::tables::BuildError;
 use crate::tables::t3::ShardError;
 
@@ -44,13 +44,8 @@ pub enum Error {
     Usage(String),
     /// The materials file is unreadable or invalid.
     Materials(MaterialsError),
-    /// A table file is malformed.
-    Format {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        source: FormatError,
-    },
+    /// A table file could not be read or is malformed.
+    Tables(TableFileError),
     /// A table could not be built, verified or spot-checked.
     Table {
         /// The table's file stem (or the shard's file name).
@@ -115,7 +110,7 @@ impl fmt::Display for Error {
             }
             Error::Usage(message) => write!(f, "{message}"),
             Error::Materials(e) => write!(f, "{e}"),
-            Error::Format { path, source } => write!(f, "{}: {source}", path.display()),
+            Error::Tables(e) => write!(f, "{e}"),
             Error::Table { table, source } => write!(f, "{table}: {source}"),
             Error::Shard(e) => write!(f, "T3 shards: {e}"),
             Error::Query(e) => write!(f, "{e}"),
@@ -134,7 +129,7 @@ impl std::error::Error for Error {
             Error::File { source, .. } => Some(source),
             Error::Usage(_) => None,
             Error::Materials(e) => Some(e),
-            Error::Format { source, .. } => Some(source),
+            Error::Tables(e) => Some(e),
             Error::Table { source, .. } => Some(source),
             Error::Shard(e) => Some(e),
             Error::Query(e) => Some(e),
@@ -148,6 +143,12 @@ impl std::error::Error for Error {
 impl From<MaterialsError> for Error {
     fn from(e: MaterialsError) -> Self {
         Error::Materials(e)
+    }
+}
+
+impl From<TableFileError> for Error {
+    fn from(e: TableFileError) -> Self {
+        Error::Tables(e)
     }
 }
 

@@ -1,29 +1,34 @@
-//! The table generator of the two-scale reflectance model, and the f64
-//! reference implementation every table is measured against.
+//! The table generator of the two-scale reflectance model.
 //!
-//! - [`quad`]: adaptive quadrature that reports convergence;
-//! - [`reference`](mod@reference): the f64 reference of docs/model.md §2 (EPD, Smith Λ, K-correlation, …);
-//! - [`tables`]: one module per table: build (parallel, deterministic) and verify;
-//! - [`fit`]: deterministic least-squares fits of scaled lobes (the compact
-//!   forms of the convolution, table T3);
+//! The f64 reference every table is measured against, and its numerical
+//! tools, are the crate `twoscale_reference`; they are re-exported here under
+//! their old paths ([`quad`], [`reference`](mod@reference), [`fit`],
+//! [`bspline`], [`rng`]).
+//!
+//! - [`tables`]: one module per table: build (parallel, deterministic) and
+//!   verify, and the registry of [`tables::TableKind`]s keyed by the
+//!   runtime's table descriptors;
 //! - [`query`]: the batch CSV queries of docs/model.md §6;
 //! - [`error`]: what a `generator` subcommand can fail with;
 //! - [`plot`]: the pictures of `docs/img/` (`generator plot`);
 //! - [`export`]: `generator export`, the tables as `.npy` or C headers;
 //! - [`report`]: what `verify` prints and writes to `docs/accuracy.md`;
-//! - [`rng`]: deterministic random points for verification.
+//! - [`build`], [`verify`](mod@verify), [`inspect`](mod@inspect): the
+//!   bodies of `generator build`/`merge`/`spot-check`, `verify`, `inspect`;
+//! - [`table_source`]: where they read tables (embedded, or a directory).
+
+pub use twoscale_reference::{bspline, fit, quad, reference, rng};
 
 pub mod analytic;
-pub mod bspline;
+pub mod build;
 pub mod error;
 pub mod export;
-pub mod fit;
+pub mod inspect;
 pub mod materials;
 pub mod plot;
-pub mod quad;
 pub mod query;
-pub mod reference;
 pub mod report;
-pub mod rng;
 pub mod sh;
+pub mod table_source;
 pub mod tables;
+pub mod verify;

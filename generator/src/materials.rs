@@ -29,6 +29,9 @@ use std::path::Path;
 
 use crate::sh::BandFilter;
 
+/// The text of the repository's `materials.toml` ([`Materials::shipped`]).
+pub const SHIPPED: &str = include_str!("../../materials.toml");
+
 /// The materials file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Materials {
@@ -150,6 +153,22 @@ impl Materials {
         let text = std::fs::read_to_string(path)
             .map_err(|e| MaterialsError(format!("cannot read {}: {e}", path.display())))?;
         Self::parse(&text).map_err(|e| MaterialsError(format!("{}: {e}", path.display())))
+    }
+
+    /// The repository's `materials.toml`, compiled into the binary: the
+    /// runtime's presets with T4's band limits (the default of `build`,
+    /// `verify` and `plot` when no `--materials FILE` is given).
+    pub fn shipped() -> Materials {
+        match Self::parse(SHIPPED) {
+            Ok(materials) => materials,
+            // The test `the_repository_file_is_valid` parses the same text.
+            Err(e) => panic!("the shipped materials.toml is invalid: {e}"),
+        }
+    }
+
+    /// `--materials FILE` if given, else [`Materials::shipped`].
+    pub fn load_or_shipped(path: Option<&Path>) -> Result<Materials, MaterialsError> {
+        path.map_or_else(|| Ok(Self::shipped()), Self::load)
     }
 
     /// Parses and validates the text of a materials file.
@@ -434,6 +453,7 @@ band_limit = 16
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
         let m = Materials::load(Path::new(path)).unwrap();
         assert!(m.materials.len() >= 2);
+        assert_eq!(Materials::shipped(), m);
     }
 
     /// The repository file holds exactly the runtime presets

@@ -14,16 +14,17 @@
 //! `ab_glyph` feature: no system font lookup); [`DEFAULT_FONT`] is where
 //! Debian's `fonts-dejavu-core` puts DejaVu Sans.
 
-use crate::materials::Material;
-use crate::tables::t4::{ModelInputs, two_scale_brdf};
-use crate::tables::{BuildError, file_name, t1, t2, t3};
+use crate::error::{Error, FileAction};
+use crate::materials::{Material, Materials};
+use crate::table_source::{TableFileError, TableSource};
+use crate::tables::t4::two_scale_brdf;
+use crate::tables::{BuildError, t1, t2, t3};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::format::aligned_copy;
 use twoscale::{ConvTable, FormatError, SigmaRatioTable, SmithG1Table, TableId};
 
 /// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
@@ -50,20 +51,8 @@ pub enum PlotError {
     },
     /// The font file is not a TrueType font.
     NotAFont(PathBuf),
-    /// A table file could not be read.
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// A table file is malformed.
-    Format {
-        /// Which table.
-        table: TableId,
-        /// What is wrong.
-        source: FormatError,
-    },
+    /// A table file could not be read or is malformed.
+    Tables(TableFileError),
     /// The tables could not be loaded or an error could not be measured.
     Table(BuildError),
     /// The material's BRDF is zero everywhere (nothing to draw on a log scale).
@@ -81,10 +70,7 @@ impl fmt::Display for PlotError {
                 path.display()
             ),
             PlotError::NotAFont(path) => write!(f, "{} is not a TrueType font", path.display()),
-            PlotError::Read { path, source } => {
-                write!(f, "cannot read {}: {source}", path.display())
-            }
-            PlotError::Format { table, source } => write!(f, "{}: {source}", table.name()),
+            PlotError::Tables(e) => write!(f, "{e}"),
             PlotError::Table(e) => write!(f, "{e}"),
             PlotError::ZeroBrdf(material) => write!(f, "{material}: the BRDF is zero everywhere"),
             PlotError::Draw(e) => write!(f, "drawing failed: {e}"),
@@ -95,13 +81,17 @@ impl fmt::Display for PlotError {
 impl std::error::Error for PlotError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            PlotError::FontUnreadable { source, .. } | PlotError::Read { source, .. } => {
-                Some(source)
-            }
-            PlotError::Format { source, .. } => Some(source),
+            PlotError::FontUnreadable { source, .. } => Some(source),
+            PlotError::Tables(e) => Some(e),
             PlotError::Table(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+impl From<TableFileError> for PlotError {
+    fn from(e: TableFileError) -> Self {
+        PlotError::Tables(e)
     }
 }
 
@@ -170,15 +160,15 @@ fn outgoing_angles(theta_i: f64) -> Vec<f64> {
 }
 
 /// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
-/// with the tables of `tables_dir` to `path`.
+/// with the tables of `source` to `path`.
 pub fn lobes(
     material: &Material,
     channel: usize,
     lambda: f64,
-    tables_dir: &Path,
+    source: &TableSource,
     path: &Path,
 ) -> Result<(), PlotError> {
-    let inputs = ModelInputs::load(tables_dir)?;
+    let inputs = source.model_inputs()?;
     let parsed = inputs.parse()?;
     let tables = parsed.brdf_tables();
     let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
@@ -294,22 +284,17 @@ pub fn lobes(
 /// plot coordinates.
 pub type Samples = Vec<(f64, f64, f64)>;
 
-/// The file of table `id` in `dir`, aligned.
-fn table_bytes(dir: &Path, id: TableId) -> Result<twoscale::format::AlignedBuf, PlotError> {
-    let path = dir.join(file_name(id));
-    let bytes = std::fs::read(&path).map_err(|source| PlotError::Read { path, source })?;
-    Ok(aligned_copy(&bytes))
-}
-
-/// The error of table `id`'s file being malformed.
-fn malformed(table: TableId) -> impl FnOnce(FormatError) -> PlotError {
-    move |source| PlotError::Format { table, source }
+/// The error of table `id`'s file in `source` being malformed.
+fn malformed(source: &TableSource, id: TableId) -> impl FnOnce(FormatError) -> PlotError {
+    let error = source.format_error(id.name());
+    move |e| PlotError::Tables(error(e))
 }
 
 /// T1's errors at `verify`'s points: `(p, log10 a, |G1 − G1_ref|)`.
-pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
-    let buf = table_bytes(dir, TableId::SmithG1)?;
-    let table = SmithG1Table::from_bytes(buf.bytes()).map_err(malformed(TableId::SmithG1))?;
+pub fn t1_errors(source: &TableSource, points: usize, seed: u64) -> Result<Samples, PlotError> {
+    let file = source.open(TableId::SmithG1)?;
+    let table =
+        SmithG1Table::from_bytes(file.bytes()).map_err(malformed(source, TableId::SmithG1))?;
     t1::verification_points(points, seed)
         .par_iter()
         .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), t1::error_at(&table, p, a)?)))
@@ -318,9 +303,10 @@ pub fn t1_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotEr
 }
 
 /// T2's errors at `verify`'s points: `(θi in degrees, log10 B, relative error)`.
-pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotError> {
-    let buf = table_bytes(dir, TableId::SigmaRatio)?;
-    let table = SigmaRatioTable::from_bytes(buf.bytes()).map_err(malformed(TableId::SigmaRatio))?;
+pub fn t2_errors(source: &TableSource, points: usize, seed: u64) -> Result<Samples, PlotError> {
+    let file = source.open(TableId::SigmaRatio)?;
+    let table = SigmaRatioTable::from_bytes(file.bytes())
+        .map_err(malformed(source, TableId::SigmaRatio))?;
     t2::verification_points(points, seed)
         .par_iter()
         .map(|&(cos_i, big_b, c)| {
@@ -336,9 +322,14 @@ pub fn t2_errors(dir: &Path, points: usize, seed: u64) -> Result<Samples, PlotEr
 
 /// T3b's e_L2 at `verify`'s profiles (`t3::profiles_for(points)` of them):
 /// `([u, c, β, p], e_L2)`.
-pub fn t3_errors(dir: &Path, points: usize, seed: u64) -> Result<Vec<([f64; 4], f64)>, PlotError> {
-    let buf = table_bytes(dir, TableId::Convolution)?;
-    let table = ConvTable::from_bytes(buf.bytes()).map_err(malformed(TableId::Convolution))?;
+pub fn t3_errors(
+    source: &TableSource,
+    points: usize,
+    seed: u64,
+) -> Result<Vec<([f64; 4], f64)>, PlotError> {
+    let file = source.open(TableId::Convolution)?;
+    let table =
+        ConvTable::from_bytes(file.bytes()).map_err(malformed(source, TableId::Convolution))?;
     t3::verification_points(t3::profiles_for(points), seed)
         .par_iter()
         .map(|&pt| Ok((pt, t3::verify_point(&table, pt)?.accurate_e_l2)))
@@ -552,4 +543,102 @@ pub fn t3_map(path: &Path, profiles: &[([f64; 4], f64)], title: &str) -> Result<
     }
     color_bar(&bar, &scale, "T3b e_L2 against exact C")?;
     root.present().map_err(draw_error)
+}
+
+/// The arguments of `generator plot`.
+pub struct PlotArgs {
+    /// Output directory.
+    pub out: PathBuf,
+    /// The tables drawn.
+    pub tables: TableSource,
+    /// The materials whose lobes are drawn.
+    pub materials: Materials,
+    /// Only these materials' lobes (all if empty).
+    pub only: Vec<String>,
+    /// Whether to draw the error maps of T1, T2, T3.
+    pub errors: bool,
+    /// Random points of the error maps, as for verify.
+    pub points: usize,
+    /// Seed of the random points, as for verify.
+    pub seed: u64,
+    /// TrueType font for the text.
+    pub font: PathBuf,
+}
+
+/// `generator plot`: the lobes of each material (`lobes-<name>.png`) and
+/// the error maps (`error-t1.png`, `error-t2.png`, `error-t3.png`) in
+/// `args.out`.
+pub fn run(args: &PlotArgs) -> Result<(), Error> {
+    load_font(&args.font)?;
+    let materials = &args.materials;
+    for name in &args.only {
+        if !materials.materials.iter().any(|m| &m.name == name) {
+            let known: Vec<_> = materials
+                .materials
+                .iter()
+                .map(|m| m.name.as_str())
+                .collect();
+            return Err(Error::Usage(format!(
+                "no material {name} (known: {})",
+                known.join(", ")
+            )));
+        }
+    }
+    std::fs::create_dir_all(&args.out).map_err(Error::file(FileAction::Create, &args.out))?;
+    let out = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
+    // The green channel (as T4's band-limit study).
+    let channel = 1;
+    let lambda = materials.wavelengths[channel];
+    for material in &materials.materials {
+        if !args.only.is_empty() && !args.only.contains(&material.name) {
+            continue;
+        }
+        let path = out.join(format!("lobes-{}.png", material.name));
+        lobes(material, channel, lambda, &args.tables, &path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if args.errors {
+        let (source, points, seed) = (&args.tables, args.points, args.seed);
+        let suffix = format!("{points} verify points, seed {seed}; largest error per bin");
+        let t1 = View {
+            title: format!("T1 (Smith G1): |G1 − G1_ref|, {suffix}"),
+            x: (0.2, 5.0, "p"),
+            y: (-4.0, 4.0, "log10 a"),
+        };
+        let path = out.join("error-t1.png");
+        heat_map(
+            &path,
+            &t1,
+            &t1_errors(source, points, seed)?,
+            (48, 32),
+            "|G1 − G1_ref|",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let t2 = View {
+            title: format!("T2 (σ ratio): relative error, {suffix} (over c)"),
+            x: (0.0, 90.0, "θi (°)"),
+            y: (-1.0, 3000f64.log10(), "log10 B"),
+        };
+        let path = out.join("error-t2.png");
+        heat_map(
+            &path,
+            &t2,
+            &t2_errors(source, points, seed)?,
+            (45, 30),
+            "relative error",
+        )?;
+        eprintln!("wrote {}", path.display());
+        let profiles = t3_errors(source, points, seed)?;
+        let path = out.join("error-t3.png");
+        t3_map(
+            &path,
+            &profiles,
+            &format!(
+                "T3b: e_L2 of each of verify's {} profiles (seed {seed})",
+                profiles.len()
+            ),
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
 }

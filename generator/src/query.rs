@@ -11,8 +11,13 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use std::path::Path;
-use twoscale::{Convolution, TableSet, TableSetError};
+use twoscale::{
+    ConvTable, Convolution, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId, TableSet,
+};
+
+use twoscale::validate::{self, Invalid, Shortest, Shortest32};
+
+use crate::table_source::{TableFile, TableFileError, TableSource};
 
 use crate::reference::{brdf, conv, epd, fresnel, kcorr};
 
@@ -84,68 +89,110 @@ impl Quantity {
         }
     }
 
-    /// Whether the evaluation reads the table files.
-    pub const fn uses_tables(self) -> bool {
-        !matches!(self, Quantity::Fresnel)
+    /// The tables the evaluation reads (only these are opened).
+    pub const fn tables(self) -> &'static [TableId] {
+        match self {
+            Quantity::G1 => &[TableId::SmithG1],
+            Quantity::SigmaRatio => &[TableId::SigmaRatio],
+            Quantity::Fresnel => &[],
+            Quantity::Conv => &[TableId::Convolution],
+            Quantity::Brdf => &twoscale::table_set::TABLES,
+        }
+    }
+
+    /// Whether the quantity is the lookup of one table, whose domain
+    /// `--clamp` may clamp to (the others validate model parameters).
+    pub const fn clamps(self) -> bool {
+        matches!(self, Quantity::G1 | Quantity::SigmaRatio | Quantity::Conv)
     }
 
     /// The output values for inputs `x` (in the order of [`Self::columns`]),
-    /// with the runtime reading `set` (`None` only if not
-    /// [`Self::uses_tables`]), or why there are none.
-    fn evaluate(self, set: Option<&TableSet>, x: &[f64]) -> Result<Vec<String>, RowError> {
-        let set = || set.ok_or(RowError::NoTables);
+    /// with the runtime reading `tables` (those of [`Self::tables`]), and
+    /// whether the point is in the table's domain; or why there are none.
+    /// A point outside the table's domain is an error unless `clamp`.
+    fn evaluate(
+        self,
+        tables: &Tables<'_>,
+        x: &[f64],
+        clamp: bool,
+    ) -> Result<(Vec<String>, bool), RowError> {
         let reference = |e: &dyn fmt::Display| RowError::Reference(e.to_string());
+        let f = |v: f64| v as f32;
+        // The table's domain, checked before the reference is computed.
+        let domain = |check: Result<(), RowError>| match check {
+            Ok(()) => Ok(true),
+            Err(_) if clamp => Ok(false),
+            Err(e) => Err(e),
+        };
         Ok(match self {
             Quantity::G1 => {
                 let (p, a) = (x[0], x[1]);
+                let table = tables.smith()?;
+                let in_domain = domain(table.check(f(p), f(a)).map_err(RowError::Invalid))?;
                 let reference = epd::g1(p, a).map_err(|e| reference(&e))?;
-                let table = set()?.smith.g1(p as f32, a as f32);
-                vec![table.to_string(), reference.to_string()]
+                let value = table.g1(f(p), f(a));
+                (vec![short32(value), short(reference)], in_domain)
             }
             Quantity::SigmaRatio => {
                 let (theta_i, big_b, c) = (x[0], x[1], x[2]);
+                let table = tables.sigma_ratio()?;
+                // T2's axis is cos θi; a bad θi is reported as the θi given.
+                let cos_theta_i = twoscale::math::cosf(f(theta_i));
+                let in_domain = domain(table.check(cos_theta_i, f(big_b), f(c)).map_err(|e| {
+                    if e.name == "cos_theta_i" {
+                        RowError::InvalidAngle {
+                            column: "theta_i",
+                            value: theta_i,
+                            invalid: e,
+                        }
+                    } else {
+                        RowError::Invalid(e)
+                    }
+                }))?;
                 let reference = kcorr::sigma_ratio(theta_i, big_b, c).map_err(|e| reference(&e))?;
-                let table = set()?
-                    .sigma_ratio
-                    .sigma_ratio(theta_i as f32, big_b as f32, c as f32);
-                vec![table.to_string(), reference.to_string()]
+                let value = table.sigma_ratio(f(theta_i), f(big_b), f(c));
+                (vec![short32(value), short(reference)], in_domain)
             }
             Quantity::Fresnel => {
                 // `table` is the runtime's f32 Fresnel (computed in f64
                 // inside), `reference` the f64 reference.
                 let (n, k, cos_theta) = (x[0], x[1], x[2]);
+                let eta = twoscale::Complex::new(f(n), f(k));
+                validate::eta(("n", "k"), eta).map_err(RowError::Invalid)?;
                 let reference = fresnel::fresnel(fresnel::Complex64::new(n, k), cos_theta)
                     .map_err(|e| reference(&e))?;
-                let eta = twoscale::Complex::new(n as f32, k as f32);
-                let table = twoscale::fresnel::fresnel(eta, cos_theta as f32);
-                vec![table.to_string(), reference.to_string()]
+                let value = twoscale::fresnel::fresnel(eta, f(cos_theta));
+                (vec![short32(value), short(reference)], true)
             }
             Quantity::Conv => {
                 // `fit` = T3a (the paper's s, g form), `table` = T3b, both
                 // from the runtime; `reference` = exact C by direct quadrature.
                 let (u, c, beta, p, theta_h) = (x[0], x[1], x[2], x[3], x[4]);
+                let table = tables.convolution()?;
+                let in_domain = domain(
+                    table
+                        .check(f(u), f(c), f(beta), f(p))
+                        .map_err(RowError::Invalid),
+                )?;
                 let reference =
                     conv::convolution(theta_h, u, c, beta, p).map_err(|e| reference(&e))?;
-                let table = &set()?.convolution;
-                let (sin, cos) = (theta_h.sin() as f32, theta_h.cos() as f32);
-                let (u, c, beta, p) = (u as f32, c as f32, beta as f32, p as f32);
-                vec![
-                    table
-                        .fit()
-                        .convolution_sin_cos(sin, cos, u, c, beta, p)
-                        .to_string(),
-                    table
-                        .convolution_sin_cos(sin, cos, u, c, beta, p)
-                        .to_string(),
-                    reference.to_string(),
-                ]
+                let (sin, cos) = (f(theta_h.sin()), f(theta_h.cos()));
+                let (u, c, beta, p) = (f(u), f(c), f(beta), f(p));
+                let fit = table.fit().convolution_sin_cos(sin, cos, u, c, beta, p);
+                let value = table.convolution_sin_cos(sin, cos, u, c, beta, p);
+                (
+                    vec![short32(fit), short32(value), short(reference)],
+                    in_domain,
+                )
             }
             Quantity::Brdf => {
                 // docs/model.md §6: the conductor two-scale model. `table` is
                 // the runtime model (`twoscale::brdf::TwoScale`, f32, baked
                 // from the table set: the path a renderer calls);
                 // `reference` is `reference::brdf::two_scale` (exact Λ,
-                // σrel, C).
+                // σrel, C). The parameters are validated as the runtime's
+                // (`Layer::validate`, `validate::eta`, `validate::wavelength`)
+                // before either is computed.
                 let params = brdf::Params {
                     beta: x[0],
                     p: x[1],
@@ -157,10 +204,6 @@ impl Quantity {
                     lambda: x[7],
                 };
                 let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
-                let options = twoscale::brdf::Options::default();
-                let reference =
-                    brdf::two_scale(&params, i, o, &options).map_err(|e| reference(&e))?;
-                let f = |v: f64| v as f32;
                 let layer = twoscale::brdf::Layer {
                     surface: twoscale::brdf::Surface {
                         beta: f(params.beta),
@@ -172,18 +215,36 @@ impl Quantity {
                     base: twoscale::brdf::BaseLayer::Conductor,
                     lambertian: 0.0,
                 };
+                let eta = twoscale::Complex::new(f(params.n), f(params.k));
+                layer.validate().map_err(RowError::Invalid)?;
+                validate::eta(("n", "k"), eta).map_err(RowError::Invalid)?;
+                validate::wavelength(f(params.lambda)).map_err(RowError::Invalid)?;
+                let options = twoscale::brdf::Options::default();
+                let reference =
+                    brdf::two_scale(&params, i, o, &options).map_err(|e| reference(&e))?;
+                let set = tables.set()?;
                 let model = twoscale::TwoScale::new(
-                    &set()?.brdf_tables(),
+                    &set.brdf_tables(),
                     layer,
                     f(params.lambda),
-                    twoscale::Complex::new(f(params.n), f(params.k)),
+                    eta,
                     options,
                 );
-                let table = model.eval(i.map(f), o.map(f));
-                vec![table.to_string(), reference.total().to_string()]
+                let value = model.eval(i.map(f), o.map(f));
+                (vec![short32(value), short(reference.total())], true)
             }
         })
     }
+}
+
+/// A reference value as printed: the shortest form that reads back to it.
+fn short(x: f64) -> String {
+    Shortest(x).to_string()
+}
+
+/// A runtime (f32) value as printed: the shortest form of the f32.
+fn short32(x: f32) -> String {
+    Shortest32(x).to_string()
 }
 
 /// Why a query could not run (before any row is answered, or while writing).
@@ -191,6 +252,9 @@ impl Quantity {
 pub enum QueryError {
     /// No quantity has this name.
     UnknownQuantity(String),
+    /// `--clamp` was given for a quantity that is not the lookup of one
+    /// table.
+    ClampUnsupported(Quantity),
     /// The input has no header line.
     EmptyInput,
     /// The input could not be read.
@@ -202,8 +266,8 @@ pub enum QueryError {
         /// The quantity's input columns.
         needs: &'static [&'static str],
     },
-    /// The table files could not be opened.
-    Tables(TableSetError),
+    /// A table file could not be opened or is malformed.
+    Tables(TableFileError),
     /// The output could not be written.
     Write(std::io::Error),
 }
@@ -215,6 +279,12 @@ impl fmt::Display for QueryError {
                 let known: Vec<_> = Quantity::ALL.iter().map(|q| q.name()).collect();
                 write!(f, "unknown quantity '{name}' (known: {})", known.join(", "))
             }
+            QueryError::ClampUnsupported(q) => write!(
+                f,
+                "--clamp applies to the lookups of one table (g1, sigma-ratio, conv); \
+                 {}'s parameters are always validated",
+                q.name()
+            ),
             QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
             QueryError::Read(e) => write!(f, "reading input: {e}"),
             QueryError::MissingColumn { column, needs } => {
@@ -224,7 +294,7 @@ impl fmt::Display for QueryError {
                     needs.join(",")
                 )
             }
-            QueryError::Tables(e) => write!(f, "{e} (build the tables with `generator build`)"),
+            QueryError::Tables(e) => write!(f, "{e}"),
             QueryError::Write(e) => write!(f, "writing output: {e}"),
         }
     }
@@ -237,6 +307,68 @@ impl std::error::Error for QueryError {
             QueryError::Tables(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+/// The validated views of the table files a quantity reads.
+#[derive(Default)]
+pub struct Tables<'a> {
+    smith: Option<SmithG1Table<'a>>,
+    sigma_ratio: Option<SigmaRatioTable<'a>>,
+    convolution: Option<ConvTable<'a>>,
+    diffuse_fresnel: Option<DiffuseFresnelTable<'a>>,
+}
+
+impl<'a> Tables<'a> {
+    /// Validates `files` (read from `source`, named in the errors).
+    fn parse(
+        files: &'a [(TableId, TableFile)],
+        source: &TableSource,
+    ) -> Result<Self, TableFileError> {
+        let mut tables = Tables::default();
+        for (id, file) in files {
+            let bytes = file.bytes();
+            let error = || source.format_error(id.name());
+            match id {
+                TableId::SmithG1 => {
+                    tables.smith = Some(SmithG1Table::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::SigmaRatio => {
+                    tables.sigma_ratio = Some(SigmaRatioTable::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::Convolution => {
+                    tables.convolution = Some(ConvTable::from_bytes(bytes).map_err(error())?);
+                }
+                TableId::DiffuseFresnel => {
+                    tables.diffuse_fresnel =
+                        Some(DiffuseFresnelTable::from_bytes(bytes).map_err(error())?);
+                }
+                _ => {}
+            }
+        }
+        Ok(tables)
+    }
+
+    fn smith(&self) -> Result<SmithG1Table<'a>, RowError> {
+        self.smith.ok_or(RowError::NoTables)
+    }
+
+    fn sigma_ratio(&self) -> Result<SigmaRatioTable<'a>, RowError> {
+        self.sigma_ratio.ok_or(RowError::NoTables)
+    }
+
+    fn convolution(&self) -> Result<&ConvTable<'a>, RowError> {
+        self.convolution.as_ref().ok_or(RowError::NoTables)
+    }
+
+    /// The four tables as the runtime's set (`brdf`).
+    fn set(&self) -> Result<TableSet<'a>, RowError> {
+        Ok(TableSet {
+            smith: self.smith()?,
+            sigma_ratio: self.sigma_ratio()?,
+            convolution: *self.convolution()?,
+            diffuse_fresnel: self.diffuse_fresnel.ok_or(RowError::NoTables)?,
+        })
     }
 }
 
@@ -265,6 +397,19 @@ pub enum RowError {
         /// Its value.
         value: f64,
     },
+    /// A parameter outside its domain (the table's, or the model's): names
+    /// the parameter, its value and the domain.
+    Invalid(Invalid),
+    /// An angle whose cosine is outside the table's domain (T2 is indexed by
+    /// cos θi).
+    InvalidAngle {
+        /// The column given.
+        column: &'static str,
+        /// Its value.
+        value: f64,
+        /// The cosine's failed check.
+        invalid: Invalid,
+    },
     /// The reference cannot be computed at this point (outside its domain,
     /// or a quadrature failed).
     Reference(String),
@@ -284,6 +429,12 @@ impl fmt::Display for RowError {
             RowError::NotFinite { column, value } => {
                 write!(f, "column '{column}' is not finite: {value}")
             }
+            RowError::Invalid(e) => write!(f, "{e}"),
+            RowError::InvalidAngle {
+                column,
+                value,
+                invalid,
+            } => write!(f, "{column} = {}: {invalid}", Shortest(*value)),
             RowError::Reference(e) => write!(f, "reference: {e}"),
             RowError::NoTables => write!(f, "the table files were not opened"),
         }
@@ -291,6 +442,14 @@ impl fmt::Display for RowError {
 }
 
 impl std::error::Error for RowError {}
+
+/// How `run` treats rows outside a table's domain.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Answer them at the clamped point (as the renderer-facing lookups
+    /// do) and add the column `in_domain`, instead of reporting them.
+    pub clamp: bool,
+}
 
 /// Outcome of a query run.
 #[derive(Debug, Default, PartialEq, Eq)]
@@ -301,17 +460,23 @@ pub struct Summary {
     pub bad: usize,
 }
 
-/// Runs query `quantity` over CSV `input`, writing CSV to `output` and one line
-/// per bad row to `errors`. Fails (before reading rows) on an unknown quantity,
-/// a missing table file, or a header without the required columns.
+/// Runs query `quantity` over CSV `input` with the tables of `tables`,
+/// writing CSV to `output` and one line per bad row to `errors`. Fails
+/// (before reading rows) on an unknown quantity, a missing or malformed
+/// table file (of those the quantity reads), or a header without the
+/// required columns.
 pub fn run(
     quantity: &str,
-    tables: &Path,
+    tables: &TableSource,
+    options: &Options,
     input: impl BufRead,
     mut output: impl Write,
     mut errors: impl Write,
 ) -> Result<Summary, QueryError> {
     let quantity = Quantity::from_name(quantity)?;
+    if options.clamp && !quantity.clamps() {
+        return Err(QueryError::ClampUnsupported(quantity));
+    }
     let columns = quantity.columns();
     let mut lines = input.lines().enumerate();
     let header = loop {
@@ -339,13 +504,15 @@ pub fn run(
         })
         .collect::<Result<Vec<usize>, QueryError>>()?;
 
-    // Load the tables before reading rows, so a missing file fails fast.
-    // (`TableSet::open` keeps its maps for the process: one set per run.)
-    let set = if quantity.uses_tables() {
-        Some(TableSet::open(tables).map_err(QueryError::Tables)?)
-    } else {
-        None
-    };
+    // Open the tables the quantity reads before reading rows, so a missing
+    // or malformed file fails fast.
+    let files = quantity
+        .tables()
+        .iter()
+        .map(|&id| tables.open(id).map(|file| (id, file)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(QueryError::Tables)?;
+    let views = Tables::parse(&files, tables).map_err(QueryError::Tables)?;
 
     let rows: Vec<(usize, String)> = lines
         .map(|(n, line)| (n + 1, line.unwrap_or_default()))
@@ -372,8 +539,12 @@ pub fn run(
         if let Some((&column, &value)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(RowError::NotFinite { column, value });
         }
-        let out = quantity.evaluate(set.as_ref(), &values)?;
-        Ok(format!("{},{}", fields.join(","), out.join(",")))
+        let (out, in_domain) = quantity.evaluate(&views, &values, options.clamp)?;
+        let mut row = format!("{},{}", fields.join(","), out.join(","));
+        if options.clamp {
+            row.push_str(if in_domain { ",true" } else { ",false" });
+        }
+        Ok(row)
     };
     let results: Vec<(usize, Result<String, RowError>)> = rows
         .par_iter()
@@ -381,7 +552,14 @@ pub fn run(
         .collect();
 
     let outputs = quantity.outputs();
-    writeln!(output, "{},{}", names.join(","), outputs.join(",")).map_err(QueryError::Write)?;
+    let clamp_column = if options.clamp { ",in_domain" } else { "" };
+    writeln!(
+        output,
+        "{},{}{clamp_column}",
+        names.join(","),
+        outputs.join(",")
+    )
+    .map_err(QueryError::Write)?;
     let mut summary = Summary::default();
     for (n, result) in results {
         match result {

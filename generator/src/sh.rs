@@ -37,17 +37,21 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use twoscale::Bxdf;
 use twoscale::sh::{MAX_BAND_LIMIT, block_size, normalized_legendre};
 
 use crate::quad::gauss_legendre;
 
-/// An isotropic BRDF `ρ(wi, wo)` in sr⁻¹, in the local frame (normal `+z`),
-/// with `wi` towards the light and `wo` towards the viewer, both unit vectors
-/// in the upper hemisphere. It must be even in `φo − φi` (mirror-symmetric),
-/// as every isotropic model of docs/model.md §2 is.
+/// What the projection evaluates: an isotropic BRDF `ρ(wi, wo)` in sr⁻¹ at
+/// f64 directions, in the local frame (normal `+z`), with `wi` towards the
+/// light and `wo` towards the viewer, both unit vectors in the upper
+/// hemisphere. It must be even in `φo − φi` (mirror-symmetric), as every
+/// isotropic model of docs/model.md §2 is.
 ///
-/// Any `Fn([f64; 3], [f64; 3]) -> f64 + Sync` is one. The two-scale f64
-/// reference of docs/model.md §2.5 plugs in here.
+/// The runtime's BRDFs are [`twoscale::Bxdf`]s; any one-wavelength one is an
+/// `IsotropicBrdf` through [`Runtime`]. The f64 BRDFs of the reference and of
+/// [`crate::analytic`] implement it directly, and any
+/// `Fn([f64; 3], [f64; 3]) -> f64 + Sync` is one.
 pub trait IsotropicBrdf: Sync {
     /// `ρ(wi, wo)`.
     fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64;
@@ -56,6 +60,17 @@ pub trait IsotropicBrdf: Sync {
 impl<F: Fn([f64; 3], [f64; 3]) -> f64 + Sync> IsotropicBrdf for F {
     fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
         self(wi, wo)
+    }
+}
+
+/// A one-wavelength runtime BRDF as an [`IsotropicBrdf`]: [`Bxdf::eval`] at
+/// the directions rounded to f32, widened to f64 (relative rounding ~6e-8).
+#[derive(Clone)]
+pub struct Runtime<B>(pub B);
+
+impl<B: Bxdf<Value = f32> + Sync> IsotropicBrdf for Runtime<B> {
+    fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        f64::from(self.0.eval(wi.map(|v| v as f32), wo.map(|v| v as f32)))
     }
 }
 

@@ -48,3 +48,36 @@ fn plot_refuses_an_unknown_material() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("no material no-such-material"), "{stderr}");
 }
+
+/// The committed lobe pictures are what `generator plot` draws from the
+/// embedded tables and the shipped materials (byte for byte: the drawing is
+/// deterministic, whatever the thread count). CI's installed-generator step
+/// compares the error maps too (they repeat verify's 20 000 points).
+#[test]
+fn the_committed_lobes_are_what_plot_draws() {
+    let out = std::env::temp_dir().join(format!("generator-plot-docs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = Command::new(env!("CARGO_BIN_EXE_generator"))
+        .args(["plot", "--no-errors", "--out"])
+        .arg(&out)
+        .status()
+        .expect("generator runs");
+    assert!(status.success(), "generator plot failed: {status}");
+    let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/img");
+    let mut drawn: Vec<PathBuf> = std::fs::read_dir(&out)
+        .expect("output directory")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    drawn.sort();
+    assert_eq!(drawn.len(), twoscale::materials::PRESETS.len());
+    for path in &drawn {
+        let name = path.file_name().expect("file name");
+        let committed = std::fs::read(docs.join(name)).expect("committed picture");
+        assert!(
+            std::fs::read(path).expect("drawn picture") == committed,
+            "docs/img/{} differs from what `generator plot --out docs/img` draws",
+            name.to_string_lossy()
+        );
+    }
+    std::fs::remove_dir_all(&out).expect("clean up");
+}

@@ -1,6 +1,6 @@
 //! Python bindings of the two-scale BRDF: the RGB model of a material over
 //! NumPy arrays of directions, the table lookups (T1 G1, T2 σrel/σs, T3 C),
-//! and the f64 reference of each quantity (`generator::reference`).
+//! and the f64 reference of each quantity (`twoscale_reference::reference`).
 //!
 //! Conventions are the runtime's (`twoscale::brdf`): unit vectors in the
 //! local frame (normal `+z`), `wi` towards the light, `wo` towards the
@@ -13,11 +13,11 @@
 //! batches of 2048 rows or more (`PARALLEL_ROWS`) are split over rayon's
 //! threads. The types are in `twoscale/_native.pyi`.
 
+mod merl;
+
 use std::collections::BTreeMap;
 use std::sync::LazyLock;
 
-use generator::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
-use generator::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 use numpy::ndarray::{Array1, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
@@ -25,10 +25,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rayon::prelude::*;
 use twoscale::brdf::{
-    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Options, SigmaRelMode, Surface,
+    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options,
+    SigmaRelMode, Surface,
 };
 use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
+use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
+use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 
 /// The committed tables, compiled into the extension.
 static TABLES: LazyLock<TableSet<'static>> = LazyLock::new(TableSet::embedded);
@@ -250,15 +253,18 @@ type SampleArrays<'py> = (
 /// domain raise `ValueError` with the runtime's message.
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
-    model: Box<Rgb<'static>>,
+    model: Box<Rgb<'static, Box<ChannelBake>>>,
     material: twoscale::brdf::Material,
     options: Options,
 }
 
 impl Material {
+    /// The model of `material`, its bakes allocated zeroed on the heap and
+    /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
+    /// is enough (`tests/test_small_stack.py`).
     fn build(material: twoscale::brdf::Material, options: Options) -> Self {
         Material {
-            model: Box::new(TABLES.rgb(&material, options)),
+            model: Box::new(Rgb::boxed(&TABLES.brdf_tables(), &material, options)),
             material,
             options,
         }
@@ -275,7 +281,7 @@ impl Material {
     fn new(
         beta: f32,
         p: f32,
-        eta: Vec<(f32, f32)>,
+        eta: Vec<[f32; 2]>, // any sequence of (n, k) sequences: tuples, or lists from TOML
         sigma_s: f32,
         b: f32,
         c: f32,
@@ -287,7 +293,7 @@ impl Material {
         colour: Option<&str>,
         halo_weight: Option<&str>,
     ) -> PyResult<Self> {
-        let eta_rgb: [(f32, f32); 3] = eta.try_into().map_err(|e: Vec<_>| {
+        let eta_rgb: [[f32; 2]; 3] = eta.try_into().map_err(|e: Vec<_>| {
             value_error(format!(
                 "eta must be three (n, k) pairs (red, green, blue), got {}",
                 e.len()
@@ -319,7 +325,7 @@ impl Material {
                 base: kind.with_albedo(albedo),
                 lambertian,
             },
-            eta_rgb: eta_rgb.map(|(n, k)| Complex::new(n, k)),
+            eta_rgb: eta_rgb.map(|[n, k]| Complex::new(n, k)),
         };
         material.validate().map_err(invalid)?;
         let options = options(masking, sigma_rel, colour, halo_weight)?;
@@ -849,5 +855,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(conv, m)?)?;
     m.add_function(wrap_pyfunction!(fresnel, m)?)?;
     m.add_function(wrap_pyfunction!(brdf, m)?)?;
+    merl::register(m)?;
     Ok(())
 }

@@ -18,10 +18,13 @@ runtime's one list of each (``twoscale::validate::Named``).
 import importlib
 from types import ModuleType
 
-from . import lookup, reference
+from . import lookup, merl, reference
 from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
+from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
-__all__ = ["BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "lookup", "reference"]
+__all__ = [
+    "BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference",
+]
 
 
 def __getattr__(name: str) -> ModuleType:

@@ -21,6 +21,12 @@ __all__ = [
     "conv",
     "fresnel",
     "brdf",
+    "merl_decode",
+    "merl_encode",
+    "merl_index",
+    "merl_bin_centres",
+    "MERL_SCALE",
+    "MERL_FILE_BYTES",
 ]
 
 RGB_WAVELENGTHS: list[float]
@@ -128,3 +134,14 @@ def brdf(
     reference: bool,
     clamp: bool = False,
 ) -> NDArray[np.float64]: ...
+
+# The MERL file format (python/src/merl.rs, used by twoscale.merl).
+MERL_SCALE: list[float]
+MERL_FILE_BYTES: int
+
+def merl_decode(data: bytes, scaled: bool) -> NDArray[np.float64]: ...
+def merl_encode(values: NDArray[np.float64], scaled: bool) -> bytes: ...
+def merl_index(wi: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.int64]: ...
+def merl_bin_centres(
+    bins: NDArray[np.int64] | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...

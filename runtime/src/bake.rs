@@ -24,6 +24,11 @@
 //!
 //! The errors against the direct lookups are measured by the tests beside
 //! each bake (`bake::tests`) and, for the whole BRDF, by `tests/bake.rs`.
+//!
+//! Each bake is plain numbers, valid when all zero ([`FromZeros`]), and is
+//! filled in place by its `init`: a model's storage
+//! ([`crate::brdf::ChannelBake`]) can be allocated zeroed on the heap, or
+//! provided by the caller, and baked without a stack copy of its arrays.
 
 use crate::conv::{ConvSlice, catmull_rom_weights};
 use crate::fresnel::{Complex, QConstants, QFactors, fresnel};
@@ -31,6 +36,7 @@ use crate::gamma::GammaShape;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE};
 use crate::smith::SmithShape;
+use zerocopy::FromZeros;
 
 /// Nodes of [`DirectionBake`].
 const MU_NODES: usize = 257;
@@ -91,7 +97,7 @@ fn cell_at(t: f32, n: usize) -> (usize, f32) {
 const ROUNDER: f32 = 12_582_912.0;
 
 /// One direction's quantities at one wavelength (module documentation).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, FromZeros)]
 pub(crate) struct DirectionBake {
     /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 0]` per node: what `eval`
     /// reads, in one row.
@@ -148,19 +154,24 @@ impl DirectionValues {
     }
 }
 
+/// The lobe weights of [`DirectionBake`] at its nodes, as computed by
+/// [`DirectionBake::lobe_weight_nodes`] (4 KB).
+pub(crate) struct LobeWeightNodes([[f32; 4]; MU_NODES]);
+
 impl DirectionBake {
-    /// Tabulates F and Q̄'s factors of `eta` (when `q` is given) and σrel/σs
-    /// of the spectrum `(B, c)` from T2.
-    pub fn new(
+    /// Tabulates in place F and Q̄'s factors of `eta` (when `q` is given) and
+    /// σrel/σs of the spectrum `(B, c)` from T2; the lobe weights are
+    /// cleared (set them with [`DirectionBake::set_lobe_weights`]).
+    pub fn init(
+        &mut self,
         eta: Complex,
         q: Option<&QConstants>,
         sigma_ratio: &SigmaRatioTable<'_>,
         big_b: f32,
         c: f32,
-    ) -> Self {
-        let mut rows = [[0.0f32; ROW]; MU_NODES];
+    ) {
         let mut cosines = [0.0f32; MU_NODES];
-        for (k, (row, cos_f32)) in rows.iter_mut().zip(cosines.iter_mut()).enumerate() {
+        for (k, (row, cos_f32)) in self.rows.iter_mut().zip(cosines.iter_mut()).enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;
             let cos = x * x;
             *cos_f32 = cos as f32;
@@ -169,28 +180,51 @@ impl DirectionBake {
                 *slot = value as f32;
             }
             row[6] = fresnel(eta, cos as f32);
+            row[7] = 0.0;
         }
         let mut ratios = [0.0f32; MU_NODES];
         sigma_ratio.sigma_ratio_cos_many(&cosines, big_b, c, &mut ratios);
-        for (row, ratio) in rows.iter_mut().zip(ratios) {
+        for (row, ratio) in self.rows.iter_mut().zip(ratios) {
             row[5] = ratio;
         }
-        DirectionBake {
-            rows,
-            weights: [[0.0f32; 4]; MU_NODES],
-        }
+        self.weights = [[0.0f32; 4]; MU_NODES];
     }
 
-    /// Tabulates the lobe weights `weights(cos θ)` (which may read `self`).
-    pub fn with_lobe_weights(mut self, weights: impl Fn(&Self, f64) -> [f64; 3]) -> Self {
-        for k in 0..MU_NODES {
+    /// The bake of [`DirectionBake::init`] in new storage.
+    #[cfg(test)]
+    pub fn new(
+        eta: Complex,
+        q: Option<&QConstants>,
+        sigma_ratio: &SigmaRatioTable<'_>,
+        big_b: f32,
+        c: f32,
+    ) -> Self {
+        let mut bake = Self::new_zeroed();
+        bake.init(eta, q, sigma_ratio, big_b, c);
+        bake
+    }
+
+    /// The lobe weights `weights(values at cos θ, cos θ)` at the nodes, for
+    /// [`DirectionBake::set_lobe_weights`].
+    pub fn lobe_weight_nodes(
+        &self,
+        weights: impl Fn(&DirectionValues, f64) -> [f64; 3],
+    ) -> LobeWeightNodes {
+        let mut nodes = [[0.0f32; 4]; MU_NODES];
+        for (k, node) in nodes.iter_mut().enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;
-            let w = weights(&self, x * x);
-            for (slot, value) in self.weights[k].iter_mut().zip(w) {
+            let cos = x * x;
+            let w = weights(&self.at(cos as f32), cos);
+            for (slot, value) in node.iter_mut().zip(w) {
                 *slot = value as f32;
             }
         }
-        self
+        LobeWeightNodes(nodes)
+    }
+
+    /// Stores the lobe weights tabulated by [`DirectionBake::lobe_weight_nodes`].
+    pub fn set_lobe_weights(&mut self, nodes: &LobeWeightNodes) {
+        self.weights = nodes.0;
     }
 
     /// F alone at a cell.
@@ -238,7 +272,7 @@ impl DirectionBake {
 /// nodes even in `sin θi` (where `M` is analytic), linear between; 0 where
 /// `M` is not positive (no mass to sample). `sample` and `pdf` read the same
 /// values.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, FromZeros)]
 pub(crate) struct RadialNormBake {
     inv_m: [f32; RADIAL_NODES],
 }
@@ -247,10 +281,9 @@ pub(crate) struct RadialNormBake {
 const RADIAL_NODES: usize = 513;
 
 impl RadialNormBake {
-    /// Tabulates `1/M` for `B = b/λ` and the spectrum's `c`.
-    pub fn new(big_b: f64, c: f64) -> Self {
-        let mut inv_m = [0.0f32; RADIAL_NODES];
-        for (k, slot) in inv_m.iter_mut().enumerate() {
+    /// Tabulates `1/M` for `B = b/λ` and the spectrum's `c` in place.
+    pub fn init(&mut self, big_b: f64, c: f64) {
+        for (k, slot) in self.inv_m.iter_mut().enumerate() {
             let sin_i = k as f64 / (RADIAL_NODES - 1) as f64;
             let reach = big_b * (1.0 + sin_i);
             // −expm1(−(c−1)/2 · ln(1 + reach²)): no cancellation for small reach.
@@ -262,15 +295,20 @@ impl RadialNormBake {
                 0.0
             };
         }
-        RadialNormBake { inv_m }
+    }
+
+    /// The bake of [`RadialNormBake::init`] in new storage.
+    #[cfg(test)]
+    pub fn new(big_b: f64, c: f64) -> Self {
+        let mut bake = Self::new_zeroed();
+        bake.init(big_b, c);
+        bake
     }
 
     /// The bake of a spectrum without diffraction (σs = 0 or B = 0): `1/M`
     /// is 0 everywhere, nothing is sampled from it, and nothing is computed.
-    pub fn none() -> Self {
-        RadialNormBake {
-            inv_m: [0.0f32; RADIAL_NODES],
-        }
+    pub fn clear(&mut self) {
+        self.inv_m = [0.0f32; RADIAL_NODES];
     }
 
     /// `1/M` at `sin θi` (clamped to [0, 1]).
@@ -283,17 +321,17 @@ impl RadialNormBake {
 }
 
 /// Smith G1 at the material's (β, p) (module documentation).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, FromZeros)]
 pub(crate) struct MaskingBake {
     beta: f32,
     g1: [f32; MASKING_NODES],
 }
 
 impl MaskingBake {
-    /// Tabulates `shape` (T1 at p) for slopes `a = β tan θ`.
-    pub fn new(beta: f32, shape: &SmithShape<'_>) -> Self {
-        let mut g1 = [0.0f32; MASKING_NODES];
-        for (k, value) in g1.iter_mut().enumerate() {
+    /// Tabulates `shape` (T1 at p) for slopes `a = β tan θ` in place.
+    pub fn init(&mut self, beta: f32, shape: &SmithShape<'_>) {
+        self.beta = beta;
+        for (k, value) in self.g1.iter_mut().enumerate() {
             let y = k as f64 / (MASKING_NODES - 1) as f64;
             *value = if k + 1 == MASKING_NODES {
                 0.0
@@ -301,7 +339,14 @@ impl MaskingBake {
                 shape.g1((y / (1.0 - y)) as f32)
             };
         }
-        MaskingBake { beta, g1 }
+    }
+
+    /// The bake of [`MaskingBake::init`] in new storage.
+    #[cfg(test)]
+    pub fn new(beta: f32, shape: &SmithShape<'_>) -> Self {
+        let mut bake = Self::new_zeroed();
+        bake.init(beta, shape);
+        bake
     }
 
     /// G1 of a direction with `z = cos θ` and tangential length `r = sin θ`
@@ -338,7 +383,7 @@ const LOGIT_RANGE: (f64, f64) = (-104.0, 16.7);
 /// slopes on nodes even in `v` reproduces [`crate::epd::Epd::sample_tan_theta`]
 /// closely (measured by the test beside it) for one log and one exp per
 /// sample instead of a Newton solve of the incomplete gamma function.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, FromZeros)]
 pub(crate) struct SlopeQuantileBake {
     ln_beta: f64,
     /// `1/(2p)`.
@@ -348,21 +393,26 @@ pub(crate) struct SlopeQuantileBake {
 }
 
 impl SlopeQuantileBake {
-    /// Tabulates the quantile for `(β, p)` as [`crate::epd::Epd`] clamps them.
-    pub fn new(beta: f32, p: f32) -> Self {
+    /// Tabulates the quantile for `(β, p)` as [`crate::epd::Epd`] clamps
+    /// them, in place.
+    pub fn init(&mut self, beta: f32, p: f32) {
         let p = f64::from(p);
         let shape = GammaShape::new(1.0 / p);
         let h = (LOGIT_RANGE.1 - LOGIT_RANGE.0) / (QUANTILE_NODES - 1) as f64;
-        let mut nodes = [[0.0f64; 2]; QUANTILE_NODES];
-        for (k, node) in nodes.iter_mut().enumerate() {
+        for (k, node) in self.nodes.iter_mut().enumerate() {
             let (g, slope) = exact_g_and_slope(p, &shape, LOGIT_RANGE.0 + k as f64 * h);
             *node = [g, h * slope];
         }
-        SlopeQuantileBake {
-            ln_beta: math::ln(f64::from(beta)),
-            half_shape: 0.5 / p,
-            nodes,
-        }
+        self.ln_beta = math::ln(f64::from(beta));
+        self.half_shape = 0.5 / p;
+    }
+
+    /// The bake of [`SlopeQuantileBake::init`] in new storage.
+    #[cfg(test)]
+    pub fn new(beta: f32, p: f32) -> Self {
+        let mut bake = Self::new_zeroed();
+        bake.init(beta, p);
+        bake
     }
 
     /// `tan θm` at `u₀` (clamped to [0, [`BELOW_ONE`]]; 0 gives the normal).
@@ -415,7 +465,7 @@ fn exact_g_and_slope(p: f64, shape: &GammaShape, v: f64) -> (f64, f64) {
 
 /// `ln C` for one material and wavelength over `(u, sin θh)` (module
 /// documentation).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, FromZeros)]
 pub(crate) struct ConvBake {
     /// `B`, the largest `u`.
     big_b: f32,
@@ -431,24 +481,22 @@ pub(crate) struct ConvBake {
 }
 
 impl ConvBake {
-    /// Tabulates `slice` for `u ∈ [0, B]` (its normalised angle evaluated in
-    /// f32 at the nodes); `beta`, `p` give the NDF's core width. `None` when
-    /// `B` is not positive and finite.
-    pub fn new(slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> Option<Self> {
+    /// Tabulates `slice` in place for `u ∈ [0, B]` (its normalised angle
+    /// evaluated in f32 at the nodes); `beta`, `p` give the NDF's core width.
+    /// `false` (and `self` left as it was) when `B` is not positive and finite.
+    pub fn init(&mut self, slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> bool {
         if !(big_b > 0.0 && big_b.is_finite()) {
-            return None;
+            return false;
         }
         let linear = (1.0 / U1).min(LINEAR_SHARE * math::log2_axis(1.0 + big_b / U0) / big_b);
         let u_span = u_axis(big_b, linear);
         // The NDF's core: where D has fallen by 10% (tan θ = β 0.1^(1/2p)).
         let ndf_width = beta * math::powff(0.1, 0.5 / p);
-        let mut bake = ConvBake {
-            big_b,
-            u_scale: (CONV_U_NODES - 1) as f32 / u_span,
-            u_linear: linear,
-            ndf_quarter_width: 0.25 * ndf_width,
-            ln_c: [0.0f32; PADDED_U * PADDED_S],
-        };
+        let bake = self;
+        bake.big_b = big_b;
+        bake.u_scale = (CONV_U_NODES - 1) as f32 / u_span;
+        bake.u_linear = linear;
+        bake.ndf_quarter_width = 0.25 * ndf_width;
         let mut top = f32::MIN;
         for j in 0..CONV_U_NODES {
             let x_u = j as f64 / (CONV_U_NODES - 1) as f64 * f64::from(u_span);
@@ -510,7 +558,14 @@ impl ConvBake {
             ln_c[at(0)] = 2.0 * ln_c[at(1)] - ln_c[at(2)];
             ln_c[at(PADDED_U - 1)] = 2.0 * ln_c[at(PADDED_U - 2)] - ln_c[at(PADDED_U - 3)];
         }
-        Some(bake)
+        true
+    }
+
+    /// The bake of [`ConvBake::init`] in new storage (`None` when `init` is `false`).
+    #[cfg(test)]
+    pub fn new(slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> Option<Self> {
+        let mut bake = Self::new_zeroed();
+        bake.init(slice, big_b, beta, p).then_some(bake)
     }
 
     /// `1/w(u)`: `w` is about a quarter of the lobe's core width at `u`, the

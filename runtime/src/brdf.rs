@@ -56,7 +56,9 @@ use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
+use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
+use zerocopy::FromZeros;
 
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];
@@ -305,17 +307,19 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
     }
 }
 
-/// The two-scale BRDF at one wavelength (see the module documentation).
+/// What a [`TwoScale`] bakes for its material and wavelength (F, Q̄'s
+/// factors and σrel over `cos θ`, G1 over the slope, the sampler's EPD
+/// quantile, and C over `(u, θh)` when the source of C is T3b; module
+/// `bake`): 45 KB of plain numbers (C 18 KB, the direction bake 12 KB, the
+/// quantile 8 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
 ///
-/// Construction bakes what depends only on the material and wavelength
-/// (F, Q̄'s factors and σrel over `cos θ`, G1 over the slope, the sampler's
-/// EPD quantile, and C over `(u, θh)` when the source of C is T3b; module
-/// `bake`), so that `eval` reads small tables. 45 KB (C 18 KB, the
-/// direction bake 12 KB, the quantile 8 KB, G1 4 KB, the diffraction
-/// sampler's `1/M` 2 KB; [`Rgb`] three times that); `Clone`, not `Copy`.
-#[derive(Clone)]
-pub struct TwoScale<'a> {
-    ndf: Epd<'a>,
+/// All zeros is a valid (empty) value, so storage can be allocated zeroed on
+/// the heap (`ChannelBake::boxed`, feature `std`) or provided by the caller
+/// (`&mut ChannelBake`, e.g. a `static`); [`TwoScale::new_in`] and
+/// [`Rgb::new_in`] fill it in place, and construction then needs no stack
+/// beyond a few KB (the test `construction_fits_a_64_kib_stack`).
+#[derive(Clone, FromZeros)]
+pub struct ChannelBake {
     /// G1 at the material's (β, p).
     masking: MaskingBake,
     /// The specular sampler's `tan θm` quantile at the material's (β, p).
@@ -324,12 +328,49 @@ pub struct TwoScale<'a> {
     direction: DirectionBake,
     /// `1/M(sin θi)` of the diffraction sampler.
     radial_norm: RadialNormBake,
+    /// `C` over `(u, θh)` for this material, valid when `conv_baked`.
+    conv: ConvBake,
+    /// Whether `conv` holds C (the source of C offers a slice, as T3b does);
+    /// else the source is read directly.
+    conv_baked: bool,
+}
+
+impl ChannelBake {
+    /// Empty storage on the heap, allocated zeroed: no stack temporary
+    /// (feature `std`; aborts as `Box::new` does if allocation fails).
+    #[cfg(feature = "std")]
+    pub fn boxed() -> std::boxed::Box<ChannelBake> {
+        ChannelBake::new_box_zeroed().unwrap_or_else(|_| {
+            std::alloc::handle_alloc_error(core::alloc::Layout::new::<ChannelBake>())
+        })
+    }
+
+    /// Empty storage by value (45 KB on the caller's stack).
+    pub fn zeroed() -> ChannelBake {
+        ChannelBake::new_zeroed()
+    }
+
+    /// T3b's `C` bake, when there is one.
+    #[inline]
+    fn conv(&self) -> Option<&ConvBake> {
+        self.conv_baked.then_some(&self.conv)
+    }
+}
+
+/// The two-scale BRDF at one wavelength (see the module documentation).
+///
+/// Construction bakes what depends only on the material and wavelength into
+/// a [`ChannelBake`] (so that `eval` reads small tables), held as `B`: by
+/// value (the default, 45 KB; [`TwoScale::new`]), boxed
+/// (`TwoScale::boxed`, feature `std`) or borrowed (`&mut ChannelBake`),
+/// any `B: Borrow<ChannelBake>`; [`Rgb`] is three of them. `Clone` (when `B`
+/// is), not `Copy`.
+#[derive(Clone)]
+pub struct TwoScale<'a, B = ChannelBake> {
+    ndf: Epd<'a>,
     /// Q̄'s constants of η (`None` for η = 1: Q̄ = 0).
     q: Option<QConstants>,
     conv: &'a (dyn Convolution + Sync),
-    /// `C` over `(u, θh)` for this material, when `conv` offers a slice
-    /// (T3b does); else `conv` is read directly.
-    conv_bake: Option<ConvBake>,
     /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
     surface: Surface,
     lambda: f64,
@@ -348,24 +389,25 @@ pub struct TwoScale<'a> {
     eta_re: f64,
     lambertian: f64,
     options: Options,
+    /// The per-material tables.
+    bake: B,
 }
 
-/// What [`TwoScale::new`] bakes from the surface alone, independent of the
-/// wavelength: made once for the three channels of [`Rgb`].
+/// What [`TwoScale::new`] derives from the surface alone, independent of the
+/// wavelength: made once for the three channels of [`Rgb`] (G1 and the
+/// quantile are baked once, into the first channel, and copied).
 struct SurfaceBakes<'a> {
     ndf: Epd<'a>,
     /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
     surface: Surface,
-    masking: MaskingBake,
-    slope_quantile: SlopeQuantileBake,
     /// T3b's material slice when there is diffraction and the source of C
     /// offers one.
     slice: Option<ConvSlice<'a>>,
 }
 
 impl<'a> SurfaceBakes<'a> {
-    /// Sanitises `s` (as [`TwoScale::new`] documents) and bakes G1, the
-    /// quantile and C's material slice.
+    /// Sanitises `s` (as [`TwoScale::new`] documents) and blends C's
+    /// material slice.
     fn new(tables: &Tables<'a>, s: Surface) -> Self {
         let nonneg = |x: f32| if x > 0.0 { x.min(f32::MAX) } else { 0.0 };
         let c_ok = s.c > 1.0;
@@ -385,12 +427,17 @@ impl<'a> SurfaceBakes<'a> {
             None
         };
         SurfaceBakes {
-            masking: MaskingBake::new(ndf.beta(), &tables.smith.shape(ndf.p())),
-            slope_quantile: SlopeQuantileBake::new(ndf.beta(), ndf.p()),
             ndf,
             surface,
             slice,
         }
+    }
+
+    /// Bakes G1 and the sampler's quantile into `bake`.
+    fn bake_into(&self, tables: &Tables<'a>, bake: &mut ChannelBake) {
+        let (beta, p) = (self.ndf.beta(), self.ndf.p());
+        bake.masking.init(beta, &tables.smith.shape(p));
+        bake.slope_quantile.init(beta, p);
     }
 }
 
@@ -423,7 +470,9 @@ struct Pair {
 impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
-    /// the type's documentation (cost: `cargo bench --bench brdf -- construct`).
+    /// [`ChannelBake`] (cost: `cargo bench --bench brdf -- construct`). The
+    /// value is 45 KB: on small stacks use `TwoScale::boxed` or
+    /// [`TwoScale::new_in`].
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
     /// or ≤ 1 → no diffraction (σs = 0); λ NaN or ≤ 0 → 0.526 µm, λ clamped to
@@ -435,13 +484,61 @@ impl<'a> TwoScale<'a> {
         eta: Complex,
         options: Options,
     ) -> Self {
-        let shared = SurfaceBakes::new(tables, layer.surface);
-        Self::with_surface_bakes(tables, &shared, layer, lambda, eta, options)
+        Self::new_in(ChannelBake::zeroed(), tables, layer, lambda, eta, options)
     }
 
-    /// [`TwoScale::new`] with the bakes of `layer.surface` already made
-    /// (`shared` must come from the same tables and surface).
-    fn with_surface_bakes(
+    /// A conductor (no base layer, no Lambertian term) with the default options.
+    pub fn conductor(tables: &Tables<'a>, surface: Surface, lambda: f32, eta: Complex) -> Self {
+        let layer = Layer {
+            surface,
+            base: BaseLayer::Conductor,
+            lambertian: 0.0,
+        };
+        Self::new(tables, layer, lambda, eta, Options::default())
+    }
+}
+
+#[cfg(feature = "std")]
+impl<'a> TwoScale<'a, std::boxed::Box<ChannelBake>> {
+    /// [`TwoScale::new`] with the bakes on the heap (`ChannelBake::boxed`,
+    /// filled in place): the value is a few hundred bytes, and construction
+    /// runs on a 64 KiB stack.
+    pub fn boxed(
+        tables: &Tables<'a>,
+        layer: Layer,
+        lambda: f32,
+        eta: Complex,
+        options: Options,
+    ) -> Self {
+        Self::new_in(ChannelBake::boxed(), tables, layer, lambda, eta, options)
+    }
+}
+
+impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
+    /// [`TwoScale::new`] baking into the storage `bake` in place (whatever
+    /// it held is overwritten): a zeroed [`ChannelBake`], a box, a `&mut`
+    /// to caller-provided storage, or [`TwoScale::into_bake`] of a model to
+    /// rebuild.
+    pub fn new_in(
+        bake: B,
+        tables: &Tables<'a>,
+        layer: Layer,
+        lambda: f32,
+        eta: Complex,
+        options: Options,
+    ) -> Self {
+        let shared = SurfaceBakes::new(tables, layer.surface);
+        let mut model = Self::around(bake, tables, &shared, layer, lambda, eta, options);
+        shared.bake_into(tables, model.bake.borrow_mut());
+        model.bake_wavelength(tables, &shared, eta);
+        model
+    }
+
+    /// The model's parameters for `layer` at `lambda` and `eta` around the
+    /// storage `bake`, not yet baked (`shared` must come from the same
+    /// tables and surface).
+    fn around(
+        bake: B,
         tables: &Tables<'a>,
         shared: &SurfaceBakes<'a>,
         layer: Layer,
@@ -465,62 +562,80 @@ impl<'a> TwoScale<'a> {
             BaseLayer::Conductor => 0.0,
             _ => f64::from(tables.diffuse_fresnel.f_dr_int(eta.re)),
         };
-        let big_b = f64::from(surface.b) / lambda;
-        let q = QConstants::new(eta);
-        let conv_bake = shared
-            .slice
-            .as_ref()
-            .and_then(|slice| ConvBake::new(slice, big_b as f32, surface.beta, surface.p));
         let sigma_s = f64::from(surface.sigma_s);
         let b = f64::from(surface.b);
-        let model = TwoScale {
+        TwoScale {
             x_scale: (4.0 * PI / lambda) * (4.0 * PI / lambda),
             sigma_s_sq: sigma_s * sigma_s,
             halo_scale: (f64::from(surface.c) - 1.0) * sigma_s * sigma_s * b * b
                 / (2.0 * PI * lambda * lambda),
-            masking: shared.masking.clone(),
-            slope_quantile: shared.slope_quantile.clone(),
             ndf,
-            direction: DirectionBake::new(
-                eta,
-                q.as_ref(),
-                &tables.sigma_ratio,
-                big_b as f32,
-                surface.c,
-            ),
-            q,
-            // Read only when there is diffraction (`diffraction_setup`).
-            radial_norm: if sigma_s > 0.0 && big_b > 0.0 {
-                RadialNormBake::new(big_b, f64::from(surface.c))
-            } else {
-                RadialNormBake::none()
-            },
+            q: QConstants::new(eta),
             conv: tables.convolution,
-            conv_bake,
             surface,
             lambda,
-            big_b,
+            big_b: b / lambda,
             base,
             f_dr_int,
             eta_re: f64::from(eta.re),
             lambertian: unit(layer.lambertian),
             options,
-        };
-        let direction = model
-            .direction
-            .clone()
-            .with_lobe_weights(|bake, cos| model.weights_at(&bake.at(cos as f32), cos));
-        TwoScale { direction, ..model }
+            bake,
+        }
     }
 
-    /// A conductor (no base layer, no Lambertian term) with the default options.
-    pub fn conductor(tables: &Tables<'a>, surface: Surface, lambda: f32, eta: Complex) -> Self {
-        let layer = Layer {
-            surface,
-            base: BaseLayer::Conductor,
-            lambertian: 0.0,
+    /// Bakes, in place, what depends on the wavelength: the direction bake
+    /// and its lobe weights, `1/M` and C (G1 and the quantile are
+    /// [`SurfaceBakes::bake_into`]'s).
+    fn bake_wavelength(&mut self, tables: &Tables<'a>, shared: &SurfaceBakes<'a>, eta: Complex) {
+        let (surface, big_b, q) = (self.surface, self.big_b, self.q);
+        let sigma_s = f64::from(surface.sigma_s);
+        let bake = self.bake.borrow_mut();
+        bake.direction.init(
+            eta,
+            q.as_ref(),
+            &tables.sigma_ratio,
+            big_b as f32,
+            surface.c,
+        );
+        // Read only when there is diffraction (`diffraction_setup`).
+        if sigma_s > 0.0 && big_b > 0.0 {
+            bake.radial_norm.init(big_b, f64::from(surface.c));
+        } else {
+            bake.radial_norm.clear();
+        }
+        bake.conv_baked = match &shared.slice {
+            Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
+            None => false,
         };
-        Self::new(tables, layer, lambda, eta, Options::default())
+        let weights = self
+            .bake()
+            .direction
+            .lobe_weight_nodes(|at, cos| self.weights_at(at, cos));
+        self.bake.borrow_mut().direction.set_lobe_weights(&weights);
+    }
+
+    /// The storage of the bakes, to rebuild another model in
+    /// ([`TwoScale::new_in`]).
+    pub fn into_bake(self) -> B {
+        self.bake
+    }
+}
+
+impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
+    /// The bakes.
+    #[inline]
+    fn bake(&self) -> &ChannelBake {
+        self.bake.borrow()
+    }
+
+    /// Whether the model has a diffraction lobe (σs > 0 and b > 0) and a
+    /// diffuse term (a base layer that receives light, or `k_d > 0`): its
+    /// [`crate::Bxdf::flags`].
+    pub(crate) fn has_lobes(&self) -> (bool, bool) {
+        let diffraction = self.surface.sigma_s > 0.0 && self.surface.b > 0.0;
+        let base = self.base != BaseLayer::Conductor && !self.white();
+        (diffraction, base || self.lambertian > 0.0)
     }
 
     /// The sanitised surface parameters in use.
@@ -553,7 +668,7 @@ impl<'a> TwoScale<'a> {
         if self.white() {
             1.0
         } else {
-            f64::from(self.direction.fresnel_at(at))
+            f64::from(self.bake().direction.fresnel_at(at))
         }
     }
 
@@ -604,8 +719,8 @@ impl<'a> TwoScale<'a> {
         let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
         let (g1_i, g1_o) = (
-            self.masking.g1(tangential(wi), wi[2] as f32),
-            self.masking.g1(tangential(wo), wo[2] as f32),
+            self.bake().masking.g1(tangential(wi), wi[2] as f32),
+            self.bake().masking.g1(tangential(wo), wo[2] as f32),
         );
         let g = match self.options.masking {
             Masking::Separable => f64::from(g1_i) * f64::from(g1_o),
@@ -656,8 +771,8 @@ impl<'a> TwoScale<'a> {
         } = *pair;
         let (cos_i, cos_o) = (wi[2], wo[2]);
         let (at_i, at_o) = (
-            self.direction.at_cell(cells[0]),
-            self.direction.at_cell(cells[1]),
+            self.bake().direction.at_cell(cells[0]),
+            self.bake().direction.at_cell(cells[1]),
         );
         let s = &self.surface;
 
@@ -696,7 +811,7 @@ impl<'a> TwoScale<'a> {
             };
             let halo = self.halo_scale * one_minus_a_over;
             let u = (self.big_b * cos_d) as f32;
-            let c_value = f64::from(match &self.conv_bake {
+            let c_value = f64::from(match self.bake().conv() {
                 Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
                 None => {
                     self.conv
@@ -783,7 +898,7 @@ impl<'a> TwoScale<'a> {
     /// The lobe weights at `cos θi`, from the direction bake's table of
     /// [`TwoScale::weights_at`].
     fn weights(&self, cos_i: f64) -> [f64; 3] {
-        self.direction.lobe_weights(cos_i as f32)
+        self.bake().direction.lobe_weights(cos_i as f32)
     }
 
     /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`.
@@ -882,7 +997,7 @@ impl<'a> TwoScale<'a> {
             return None;
         }
         let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
-        let inv_m = self.radial_norm.inv_m(sin_i);
+        let inv_m = self.bake().radial_norm.inv_m(sin_i);
         if !(inv_m > 0.0) {
             return None;
         }
@@ -938,7 +1053,7 @@ impl<'a> TwoScale<'a> {
         let o = match lobe {
             Lobe::Specular => {
                 // Epd::sample with the tabulated quantile.
-                let tan = self.slope_quantile.tan_theta(u[0] as f32);
+                let tan = self.bake().slope_quantile.tan_theta(u[0] as f32);
                 let m = normal_at(tan, u[1] as f32).map(f64::from);
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
@@ -1036,11 +1151,13 @@ fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
 
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
 /// The channels share the geometry, D and G of each evaluation (they must
-/// share the surface, as [`Rgb::new`] makes them).
+/// share the surface, as [`Rgb::new`] makes them). The bakes are held as `B`,
+/// as [`TwoScale`]'s: by value ([`Rgb::new`], 136 KB), boxed (`Rgb::boxed`)
+/// or in caller-provided storage ([`Rgb::new_in`]).
 #[derive(Clone)]
-pub struct Rgb<'a> {
+pub struct Rgb<'a, B = ChannelBake> {
     /// The red, green and blue channels.
-    pub channels: [TwoScale<'a>; 3],
+    pub channels: [TwoScale<'a, B>; 3],
 }
 
 /// A sampled direction of the RGB model.
@@ -1055,25 +1172,78 @@ pub struct RgbSample {
 }
 
 impl<'a> Rgb<'a> {
-    /// The three channels of `material` at [`RGB_WAVELENGTHS`].
+    /// The three channels of `material` at [`RGB_WAVELENGTHS`]. The value is
+    /// 136 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
+        let bakes = [
+            ChannelBake::zeroed(),
+            ChannelBake::zeroed(),
+            ChannelBake::zeroed(),
+        ];
+        Self::new_in(bakes, tables, material, options)
+    }
+}
+
+#[cfg(feature = "std")]
+impl<'a> Rgb<'a, std::boxed::Box<ChannelBake>> {
+    /// [`Rgb::new`] with the bakes on the heap (`ChannelBake::boxed`,
+    /// filled in place): construction runs on a 64 KiB stack.
+    pub fn boxed(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
+        let bakes = [
+            ChannelBake::boxed(),
+            ChannelBake::boxed(),
+            ChannelBake::boxed(),
+        ];
+        Self::new_in(bakes, tables, material, options)
+    }
+}
+
+impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
+    /// [`Rgb::new`] baking into the storage `bakes` in place (see
+    /// [`TwoScale::new_in`]).
+    pub fn new_in(
+        bakes: [B; 3],
+        tables: &Tables<'a>,
+        material: &Material,
+        options: Options,
+    ) -> Self {
         // G1, the quantile and C's slice do not depend on the wavelength.
         let shared = SurfaceBakes::new(tables, material.layer.surface);
-        let channel = |k: usize| {
-            TwoScale::with_surface_bakes(
+        let mut k = 0;
+        let mut channels = bakes.map(|bake| {
+            let channel = TwoScale::around(
+                bake,
                 tables,
                 &shared,
                 material.layer,
                 RGB_WAVELENGTHS[k],
                 material.eta_rgb[k],
                 options,
-            )
-        };
-        Rgb {
-            channels: [channel(0), channel(1), channel(2)],
+            );
+            k += 1;
+            channel
+        });
+        let (first, rest) = channels.split_at_mut(1);
+        let first = first[0].bake.borrow_mut();
+        shared.bake_into(tables, first);
+        for channel in rest {
+            let bake = channel.bake.borrow_mut();
+            bake.masking.clone_from(&first.masking);
+            bake.slope_quantile.clone_from(&first.slope_quantile);
         }
+        for (channel, eta) in channels.iter_mut().zip(material.eta_rgb) {
+            channel.bake_wavelength(tables, &shared, eta);
+        }
+        Rgb { channels }
     }
 
+    /// The storage of the bakes, to rebuild another model in ([`Rgb::new_in`]).
+    pub fn into_bakes(self) -> [B; 3] {
+        self.channels.map(TwoScale::into_bake)
+    }
+}
+
+impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
     /// ρ(i, o) per channel.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         match self.channels[0].pair(i, o) {

@@ -93,9 +93,7 @@
 //!   value at `τ_max`; `cos θh ≤ 0` is the horizon.
 //! * Non-finite inputs give 0. The result is never NaN or ∞.
 
-use crate::format::{
-    ConvParams, FormatError, Header, Kernel, Quantised, Table, TableId, ValueType,
-};
+use crate::format::{ConvParams, FormatError, Header, Quantised, Table, TableId, ValueType};
 use crate::interp::Axis;
 use crate::math::{self, Real};
 use crate::validate::{self, Domain, Invalid};
@@ -149,8 +147,8 @@ pub fn kernel(x: f32, c: f32) -> f32 {
 pub const FIT_CHANNELS: usize = 2;
 
 /// The constants of the normalised angle (see the module documentation),
-/// stored in the header as fields of [`ConvParams`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// stored in the header as [`ConvParams::angle`].
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct AngleParams {
     /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
     pub tau_max: f64,
@@ -182,48 +180,11 @@ impl ConvParams {
     /// T3's header parameters: `angles` normalised angles with constants
     /// `angle`, the T3a `g` offset and the value floor.
     pub fn new(angles: usize, angle: &AngleParams, g_offset: f64, value_floor: f64) -> Self {
-        let AngleParams {
-            tau_max,
-            kernel_scale_floor,
-            ndf_weight,
-            ndf_exponent_cap,
-            ndf_softening,
-            horizon_weight,
-            edge_weight,
-            edge_smoothing,
-            edge_fade_tan,
-            edge_softening_fade,
-        } = *angle;
         ConvParams {
             angles: angles as f64,
-            tau_max,
-            kernel_scale_floor,
-            ndf_weight,
-            ndf_exponent_cap,
+            angle: *angle,
             g_offset,
             value_floor,
-            ndf_softening,
-            horizon_weight,
-            edge_weight,
-            edge_smoothing,
-            edge_fade_tan,
-            edge_softening_fade,
-        }
-    }
-
-    /// The normalised angle's constants.
-    pub fn angle(&self) -> AngleParams {
-        AngleParams {
-            tau_max: self.tau_max,
-            kernel_scale_floor: self.kernel_scale_floor,
-            ndf_weight: self.ndf_weight,
-            ndf_exponent_cap: self.ndf_exponent_cap,
-            ndf_softening: self.ndf_softening,
-            horizon_weight: self.horizon_weight,
-            edge_weight: self.edge_weight,
-            edge_smoothing: self.edge_smoothing,
-            edge_fade_tan: self.edge_fade_tan,
-            edge_softening_fade: self.edge_softening_fade,
         }
     }
 }
@@ -443,7 +404,7 @@ impl<'a> ConvTable<'a> {
                 "T3 needs 4 axes and 2 + angles channels with at least 4 angles",
             ));
         }
-        let angle = params.angle();
+        let angle = params.angle;
         // NaN fails every comparison, so it is rejected too.
         let valid = angle.tau_max > 0.0
             && angle.ndf_exponent_cap > 0.0
@@ -469,9 +430,6 @@ impl<'a> ConvTable<'a> {
                 ));
             }
         };
-        if header.kernel != Kernel::Multilinear {
-            return Err(FormatError::Shape("T3 stores node values (kernel 1)"));
-        }
         let axes = [
             Axis::numbered(0, &used[0])?,
             Axis::numbered(1, &used[1])?,

@@ -55,69 +55,189 @@ pub const PAYLOAD_ALIGN: usize = 64;
 /// Size of [`Header`] in bytes.
 pub const HEADER_SIZE: usize = size_of::<Header>();
 
-/// Which quantity a table holds.
+/// Everything the runtime knows about one table, declared once (in
+/// `table_ids!`'s invocation in `runtime/src/format.rs`) and read by every other place: the
+/// readers, [`crate::TableSet`], the C API, the generator's registry, export
+/// and inspect.
 ///
-/// Tables are known by their **T-number** ([`TableId::number`]: T1 … T5, in
-/// the docs, on the command line and in file names, `t3-convolution.tbl`).
-/// The file stores a different number, the **tag** ([`TableId::tag`]): tags
-/// are part of the file format and never change, and they were given in the
-/// order the tables were added (T5 took tag 3 before T3 existed; tag 5 is
-/// retired). This is the one place the two meet:
-///
-/// | T-number | variant | tag | file |
-/// |---|---|---|---|
-/// | T1 | [`SmithG1`](TableId::SmithG1) | 1 | `t1-smith-g1.tbl` |
-/// | T2 | [`SigmaRatio`](TableId::SigmaRatio) | 2 | `t2-sigma-ratio.tbl` |
-/// | T3 | [`Convolution`](TableId::Convolution) | 4 | `t3-convolution.tbl` |
-/// | T4 | [`ShBrdf`](TableId::ShBrdf) | 6 | `t4-<material>.tbl` |
-/// | T5 | [`DiffuseFresnel`](TableId::DiffuseFresnel) | 3 | `t5-diffuse-fresnel.tbl` |
-#[derive(
-    TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq, Hash,
-)]
-#[repr(u32)]
-pub enum TableId {
+/// Tables are known by their **T-number** ([`number`](Self::number): T1 … T5,
+/// in the docs, on the command line and in file names) and stored by their
+/// **tag** ([`TableId::tag`]): tags are part of the file format and never
+/// change, and they were given in the order the tables were added (T5 took
+/// tag 3 before T3 existed; tag 5 is retired).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableDescriptor {
+    /// The id (its discriminant is the tag stored in the file).
+    pub id: TableId,
+    /// The T-number the docs and the command line use (`3` for T3).
+    pub number: u32,
+    /// Short name `t<number>-<quantity>`: the file stem (`<stem>.tbl`) and
+    /// the name on the command line. T4 has one file per material,
+    /// `t4-<material>.tbl`; its stem names the kind.
+    pub stem: &'static str,
+    /// One-line description of the quantity.
+    pub description: &'static str,
+    /// Names of the axes, in storage order.
+    pub axis_names: &'static [&'static str],
+    /// Names of the generation parameters stored in [`Header::params`]
+    /// (unused slots are zero and unnamed): the fields of the table's
+    /// parameter struct ([`SmithG1Params`], [`SigmaRatioParams`],
+    /// [`DiffuseFresnelParams`], [`ConvParams`], [`ShBrdfParams`]).
+    pub param_names: &'static [&'static str],
+    /// How the runtime interpolates the payload; the reader refuses a file
+    /// whose header says otherwise ([`Table::expecting`]).
+    pub kernel: Kernel,
+    /// How the payload is stored; the reader refuses a file whose header
+    /// says otherwise ([`Table::expecting`]).
+    pub value_type: ValueType,
+    /// What the auxiliary values are (empty when the table has none).
+    pub aux: &'static str,
+    /// Whether [`crate::TableSet`] holds it (and the `embedded` feature
+    /// compiles it in): every table the BRDF reads; not T4.
+    pub in_set: bool,
+}
+
+/// Declares the table ids and their descriptors (the one place a table's
+/// facts are written; ARCHITECTURE.md's "Adding a table").
+macro_rules! table_ids {
+    ($(
+        $(#[$meta:meta])*
+        $variant:ident = $tag:literal {
+            number: $number:literal,
+            stem: $stem:literal,
+            description: $description:literal,
+            axes: [$($axis:literal),+],
+            params: $params:ident,
+            kernel: $kernel:ident,
+            value_type: $value_type:ident,
+            aux: $aux:literal,
+            in_set: $in_set:tt,
+        }
+    )+) => {
+        /// Which quantity a table holds; its facts are its
+        /// [`descriptor`](TableId::descriptor).
+        #[derive(
+            TryFromBytes, IntoBytes, KnownLayout, Immutable, Clone, Copy, Debug, PartialEq, Eq, Hash,
+        )]
+        #[repr(u32)]
+        pub enum TableId {
+            $($(#[$meta])* $variant = $tag,)+
+        }
+
+        impl TableId {
+            /// Every table id, in tag order.
+            pub const ALL: [TableId; [$($tag),+].len()] = [$(TableId::$variant),+];
+
+            /// Everything the runtime knows about the table.
+            pub const fn descriptor(self) -> &'static TableDescriptor {
+                match self {
+                    $(TableId::$variant => &TableDescriptor {
+                        id: TableId::$variant,
+                        number: $number,
+                        stem: $stem,
+                        description: $description,
+                        axis_names: &[$($axis),+],
+                        param_names: $params::NAMES,
+                        kernel: Kernel::$kernel,
+                        value_type: ValueType::$value_type,
+                        aux: $aux,
+                        in_set: $in_set,
+                    },)+
+                }
+            }
+        }
+
+        /// The committed files of the set's tables, compiled in (feature
+        /// `embedded`). `tables` is a link to the workspace's `tables/` (the
+        /// generator writes there); `cargo package` follows it, so a
+        /// packaged crate carries the files.
+        #[cfg(feature = "embedded")]
+        pub(crate) fn embedded_bytes(id: TableId) -> Option<&'static [u8]> {
+            match id {
+                $(TableId::$variant => table_ids!(@embed $in_set, $stem),)+
+            }
+        }
+    };
+    (@embed true, $stem:literal) => {
+        Some($crate::include_table!(concat!("../tables/", $stem, ".tbl")))
+    };
+    (@embed false, $stem:literal) => {
+        None
+    };
+}
+
+table_ids! {
     /// T1: Smith G1 of the EPD NDF over (p, ã = k_p·a); see [`crate::smith`].
-    SmithG1 = 1,
+    SmithG1 = 1 {
+        number: 1,
+        stem: "t1-smith-g1",
+        description: "Smith G1 of the EPD NDF (HP17 36-38), axes p and k_p*beta*tan(theta); aux = k_p per p node",
+        axes: ["p", "a_scaled"],
+        params: SmithG1Params,
+        kernel: Multilinear,
+        value_type: F32,
+        aux: "k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) at each p node",
+        in_set: true,
+    }
     /// T2: σrel/σs of the K-correlation spectrum over (cos θi, B = b/λ, c);
     /// see [`crate::kcorr`].
-    SigmaRatio = 2,
+    SigmaRatio = 2 {
+        number: 2,
+        stem: "t2-sigma-ratio",
+        description: "sigma_rel/sigma_s of the K-correlation spectrum (HP17 17-19) divided by its closed form at normal incidence; cubic B-spline coefficients",
+        axes: ["cos_theta_i", "B", "c"],
+        params: SigmaRatioParams,
+        kernel: CubicBSpline,
+        value_type: F32,
+        aux: "",
+        in_set: true,
+    }
     /// T5: internal diffuse Fresnel reflectance F_dr,int(η) of a dielectric
     /// over η; see [`crate::fresnel::DiffuseFresnelTable`].
-    DiffuseFresnel = 3,
+    DiffuseFresnel = 3 {
+        number: 5,
+        stem: "t5-diffuse-fresnel",
+        description: "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, docs/model.md 2.6); cubic B-spline coefficients",
+        axes: ["eta"],
+        params: DiffuseFresnelParams,
+        kernel: CubicBSpline,
+        value_type: F32,
+        aux: "",
+        in_set: true,
+    }
     /// T3: the convolution `C(θh; u, c, β, p)` of the diffraction lobe with
     /// the EPD NDF over (u, c, β, p): the paper's `s, g` (T3a) and `ln C` at
     /// 32 normalised angles (T3b) per node; see [`crate::conv`].
-    Convolution = 4,
+    Convolution = 4 {
+        number: 3,
+        stem: "t3-convolution",
+        description: "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); u16 codes per node; Catmull-Rom in the parameters and in xi",
+        axes: ["u", "c", "beta", "p"],
+        params: ConvParams,
+        kernel: CatmullRom,
+        value_type: U16,
+        aux: "",
+        in_set: true,
+    }
     /// T4: spherical-harmonic BRDF matrix of one material (\[WAT92\] §2,
     /// docs/model.md §2.9), one channel per wavelength; see [`crate::sh`].
-    ShBrdf = 6,
+    ShBrdf = 6 {
+        number: 4,
+        stem: "t4-sh-brdf",
+        description: "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, docs/model.md 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength",
+        axes: ["coefficient"],
+        params: ShBrdfParams,
+        kernel: Multilinear,
+        value_type: F32,
+        aux: "",
+        in_set: false,
+    }
 }
 
 impl TableId {
-    /// Every table id, in tag order.
-    pub const ALL: [TableId; 5] = [
-        TableId::SmithG1,
-        TableId::SigmaRatio,
-        TableId::DiffuseFresnel,
-        TableId::Convolution,
-        TableId::ShBrdf,
-    ];
-
-    /// The tag stored in the file (see the type's documentation).
+    /// The tag stored in the file.
     pub const fn tag(self) -> u32 {
         self as u32
-    }
-
-    /// The T-number the docs and the command line use (`3` for T3; see the
-    /// type's documentation).
-    pub const fn number(self) -> u32 {
-        match self {
-            TableId::SmithG1 => 1,
-            TableId::SigmaRatio => 2,
-            TableId::Convolution => 3,
-            TableId::ShBrdf => 4,
-            TableId::DiffuseFresnel => 5,
-        }
     }
 
     /// The id with this tag, if any.
@@ -125,64 +245,68 @@ impl TableId {
         Self::ALL.into_iter().find(|id| id.tag() == tag)
     }
 
-    /// Short name, `t<number>-<quantity>`, used for file names (`<name>.tbl`)
-    /// and on the command line (T4's files add the material:
-    /// `t4-sh-brdf` names the kind, `t4-<material>.tbl` the files).
+    /// The T-number ([`TableDescriptor::number`]).
+    pub const fn number(self) -> u32 {
+        self.descriptor().number
+    }
+
+    /// The file stem and command-line name ([`TableDescriptor::stem`]).
     pub const fn name(self) -> &'static str {
-        match self {
-            TableId::SmithG1 => "t1-smith-g1",
-            TableId::SigmaRatio => "t2-sigma-ratio",
-            TableId::DiffuseFresnel => "t5-diffuse-fresnel",
-            TableId::Convolution => "t3-convolution",
-            TableId::ShBrdf => "t4-sh-brdf",
-        }
+        self.descriptor().stem
     }
 
-    /// One-line description of the quantity.
+    /// One-line description ([`TableDescriptor::description`]).
     pub const fn description(self) -> &'static str {
-        match self {
-            TableId::SmithG1 => {
-                "Smith G1 of the EPD NDF (HP17 36-38), axes p and k_p*beta*tan(theta); aux = k_p per p node"
-            }
-            TableId::SigmaRatio => {
-                "sigma_rel/sigma_s of the K-correlation spectrum (HP17 17-19) divided by its closed form at normal incidence; cubic B-spline coefficients"
-            }
-            TableId::DiffuseFresnel => {
-                "internal diffuse Fresnel reflectance F_dr,int(eta) = 2 int_0^1 F(1/eta, mu) mu dmu of a dielectric (HP17 43, docs/model.md 2.6); cubic B-spline coefficients"
-            }
-            TableId::Convolution => {
-                "convolution C(theta_h; u, c, beta, p) of the diffraction kernel with the EPD NDF (HP17 32-33, 39-41); channels: ln s, ln(g^2 + g_offset) of the paper's fit s*k(2g sin theta_h) (T3a), then ln C at evenly spaced values of the normalised angle xi (T3b); u16 codes per node; Catmull-Rom in the parameters and in xi"
-            }
-            TableId::ShBrdf => {
-                "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, docs/model.md 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength"
-            }
-        }
+        self.descriptor().description
     }
 
-    /// Names of the axes, in storage order.
+    /// Names of the axes ([`TableDescriptor::axis_names`]).
     pub const fn axis_names(self) -> &'static [&'static str] {
-        match self {
-            TableId::SmithG1 => &["p", "a_scaled"],
-            TableId::SigmaRatio => &["cos_theta_i", "B", "c"],
-            TableId::DiffuseFresnel => &["eta"],
-            TableId::Convolution => &["u", "c", "beta", "p"],
-            TableId::ShBrdf => &["coefficient"],
-        }
+        self.descriptor().axis_names
     }
 
-    /// Names of the generation parameters stored in [`Header::params`] (unused
-    /// slots are zero and unnamed): the fields of the table's parameter struct
-    /// ([`SmithG1Params`], [`SigmaRatioParams`], [`DiffuseFresnelParams`],
-    /// [`ConvParams`], [`ShBrdfParams`]).
+    /// Names of the generation parameters ([`TableDescriptor::param_names`]).
     pub const fn param_names(self) -> &'static [&'static str] {
-        match self {
-            TableId::SmithG1 => SmithG1Params::NAMES,
-            TableId::SigmaRatio => SigmaRatioParams::NAMES,
-            TableId::DiffuseFresnel => DiffuseFresnelParams::NAMES,
-            TableId::Convolution => ConvParams::NAMES,
-            TableId::ShBrdf => ShBrdfParams::NAMES,
-        }
+        self.descriptor().param_names
     }
+
+    /// The file name, `<stem>.tbl`.
+    #[cfg(feature = "std")]
+    pub fn file_name(self) -> std::string::String {
+        std::format!("{}.tbl", self.name())
+    }
+}
+
+/// Implements a parameter struct's header slots: `NAMES`, `COUNT`,
+/// `to_values` (what the generator writes) and `from_header` (what the
+/// runtime reads), slot `k` holding the `k`-th listed field (a field of a
+/// nested struct is written `outer.inner`; its name is `inner`).
+macro_rules! header_slots {
+    ($name:ident { $($first:ident $(. $rest:ident)?),+ $(,)? }) => {
+        impl $name {
+            /// The field names, in slot order (what `generator inspect` prints).
+            pub const NAMES: &'static [&'static str] = &[$(header_slots!(@name $first $($rest)?)),+];
+            /// Number of slots used.
+            pub const COUNT: usize = Self::NAMES.len();
+
+            /// The parameters in slot order (what the writer stores).
+            pub fn to_values(&self) -> [f64; Self::COUNT] {
+                [$(self.$first $(.$rest)?),+]
+            }
+
+            /// The parameters stored in `header`.
+            pub fn from_header(header: &Header) -> Self {
+                let mut slots = header.params.iter().copied();
+                let mut out = Self::default();
+                $(out.$first $(.$rest)? = slots.next().unwrap_or(0.0);)+
+                out
+            }
+        }
+
+        const _: () = assert!($name::COUNT <= PARAM_COUNT);
+    };
+    (@name $first:ident) => { stringify!($first) };
+    (@name $first:ident $rest:ident) => { stringify!($rest) };
 }
 
 /// Defines a table's generation parameters as a struct of named `f64`
@@ -197,27 +321,7 @@ macro_rules! header_params {
             $($(#[$field_meta])* pub $field: f64,)+
         }
 
-        impl $name {
-            /// The field names, in slot order (what `generator inspect` prints).
-            pub const NAMES: &'static [&'static str] = &[$(stringify!($field)),+];
-            /// Number of slots used.
-            pub const COUNT: usize = Self::NAMES.len();
-
-            /// The parameters in slot order (what the writer stores).
-            pub fn to_values(&self) -> [f64; Self::COUNT] {
-                [$(self.$field),+]
-            }
-
-            /// The parameters stored in `header`.
-            pub fn from_header(header: &Header) -> Self {
-                let mut slots = header.params.iter().copied();
-                Self {
-                    $($field: slots.next().unwrap_or(0.0),)+
-                }
-            }
-        }
-
-        const _: () = assert!($name::COUNT <= PARAM_COUNT);
+        header_slots!($name { $($field),+ });
     };
 }
 
@@ -251,40 +355,39 @@ header_params! {
     }
 }
 
-header_params! {
-    /// T3's generation parameters: its number of normalised angles, the
-    /// normalised angle's constants (`conv::AngleParams`, docs/model.md §3),
-    /// the T3a `g` offset and the value floor.
-    ConvParams {
-        /// Number of normalised angles ξ (the `ln C` channels).
-        angles,
-        /// `τ_max`: the largest `tan θh` represented (`ξ = 1`).
-        tau_max,
-        /// `u_floor`: `u_e = √(u² + u_floor²)`.
-        kernel_scale_floor,
-        /// `λ`: weight of the NDF term.
-        ndf_weight,
-        /// `Y`: where the NDF term saturates.
-        ndf_exponent_cap,
-        /// T3a stores `ln(g² + g_offset)`.
-        g_offset,
-        /// `ln C` is stored at least at `ln(value_floor · peak)`.
-        value_floor,
-        /// `κ`: softening of the NDF exponent.
-        ndf_softening,
-        /// `w_h`: weight of the horizon term.
-        horizon_weight,
-        /// `w_e`: weight of the edge term.
-        edge_weight,
-        /// `s_e`: smoothing of the edge term's onset.
-        edge_smoothing,
-        /// `τ_f`: the edge term fades out for edges near the horizon.
-        edge_fade_tan,
-        /// `m`: the edge term fades where the kernel is wider than the NDF,
-        /// by `(p′/p)^m` (format version 3; 0 gives format 2's angle).
-        edge_softening_fade,
-    }
+/// T3's generation parameters: its number of normalised angles, the
+/// normalised angle's constants ([`AngleParams`](crate::conv::AngleParams),
+/// docs/model.md §3), the T3a `g` offset and the value floor.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct ConvParams {
+    /// Number of normalised angles ξ (the `ln C` channels).
+    pub angles: f64,
+    /// The normalised angle's constants.
+    pub angle: crate::conv::AngleParams,
+    /// T3a stores `ln(g² + g_offset)`.
+    pub g_offset: f64,
+    /// `ln C` is stored at least at `ln(value_floor · peak)`.
+    pub value_floor: f64,
 }
+
+// The slot order is format version 3's (the angle's fields are not
+// contiguous: format 1 had five of them, the others came later); the
+// edge term's fade `m` (slot 13) is what version 3 added.
+header_slots!(ConvParams {
+    angles,
+    angle.tau_max,
+    angle.kernel_scale_floor,
+    angle.ndf_weight,
+    angle.ndf_exponent_cap,
+    g_offset,
+    value_floor,
+    angle.ndf_softening,
+    angle.horizon_weight,
+    angle.edge_weight,
+    angle.edge_smoothing,
+    angle.edge_fade_tan,
+    angle.edge_softening_fade,
+});
 
 header_params! {
     /// T4's generation parameters.
@@ -438,19 +541,29 @@ impl Quantised<'_> {
 #[repr(u32)]
 pub enum Kernel {
     /// The payload holds values at the nodes (not spline coefficients),
-    /// `nodes` values per axis: `interp::Grid` blends them n-linearly (T1),
-    /// T3's reader with Catmull–Rom weights (`crate::conv`); T4's are the
-    /// packed SH matrix (`crate::sh`).
+    /// `nodes` values per axis, blended n-linearly (`interp::Grid`, T1); T4's
+    /// are the packed SH matrix (`crate::sh`).
     Multilinear = 1,
     /// Uniform cubic B-spline in the mapped coordinates: the payload holds the
     /// spline's coefficients, `nodes + 2` per axis (one beyond each end node),
     /// prefiltered by the generator so that the spline interpolates the samples.
     CubicBSpline = 2,
+    /// The payload holds values at the nodes, `nodes` values per axis,
+    /// blended with Catmull–Rom weights over nodes `i − 1 … i + 2` (quadratic
+    /// in the first and last cell): T3 (`crate::conv`). Before this tag T3
+    /// was written with tag 1, which misdescribed it; a reader that does not
+    /// know tag 3 refuses the file ([`FormatError::UnknownKernel`]) rather
+    /// than misread it, so the format version is unchanged.
+    CatmullRom = 3,
 }
 
 impl Kernel {
     /// Every kernel, in tag order.
-    pub const ALL: [Kernel; 2] = [Kernel::Multilinear, Kernel::CubicBSpline];
+    pub const ALL: [Kernel; 3] = [
+        Kernel::Multilinear,
+        Kernel::CubicBSpline,
+        Kernel::CatmullRom,
+    ];
 
     /// The kernel with this tag, if any.
     pub fn from_tag(tag: u32) -> Option<Kernel> {
@@ -460,7 +573,7 @@ impl Kernel {
     /// Stored values along an axis of `nodes` nodes.
     pub const fn stored_per_axis(self, nodes: u32) -> u64 {
         match self {
-            Kernel::Multilinear => nodes as u64,
+            Kernel::Multilinear | Kernel::CatmullRom => nodes as u64,
             Kernel::CubicBSpline => nodes as u64 + 2,
         }
     }
@@ -718,6 +831,22 @@ pub enum FormatError {
         /// The table in the file.
         found: TableId,
     },
+    /// The file is valid but its kernel is not the one the runtime uses for
+    /// this table ([`TableDescriptor::kernel`]).
+    WrongKernel {
+        /// The table.
+        table: TableId,
+        /// The kernel in the file.
+        found: Kernel,
+    },
+    /// The file is valid but its values are not stored as the runtime reads
+    /// them for this table ([`TableDescriptor::value_type`]).
+    WrongValueType {
+        /// The table.
+        table: TableId,
+        /// The value type in the file.
+        found: ValueType,
+    },
     /// The file is valid but its shape is not the one this table kind needs.
     Shape(&'static str),
 }
@@ -769,6 +898,18 @@ impl fmt::Display for FormatError {
                 "expected table {}, found {}",
                 expected.name(),
                 found.name()
+            ),
+            WrongKernel { table, found } => write!(
+                f,
+                "{} is interpolated with kernel {:?}, the file says {found:?}; rebuild it with this generator",
+                table.name(),
+                table.descriptor().kernel
+            ),
+            WrongValueType { table, found } => write!(
+                f,
+                "{} is stored as {:?}, the file holds {found:?}; rebuild it with this generator",
+                table.name(),
+                table.descriptor().value_type
             ),
             Shape(reason) => write!(f, "unexpected table shape: {reason}"),
         }
@@ -955,11 +1096,26 @@ impl<'a> Table<'a> {
     }
 
     /// The table itself if it holds `expected`, else [`FormatError::WrongTable`].
+    /// Also checks that the file's kernel and value type are the ones its
+    /// [`TableDescriptor`] says the runtime uses.
     pub fn expecting(self, expected: TableId) -> Result<Self, FormatError> {
         if self.header.table_id != expected {
             return Err(FormatError::WrongTable {
                 expected,
                 found: self.header.table_id,
+            });
+        }
+        let descriptor = expected.descriptor();
+        if self.header.kernel != descriptor.kernel {
+            return Err(FormatError::WrongKernel {
+                table: expected,
+                found: self.header.kernel,
+            });
+        }
+        if self.header.value_type != descriptor.value_type {
+            return Err(FormatError::WrongValueType {
+                table: expected,
+                found: self.header.value_type,
             });
         }
         Ok(self)
@@ -1342,22 +1498,122 @@ mod tests {
         }
     }
 
-    /// Every table's name starts with its T-number, tags and T-numbers are
-    /// each unique, and a tag round-trips.
+    /// Every descriptor: its id's tag round-trips, it is its id's, its stem
+    /// starts with its T-number, stems, T-numbers and tags are each
+    /// unique, its axes fit the header, its parameter names fit the header's
+    /// slots, and every table of the set is embedded.
     #[test]
-    fn names_carry_the_t_number() {
+    fn every_descriptor_is_consistent() {
         for id in TableId::ALL {
-            assert!(
-                id.name().starts_with(&format!("t{}-", id.number())),
-                "{id:?}"
-            );
+            let d = id.descriptor();
+            assert_eq!(d.id, id);
             assert_eq!(TableId::from_tag(id.tag()), Some(id));
+            assert!(
+                d.stem.starts_with(&format!("t{}-", d.number)),
+                "{id:?}: {}",
+                d.stem
+            );
+            assert!((1..=MAX_AXES).contains(&d.axis_names.len()), "{id:?}");
+            assert!(d.param_names.len() <= PARAM_COUNT, "{id:?}");
+            #[cfg(feature = "embedded")]
+            assert_eq!(embedded_bytes(id).is_some(), d.in_set, "{id:?}");
             for other in TableId::ALL {
                 if other != id {
-                    assert_ne!(other.number(), id.number());
+                    let o = other.descriptor();
+                    assert_ne!(o.number, d.number);
+                    assert_ne!(o.stem, d.stem);
                     assert_ne!(other.tag(), id.tag());
                 }
             }
+        }
+    }
+
+    /// A table whose header names another kernel than its descriptor's is
+    /// refused: T3 written with kernel 1 (`Multilinear`, what T3 files said
+    /// before tag 3) names the kernel it needs.
+    #[cfg(all(feature = "embedded", feature = "std"))]
+    #[test]
+    fn a_table_with_another_kernel_is_refused() {
+        let t3 = embedded_bytes(TableId::Convolution).unwrap_or(&[]);
+        let mut file = aligned_copy(t3);
+        let at = offset_of!(Header, kernel);
+        file.bytes_mut()[at..at + 4].copy_from_slice(&(Kernel::Multilinear as u32).to_le_bytes());
+        let sum = checksum(file.bytes());
+        file.bytes_mut()[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
+        let table = Table::from_bytes(file.bytes()).expect("still a valid file");
+        let error = table.expecting(TableId::Convolution).err();
+        assert_eq!(
+            error,
+            Some(FormatError::WrongKernel {
+                table: TableId::Convolution,
+                found: Kernel::Multilinear,
+            })
+        );
+        let message = std::format!("{}", error.unwrap_or(FormatError::Shape("")));
+        assert!(message.contains("CatmullRom"), "{message}");
+        assert!(crate::conv::ConvTable::from_bytes(file.bytes()).is_err());
+    }
+
+    /// T3's parameters nest its angle constants: slot order is format 3's
+    /// (angles, τ_max, u_floor, λ, Y, g_offset, value_floor, κ, w_h, w_e,
+    /// s_e, τ_f, m) and a header round-trips.
+    #[test]
+    fn conv_params_keep_their_slots() {
+        let values: [f64; 13] = core::array::from_fn(|k| k as f64 + 1.0);
+        let params = {
+            let mut slots = values.iter().copied();
+            let mut next = || slots.next().unwrap_or(0.0);
+            ConvParams {
+                angles: next(),
+                angle: crate::conv::AngleParams {
+                    tau_max: next(),
+                    kernel_scale_floor: next(),
+                    ndf_weight: next(),
+                    ndf_exponent_cap: next(),
+                    ..Default::default()
+                },
+                g_offset: next(),
+                value_floor: next(),
+            }
+        };
+        let params = ConvParams {
+            angle: crate::conv::AngleParams {
+                ndf_softening: 8.0,
+                horizon_weight: 9.0,
+                edge_weight: 10.0,
+                edge_smoothing: 11.0,
+                edge_fade_tan: 12.0,
+                edge_softening_fade: 13.0,
+                ..params.angle
+            },
+            ..params
+        };
+        assert_eq!(params.to_values(), values);
+        assert_eq!(
+            ConvParams::NAMES,
+            [
+                "angles",
+                "tau_max",
+                "kernel_scale_floor",
+                "ndf_weight",
+                "ndf_exponent_cap",
+                "g_offset",
+                "value_floor",
+                "ndf_softening",
+                "horizon_weight",
+                "edge_weight",
+                "edge_smoothing",
+                "edge_fade_tan",
+                "edge_softening_fade",
+            ]
+        );
+        #[cfg(feature = "embedded")]
+        {
+            let bytes = embedded_bytes(TableId::Convolution).unwrap_or(&[]);
+            let header = Table::from_bytes(bytes).expect("the committed T3").header();
+            let params = ConvParams::from_header(header);
+            assert_eq!(params.to_values()[..], header.params[..ConvParams::COUNT]);
+            assert_eq!(params.angle.edge_softening_fade, header.params[12]);
         }
     }
 }

@@ -192,6 +192,12 @@ impl<'a> Hp15<'a> {
         (pdf > 0.0).then_some((o, pdf))
     }
 
+    /// `[k_s, k_w, k_d]` as used (negative colours count as 0).
+    pub(crate) fn colours(&self) -> [f32; 3] {
+        let p = &self.params;
+        [p.ks, p.kw, p.kd].map(|x| x.max(0.0))
+    }
+
     /// The wavelength in use (µm).
     pub fn wavelength(&self) -> f32 {
         self.lambda as f32

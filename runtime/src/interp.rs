@@ -221,6 +221,11 @@ impl<'a> Grid<'a> {
         let mut strides = [0; MAX_AXES];
         let mut stride = channels;
         let kernel = header.kernel;
+        if kernel == Kernel::CatmullRom {
+            return Err(FormatError::Shape(
+                "a Catmull-Rom grid is read by its table's reader (crate::conv), not interp::Grid",
+            ));
+        }
         for d in (0..used.len()).rev() {
             strides[d] = stride;
             stride *= kernel.stored_per_axis(axes[d].cells + 1) as usize;
@@ -267,7 +272,8 @@ impl<'a> Grid<'a> {
             cells[d] = self.axes[d.min(MAX_AXES - 1)].locate(x[d]);
         }
         match self.kernel {
-            Kernel::Multilinear => self.blend(cells, channel),
+            // `Grid::new` refuses Catmull–Rom grids (T3 has its own reader).
+            Kernel::Multilinear | Kernel::CatmullRom => self.blend(cells, channel),
             Kernel::CubicBSpline => self.blend_cubic(cells, channel),
         }
     }

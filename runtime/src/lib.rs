@@ -16,6 +16,7 @@
 
 mod bake;
 pub mod brdf;
+pub mod bxdf;
 pub mod conv;
 pub mod epd;
 pub mod format;
@@ -26,6 +27,7 @@ pub mod interp;
 pub mod kcorr;
 pub mod materials;
 pub mod math;
+pub mod merl;
 #[cfg(feature = "std")]
 pub mod mmap;
 pub mod sh;
@@ -36,11 +38,14 @@ mod test_rng;
 pub mod validate;
 
 pub use brdf::{Rgb, TwoScale};
+pub use bxdf::{Bxdf, BxdfFlags, BxdfSample};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
 pub use format::{AlignedBytes, FormatError, Table, TableId};
 pub use fresnel::{Complex, DiffuseFresnelTable};
 pub use kcorr::{KCorrelation, SigmaRatioTable};
 pub use sh::ShBrdfTable;
 pub use smith::{SmithG1Table, SmithShape};
+#[cfg(feature = "std")]
+pub use table_set::{OwnedTableSet, TableStorage};
 pub use table_set::{TableBytes, TableSet, TableSetError, UnknownMaterial};
 pub use validate::{Domain, Invalid, Named, Shortest, Shortest32};

@@ -67,6 +67,10 @@ forward! {
     cos(x) -> f64 = cos / cos;
     /// arctan x (f64).
     atan(x) -> f64 = atan / atan;
+    /// arccos x (f64).
+    acos(x) -> f64 = acos / acos;
+    /// The angle of the point (x, y), in (−π, π] (f64).
+    atan2(y, x) -> f64 = atan2 / atan2;
     /// arctan x (f32).
     atanf(x) -> f32 = atan / atanf;
 }

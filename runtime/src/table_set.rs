@@ -24,14 +24,28 @@ use crate::materials::PRESETS;
 use crate::smith::SmithG1Table;
 use core::fmt;
 
-/// The tables of a set, in the order of [`TableBytes`]' fields; each is the
-/// file `<TableId::name()>.tbl`.
-pub const TABLES: [TableId; 4] = [
-    TableId::SmithG1,
-    TableId::SigmaRatio,
-    TableId::Convolution,
-    TableId::DiffuseFresnel,
-];
+/// The tables of a set ([`TableDescriptor::in_set`]), in tag order; each
+/// is the file `<TableId::name()>.tbl`.
+///
+/// [`TableDescriptor::in_set`]: crate::format::TableDescriptor::in_set
+pub const TABLES: [TableId; 4] = set_tables();
+
+const fn set_tables<const N: usize>() -> [TableId; N] {
+    let mut out = [TableId::SmithG1; N];
+    let (mut i, mut k) = (0, 0);
+    while i < TableId::ALL.len() {
+        if TableId::ALL[i].descriptor().in_set {
+            out[k] = TableId::ALL[i];
+            k += 1;
+        }
+        i += 1;
+    }
+    assert!(
+        k == N,
+        "TABLES' length is the number of descriptors in the set"
+    );
+    out
+}
 
 /// The bytes of the four files (each 64-byte aligned, e.g. from
 /// [`include_table!`](crate::include_table) or a memory map).
@@ -45,6 +59,21 @@ pub struct TableBytes<'a> {
     pub convolution: &'a [u8],
     /// `t5-diffuse-fresnel.tbl`.
     pub diffuse_fresnel: &'a [u8],
+}
+
+impl<'a> TableBytes<'a> {
+    /// The bytes of each table of [`TABLES`], from `bytes` (the one place
+    /// the fields meet the ids; the first error is returned).
+    pub fn try_from_fn<E>(
+        mut bytes: impl FnMut(TableId) -> Result<&'a [u8], E>,
+    ) -> Result<Self, E> {
+        Ok(TableBytes {
+            smith: bytes(TableId::SmithG1)?,
+            sigma_ratio: bytes(TableId::SigmaRatio)?,
+            convolution: bytes(TableId::Convolution)?,
+            diffuse_fresnel: bytes(TableId::DiffuseFresnel)?,
+        })
+    }
 }
 
 /// Why a table set could not be formed: which file, and what is wrong with it.
@@ -120,18 +149,15 @@ pub struct TableSet<'a> {
 impl<'a> TableSet<'a> {
     /// Validates the four files; the error names the first file at fault.
     pub fn from_bytes(bytes: TableBytes<'a>) -> Result<Self, TableSetError> {
-        let at = |k: usize| {
-            move |error: FormatError| TableSetError::Format {
-                table: TABLES[k],
-                error,
-            }
-        };
+        let at = |table: TableId| move |error: FormatError| TableSetError::Format { table, error };
         Ok(TableSet {
-            smith: SmithG1Table::from_bytes(bytes.smith).map_err(at(0))?,
-            sigma_ratio: SigmaRatioTable::from_bytes(bytes.sigma_ratio).map_err(at(1))?,
-            convolution: ConvTable::from_bytes(bytes.convolution).map_err(at(2))?,
+            smith: SmithG1Table::from_bytes(bytes.smith).map_err(at(TableId::SmithG1))?,
+            sigma_ratio: SigmaRatioTable::from_bytes(bytes.sigma_ratio)
+                .map_err(at(TableId::SigmaRatio))?,
+            convolution: ConvTable::from_bytes(bytes.convolution)
+                .map_err(at(TableId::Convolution))?,
             diffuse_fresnel: DiffuseFresnelTable::from_bytes(bytes.diffuse_fresnel)
-                .map_err(at(3))?,
+                .map_err(at(TableId::DiffuseFresnel))?,
         })
     }
 
@@ -173,30 +199,17 @@ impl<'a> TableSet<'a> {
 }
 
 #[cfg(feature = "embedded")]
-mod embedded {
-    use crate::format::AlignedBytes;
-    // `tables` is a link to the workspace's `tables/` (the generator writes
-    // there); `cargo package` follows it, so a packaged crate carries the files.
-    pub static T1: &AlignedBytes<[u8]> =
-        &AlignedBytes(*include_bytes!("../tables/t1-smith-g1.tbl"));
-    pub static T2: &AlignedBytes<[u8]> =
-        &AlignedBytes(*include_bytes!("../tables/t2-sigma-ratio.tbl"));
-    pub static T3: &AlignedBytes<[u8]> =
-        &AlignedBytes(*include_bytes!("../tables/t3-convolution.tbl"));
-    pub static T5: &AlignedBytes<[u8]> =
-        &AlignedBytes(*include_bytes!("../tables/t5-diffuse-fresnel.tbl"));
-}
-
-#[cfg(feature = "embedded")]
 impl TableSet<'static> {
     /// The bytes of the tables compiled into the crate (feature `embedded`).
     pub fn embedded_bytes() -> TableBytes<'static> {
-        TableBytes {
-            smith: embedded::T1.bytes(),
-            sigma_ratio: embedded::T2.bytes(),
-            convolution: embedded::T3.bytes(),
-            diffuse_fresnel: embedded::T5.bytes(),
-        }
+        // Every table of the set is compiled in (`format::embedded_bytes`).
+        let bytes = TableBytes::try_from_fn(|id| crate::format::embedded_bytes(id).ok_or(()));
+        bytes.unwrap_or(TableBytes {
+            smith: &[],
+            sigma_ratio: &[],
+            convolution: &[],
+            diffuse_fresnel: &[],
+        })
     }
 
     /// The committed tables, compiled into the crate (feature `embedded`): no
@@ -218,23 +231,130 @@ impl TableSet<'static> {
 #[cfg(feature = "std")]
 impl TableSet<'static> {
     /// Memory-maps the four files of `dir` (read-only) and validates them.
-    /// The maps are kept for the rest of the process (the set borrows them
-    /// for `'static`): open a directory once, not per material. Table files
-    /// are immutable; replacing one while mapped must be a rename.
-    pub fn open(dir: impl AsRef<std::path::Path>) -> Result<TableSet<'static>, TableSetError> {
-        let map = |k: usize| -> Result<&'static [u8], TableSetError> {
-            let path = dir.as_ref().join(std::format!("{}.tbl", TABLES[k].name()));
+    /// The set owns the maps: they are released when it is dropped. Table
+    /// files are immutable; replacing one while mapped must be a rename.
+    pub fn open(dir: impl AsRef<std::path::Path>) -> Result<OwnedTableSet, TableSetError> {
+        OwnedTableSet::from_storage(|id| {
+            let path = dir.as_ref().join(id.file_name());
             match crate::mmap::MappedFile::open(&path) {
-                Ok(file) => Ok(std::boxed::Box::leak(std::boxed::Box::new(file)).bytes()),
+                Ok(file) => Ok(TableStorage::Mapped(file)),
                 Err(error) => Err(TableSetError::Io { path, error }),
             }
-        };
-        Self::from_bytes(TableBytes {
-            smith: map(0)?,
-            sigma_ratio: map(1)?,
-            convolution: map(2)?,
-            diffuse_fresnel: map(3)?,
         })
+    }
+}
+
+/// Where the bytes of one table of an [`OwnedTableSet`] live.
+#[cfg(feature = "std")]
+pub enum TableStorage {
+    /// A read-only memory map of the file.
+    Mapped(crate::mmap::MappedFile),
+    /// A 64-byte-aligned heap copy.
+    Copied(crate::format::AlignedBuf),
+}
+
+#[cfg(feature = "std")]
+impl TableStorage {
+    /// The bytes.
+    pub fn bytes(&self) -> &[u8] {
+        match self {
+            TableStorage::Mapped(map) => map.bytes(),
+            TableStorage::Copied(buf) => buf.bytes(),
+        }
+    }
+}
+
+/// A [`TableSet`] together with the storage of its bytes (memory maps or
+/// heap copies), released when it is dropped ([`TableSet::open`]). Models
+/// borrow [`OwnedTableSet::set`].
+#[cfg(feature = "std")]
+pub struct OwnedTableSet {
+    /// Views of `storage` (declared first, so dropped first), or of static
+    /// bytes; never handed out as `'static` (see [`OwnedTableSet::set`]).
+    set: TableSet<'static>,
+    storage: std::vec::Vec<TableStorage>,
+}
+
+#[cfg(feature = "std")]
+impl OwnedTableSet {
+    /// Validates the tables of [`TABLES`] held by the storage `storage`
+    /// gives for each; the first error is returned.
+    pub fn from_storage(
+        mut storage: impl FnMut(TableId) -> Result<TableStorage, TableSetError>,
+    ) -> Result<OwnedTableSet, TableSetError> {
+        let storage = TABLES
+            .iter()
+            .map(|&id| storage(id))
+            .collect::<Result<std::vec::Vec<_>, _>>()?;
+        let set = TableSet::from_bytes(
+            TableBytes::try_from_fn(|id| {
+                let k = TABLES.iter().position(|&t| t == id);
+                k.and_then(|k| storage.get(k)).map(extend).ok_or(())
+            })
+            .map_err(|()| TableSetError::Format {
+                table: TableId::SmithG1,
+                error: FormatError::BadHeader("a table of the set has no storage"),
+            })?,
+        )?;
+        Ok(OwnedTableSet { set, storage })
+    }
+
+    /// A set of `'static` bytes (the embedded tables, say), with no storage
+    /// to own.
+    pub fn from_static(set: TableSet<'static>) -> OwnedTableSet {
+        OwnedTableSet {
+            set,
+            storage: std::vec::Vec::new(),
+        }
+    }
+
+    /// The set, borrowed for as long as `self` lives.
+    pub fn set(&self) -> &TableSet<'_> {
+        &self.set
+    }
+
+    /// The storage, in the order of [`TABLES`] (empty for
+    /// [`OwnedTableSet::from_static`]).
+    pub fn storage(&self) -> &[TableStorage] {
+        &self.storage
+    }
+}
+
+#[cfg(feature = "std")]
+impl fmt::Debug for TableStorage {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let kind = match self {
+            TableStorage::Mapped(_) => "Mapped",
+            TableStorage::Copied(_) => "Copied",
+        };
+        write!(f, "{kind}({} bytes)", self.bytes().len())
+    }
+}
+
+#[cfg(feature = "std")]
+impl fmt::Debug for OwnedTableSet {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("OwnedTableSet")
+            .field("set", &self.set)
+            .field("storage", &self.storage)
+            .finish()
+    }
+}
+
+/// The bytes of `storage` for `'static`, for the views of an
+/// [`OwnedTableSet`] that owns `storage`.
+#[cfg(feature = "std")]
+fn extend(storage: &TableStorage) -> &'static [u8] {
+    let bytes: *const [u8] = storage.bytes();
+    // SAFETY: the bytes lie in a memory map or a heap buffer owned by
+    // `storage`; neither moves when the `TableStorage` (or the `Vec` holding
+    // it) moves, neither is ever written, and both live until the
+    // `OwnedTableSet` that holds `storage` drops it, after its `set` (field
+    // order). The `'static` views are reachable only through
+    // `OwnedTableSet::set`, which shortens them to the owner's borrow.
+    #[allow(unsafe_code)]
+    unsafe {
+        &*bytes
     }
 }
 
@@ -243,6 +363,8 @@ impl TableSet<'static> {
 const _: () = {
     const fn send_sync<T: Send + Sync>() {}
     send_sync::<TableSet<'static>>();
+    #[cfg(feature = "std")]
+    send_sync::<OwnedTableSet>();
     send_sync::<Rgb<'static>>();
     send_sync::<crate::brdf::TwoScale<'static>>();
 };
@@ -250,6 +372,30 @@ const _: () = {
 #[cfg(all(test, feature = "embedded"))]
 mod tests {
     use super::*;
+
+    /// Lines of this process's memory map that map `file`.
+    #[cfg(all(target_os = "linux", feature = "std"))]
+    fn mapped(file: &str) -> usize {
+        let maps = std::fs::read_to_string("/proc/self/maps").expect("/proc/self/maps");
+        maps.lines().filter(|line| line.ends_with(file)).count()
+    }
+
+    /// An opened set owns its maps: opening and dropping it 50 times leaves
+    /// no map of its files behind (the maps used to be leaked, 4 per open).
+    #[cfg(all(target_os = "linux", feature = "std"))]
+    #[test]
+    fn an_opened_set_releases_its_maps() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tables");
+        let stem = TableId::Convolution.file_name();
+        let before = mapped(&stem);
+        for _ in 0..50 {
+            let owned = TableSet::open(dir).expect("the committed tables");
+            assert_eq!(mapped(&stem), before + 1);
+            let rgb = owned.set().material("gold-rough").expect("preset");
+            assert!(rgb.eval([0.3, 0.1, 0.9], [-0.3, 0.0, 0.95])[0] > 0.0);
+        }
+        assert_eq!(mapped(&stem), before);
+    }
 
     #[test]
     fn embedded_tables_validate() {

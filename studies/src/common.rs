@@ -1,13 +1,13 @@
 //! What the T3 studies share: exact profiles, the committed table, the two
 //! parameter distributions, and error summaries.
 
-use generator::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
-use generator::rng::SplitMix64;
 use generator::tables::t3;
 use generator::tables::t4::WORKSPACE_TABLES;
 use std::path::Path;
 use twoscale::format::{AlignedBuf, AxisHeader, TableId};
 use twoscale::interp::Axis;
+use twoscale_reference::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
+use twoscale_reference::rng::SplitMix64;
 
 /// T3's parameter axes `(u, c, β, p)`, as the generator builds them.
 pub const AXES: [AxisHeader; 4] = [t3::U_AXIS, t3::C_AXIS, t3::BETA_AXIS, t3::P_AXIS];

@@ -7,8 +7,6 @@
 //! and p with `twoscale::conv::axis_weights`), against exact `C`.
 
 use crate::common::{Distribution, Exact, cell_on, exact_c, floored_ln, percentiles, quantile};
-use generator::reference::conv::{kernel_integral, ndf_integral};
-use generator::reference::epd::{ndf_peak, ndf_sin_cos};
 use generator::tables::t3;
 use rayon::prelude::*;
 use twoscale::conv::{
@@ -16,6 +14,8 @@ use twoscale::conv::{
 };
 use twoscale::format::AxisHeader;
 use twoscale::interp::node_value;
+use twoscale_reference::reference::conv::{kernel_integral, ndf_integral};
+use twoscale_reference::reference::epd::{ndf_peak, ndf_sin_cos};
 
 /// An angle under test: the runtime's (any constants), or format 1's.
 #[derive(Clone, Copy, Debug, PartialEq)]

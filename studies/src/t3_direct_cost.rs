@@ -7,11 +7,11 @@
 //! (same stride): the agreement of a changed quadrature with the old one on
 //! real T3 nodes, every angle.
 
-use generator::reference::conv::{DirectOptions, convolution_direct};
 use generator::tables::t3::{angle_rule, node_count, node_params, node_tries_zonal_harmonics};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
+use twoscale_reference::reference::conv::{DirectOptions, convolution_direct};
 
 /// One direct node: index, evaluations, seconds, values.
 type NodeRun = (usize, usize, f64, Vec<f64>);

@@ -5,15 +5,15 @@
 //! * [`cubic_axes`]: which parameter axes get Catmull–Rom instead of linear
 //!   weights (the runtime's `ConvTable::with_cubic_axes`);
 //! * [`spline`]: Catmull–Rom (shipped) against a not-a-knot cubic B-spline
-//!   on prefiltered coefficients (`generator::bspline::prefilter`, the same
+//!   on prefiltered coefficients (`twoscale_reference::bspline::prefilter`, the same
 //!   storage), along the parameters, along ξ, or both.
 
 use crate::common::{AXES, Distribution, Exact, cell, committed_t3, percentiles};
-use generator::bspline::prefilter;
 use generator::tables::t3;
 use rayon::prelude::*;
 use twoscale::conv::{ConvTable, FIT_CHANNELS, along_xi, axis_weights, normalised_angle};
 use twoscale::interp::{bspline_weights, node_value};
+use twoscale_reference::bspline::prefilter;
 
 /// The committed T3 as the runtime reads it, with `cubic` parameter axes,
 /// at the rule nodes of `exact`.

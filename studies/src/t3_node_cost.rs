@@ -7,12 +7,12 @@
 //! `zh_only`, only the nodes that the build tries by zonal harmonics
 //! (`t3::node_tries_zonal_harmonics`).
 
-use generator::reference::conv::{Method, MomentCache, convolution_profile_cached};
 use generator::tables::t3::{
     angle_rule, fit_paper_form, node_count, node_params, node_tries_zonal_harmonics,
 };
 use std::collections::BTreeMap;
 use std::time::Instant;
+use twoscale_reference::reference::conv::{Method, MomentCache, convolution_profile_cached};
 
 /// Times every `stride`-th node (only the zonal-harmonic ones with
 /// `zh_only`); CSV rows on stdout, totals on stderr.

@@ -237,10 +237,66 @@ int main(int argc, char **argv) {
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "eta_im[2]");
     bad = desc;
     bad.base = 3;
-    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "base");
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "base = 3");
     bad = desc;
     bad.halo_weight = -1;
-    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "halo_weight");
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "halo_weight = -1 is not one of TS_HALO_PRINTED (0), TS_HALO_INCIDENT (1)");
+    bad = desc;
+    bad.masking = 1; /* by name: TS_MASKING_HEIGHT_CORRELATED */
+    CHECK(TS_MASKING_HEIGHT_CORRELATED == 1);
+    {
+        ts_material *hc = ts_material_new(embedded, &bad);
+        CHECK(hc != NULL);
+        ts_material_free(hc);
+    }
+
+    /* Values outside the runtime's domain (Material::validate), with its message. */
+    CHECK(desc.base == TS_BASE_CONDUCTOR);
+    bad = desc;
+    bad.beta = -0.1f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.beta = -0.1: must be in [0.0001, 10]");
+    bad = desc;
+    bad.p = 100.0f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.p = 100: must be in [0.2, 5]");
+    bad = desc;
+    bad.c = 0.5f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.c = 0.5: must be finite and > 1");
+    bad = desc;
+    bad.sigma_s = -1.0f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.sigma_s = -1: must be finite and");
+    bad = desc;
+    bad.b = -5.0f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.b = -5: must be finite and");
+    bad = desc;
+    bad.base_albedo = 0.5f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "ts_material_desc.base_albedo = 0.5");
+    bad = desc;
+    bad.eta_im[1] = -1.0f;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "ts_material_desc.eta_im[1] = -1");
+
+    /* The caller's layout: size must be sizeof(ts_material_desc). */
+    CHECK(desc.size == sizeof desc);
+    bad = desc;
+    bad.size = 0;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "ts_material_desc.size = 0");
+    bad = desc;
+    bad.size = (uint32_t)sizeof desc + 4;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "sizeof(ts_material_desc)");
+
+    /* The version is MAJOR.MINOR.PATCH. */
+    {
+        unsigned major, minor, patch;
+        char end;
+        CHECK(ts_version() != NULL &&
+              sscanf(ts_version(), "%u.%u.%u%c", &major, &minor, &patch, &end) == 3);
+    }
 
     /* Truncated, corrupted, swapped and empty table bytes, and a missing directory. */
     ts_table_bytes t = bytes;

@@ -148,6 +148,7 @@ static int compare(const char *path, long expected) {
             ts_material_free(m);
             ts_material_desc desc;
             memset(&desc, 0, sizeof desc); /* conductor, the paper's options */
+            desc.size = sizeof desc;
             desc.beta = (float)g[BETA];
             desc.p = (float)g[P];
             desc.sigma_s = (float)g[SIGMA_S];

@@ -21,7 +21,7 @@ fi
 cargo build -p twoscale-capi -p generator --release --locked
 lib=target/release
 cflags=(-std=c11 -Wall -Wextra -Werror -pedantic -O2 -g -I capi/include)
-for t in misuse query_rows; do
+for t in misuse query_rows small_stack; do
   cc "${cflags[@]}" "capi/tests/c/$t.c" -L "$lib" -ltwoscale_capi -Wl,-rpath,"$PWD/$lib" \
     -lm -lpthread -o "$out/$t"
 done
@@ -36,11 +36,25 @@ memcheck=(valgrind --error-exitcode=1 --leak-check=full
 "$out/query_rows" rows "$materials" "$pairs" 2026 > "$out/rows.csv"
 "$lib/generator" query brdf --tables tables < "$out/rows.csv" > "$out/answered.csv"
 "${memcheck[@]}" "$out/query_rows" compare "$out/answered.csv" "$materials" "$pairs"
+"${memcheck[@]}" "$out/small_stack"
 
-# The example of docs/c-api.md (its one ```c block) compiles, runs, and prints
-# three positive values.
-awk '/^```c$/{on=1; next} /^```$/{on=0} on' docs/c-api.md > "$out/example.c"
-cc "${cflags[@]}" "$out/example.c" -L "$lib" -ltwoscale_capi -Wl,-rpath,"$PWD/$lib" -lm \
-  -o "$out/example"
-"${memcheck[@]}" "$out/example" | tee "$out/example.txt"
-awk '{ exit !($3 > 0 && $4 > 0 && $5 > 0) }' "$out/example.txt"
+# docs/c-api.md verbatim: its one ```c block saved as example.c at the root
+# and the ```sh block of "Build and link" run there (it builds and runs
+# ./example and ./example-static); each prints three positive values. Then
+# the example once more under memcheck.
+snippet=(example.c example example-static)
+for f in "${snippet[@]}"; do
+  if [ -e "$f" ]; then
+    echo "$f exists at the root; move it away (the docs/c-api.md check writes it)" >&2
+    exit 1
+  fi
+done
+trap 'rm -rf "$out" "${snippet[@]}"' EXIT
+awk '/^```c$/{on=1; next} /^```$/{on=0} on' docs/c-api.md > example.c
+awk '/^## /{section=($0 == "## Build and link")} section && /^```sh$/{on=1; next}
+  on && /^```$/{exit} on' docs/c-api.md > "$out/build-and-link.sh"
+grep -q 'example-static' "$out/build-and-link.sh"
+bash -euo pipefail "$out/build-and-link.sh" | tee "$out/example.txt"
+test "$(wc -l < "$out/example.txt")" -eq 2
+awk '{ if (!($3 > 0 && $4 > 0 && $5 > 0)) exit 1 }' "$out/example.txt"
+"${memcheck[@]}" ./example > /dev/null

@@ -7,11 +7,10 @@
 
 use std::fmt::Write as _;
 
-use twoscale::TableId;
 use twoscale::format::Mapping;
 use twoscale::interp::coordinate_f64;
 
-use super::{Encoded, NamedArray, Source, aux_array, interpolation, npy};
+use super::{Encoded, NamedArray, Source, aux_array, npy};
 
 /// `t1-smith-g1` → `ts_t1_smith_g1`.
 pub fn prefix(stem: &str) -> String {
@@ -112,7 +111,7 @@ fn coordinate_expression(mapping: Mapping, param: f64, param2: f64) -> String {
 /// T3's normalised angle in C (double, as the runtime's
 /// `twoscale::conv::normalised_angle`; `P` is the macro prefix of the
 /// header's parameters, `p` the function prefix).
-fn normalised_angle(p: &str, u: &str) -> String {
+pub fn normalised_angle(p: &str, u: &str) -> String {
     format!(
         r#"/* The normalised angle xi in [0, 1] of tau = tan(theta_h) for the (clamped) parameters
  * (u, beta, p): xi = F(min(tau, tau_max)) / F(tau_max), F as in docs/export.md (T3, step 3);
@@ -153,179 +152,202 @@ static inline double {p}_normalised_angle(double tau, double u, double beta, dou
     )
 }
 
-/// The lookups of T1, T2 and T5 in C over the header's first exported
-/// precision (`value` is the C expression of stored value `k`), as the
-/// runtime does them (docs/export.md); T3's full lookup is left to the
-/// consumer (its normalised angle is in the header).
-fn lookups(id: TableId, p: &str, u: &str, value: &str) -> String {
-    let v = |k: &str| value.replace("(k)", &format!("({k})"));
-    match id {
-        TableId::SmithG1 => format!(
-            r#"/* G1 bilinear in (p, a_scaled) inside the table (a_scaled <= {u}_A_SCALED_HI). */
+/// Stored value `k` as the C expression `value` (which reads `(k)`) at index `k`.
+fn value_at(value: &str, k: &str) -> String {
+    value.replace("(k)", &format!("({k})"))
+}
+
+/// T1's lookup in C: G1 bilinear in (p, a_scaled), and the asymptote beyond the last node. The C lookups read the header's first exported precision
+/// (`value`, the C expression of stored value `k`) as the runtime does
+/// (docs/export.md); `p` is the identifier prefix, `u` its upper case.
+pub fn smith_g1(p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value_at(value, k);
+    format!(
+        r#"/* G1 bilinear in (p, a_scaled) inside the table (a_scaled <= {u}_A_SCALED_HI). */
 static inline float {p}_bilinear(float p, float a_scaled) {{
-    float tp, ta;
-    int i = ts_cell({p}_p_position(p), {u}_P_NODES, &tp);
-    int j = ts_cell({p}_a_scaled_position(a_scaled), {u}_A_SCALED_NODES, &ta);
-    int n = {u}_A_SCALED_NODES;
-    float v00 = {}, v01 = {};
-    float v10 = {}, v11 = {};
-    float g0 = v00 + ta * (v01 - v00), g1 = v10 + ta * (v11 - v10);
-    return g0 + tp * (g1 - g0);
+float tp, ta;
+int i = ts_cell({p}_p_position(p), {u}_P_NODES, &tp);
+int j = ts_cell({p}_a_scaled_position(a_scaled), {u}_A_SCALED_NODES, &ta);
+int n = {u}_A_SCALED_NODES;
+float v00 = {}, v01 = {};
+float v10 = {}, v11 = {};
+float g0 = v00 + ta * (v01 - v00), g1 = v10 + ta * (v11 - v10);
+return g0 + tp * (g1 - g0);
 }}
 /* Smith G1 of the EPD at shape p and a = beta * tan(theta) (HP17 38), given
  * k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) (once per material): the table for
  * a_scaled = k_p * a up to its last node, the asymptote Lambda(last) + (a_scaled - last)
  * beyond. a <= 0 or NaN gives 1. */
 static inline float {p}_g1(float p, float a, float k_p) {{
-    if (!(a > 0.0f)) return 1.0f;
-    float a_scaled = k_p * a;
-    if (a_scaled <= {u}_A_SCALED_HI) return {p}_bilinear(p, a_scaled);
-    float g_last = {p}_bilinear(p, {u}_A_SCALED_HI);
-    float lambda_last = g_last > 0.0f ? fmaxf(1.0f / g_last - 1.0f, 0.0f) : 3.4028235e38f;
-    return 1.0f / (1.0f + lambda_last + (a_scaled - {u}_A_SCALED_HI));
+if (!(a > 0.0f)) return 1.0f;
+float a_scaled = k_p * a;
+if (a_scaled <= {u}_A_SCALED_HI) return {p}_bilinear(p, a_scaled);
+float g_last = {p}_bilinear(p, {u}_A_SCALED_HI);
+float lambda_last = g_last > 0.0f ? fmaxf(1.0f / g_last - 1.0f, 0.0f) : 3.4028235e38f;
+return 1.0f / (1.0f + lambda_last + (a_scaled - {u}_A_SCALED_HI));
 }}
 
 "#,
-            v("i * n + j"),
-            v("i * n + j + 1"),
-            v("(i + 1) * n + j"),
-            v("(i + 1) * n + j + 1")
-        ),
-        TableId::DiffuseFresnel => format!(
-            r#"/* F_dr,int(eta): the cubic B-spline at eta clamped to [1, 3], clamped to [0, 1]. */
+        v("i * n + j"),
+        v("i * n + j + 1"),
+        v("(i + 1) * n + j"),
+        v("(i + 1) * n + j + 1")
+    )
+}
+
+/// T5's lookup in C: the cubic B-spline at η. The C lookups read the header's first exported precision
+/// (`value`, the C expression of stored value `k`) as the runtime does
+/// (docs/export.md); `p` is the identifier prefix, `u` its upper case.
+pub fn diffuse_fresnel(p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value_at(value, k);
+    format!(
+        r#"/* F_dr,int(eta): the cubic B-spline at eta clamped to [1, 3], clamped to [0, 1]. */
 static inline float {p}_f_dr(float eta) {{
-    float t, w[4];
-    int i = ts_cell({p}_eta_position(eta), {u}_ETA_NODES, &t);
-    ts_bspline_weights(t, w);
-    float f = w[0] * {} + w[1] * {} + w[2] * {} + w[3] * {};
-    return fminf(fmaxf(f, 0.0f), 1.0f);
+float t, w[4];
+int i = ts_cell({p}_eta_position(eta), {u}_ETA_NODES, &t);
+ts_bspline_weights(t, w);
+float f = w[0] * {} + w[1] * {} + w[2] * {} + w[3] * {};
+return fminf(fmaxf(f, 0.0f), 1.0f);
 }}
 
 "#,
-            v("i"),
-            v("i + 1"),
-            v("i + 2"),
-            v("i + 3")
-        ),
-        TableId::SigmaRatio => format!(
-            r#"/* sigma_rel / sigma_s inside the table's domain (B in [0.05, 3000], c in (1, 100]):
+        v("i"),
+        v("i + 1"),
+        v("i + 2"),
+        v("i + 3")
+    )
+}
+
+/// T2's lookup in C: the tricubic B-spline times the closed form r0. The C lookups read the header's first exported precision
+/// (`value`, the C expression of stored value `k`) as the runtime does
+/// (docs/export.md); `p` is the identifier prefix, `u` its upper case.
+pub fn sigma_ratio(p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value_at(value, k);
+    format!(
+        r#"/* sigma_rel / sigma_s inside the table's domain (B in [0.05, 3000], c in (1, 100]):
  * q = tricubic B-spline at (cos theta_i, B, c), times r0 = sqrt(1 - (1 + B^2)^(-(c-1)/2)).
  * Outside it the runtime applies the rules of runtime/src/kcorr.rs. */
 static inline float {p}_sigma_ratio(float cos_theta_i, float big_b, float c) {{
-    float t0, t1, t2, w0[4], w1[4], w2[4];
-    int i0 = ts_cell({p}_cos_theta_i_position(cos_theta_i), {u}_COS_THETA_I_NODES, &t0);
-    int i1 = ts_cell({p}_B_position(big_b), {u}_B_NODES, &t1);
-    int i2 = ts_cell({p}_c_position(c), {u}_C_NODES, &t2);
-    int n1 = {u}_B_NODES + 2, n2 = {u}_C_NODES + 2;
-    ts_bspline_weights(t0, w0);
-    ts_bspline_weights(t1, w1);
-    ts_bspline_weights(t2, w2);
-    float q = 0.0f;
-    for (int a = 0; a < 4; a++)
-        for (int b = 0; b < 4; b++)
-            for (int d = 0; d < 4; d++) {{
-                int k = ((i0 + a) * n1 + i1 + b) * n2 + i2 + d;
-                q += w0[a] * w1[b] * w2[d] * {};
-            }}
-    double bb = big_b, cc = c;
-    double r0 = sqrt(fmax(-expm1(-(cc - 1.0) / 2.0 * log1p(bb * bb)), 0.0));
-    return (float)(q * r0);
+float t0, t1, t2, w0[4], w1[4], w2[4];
+int i0 = ts_cell({p}_cos_theta_i_position(cos_theta_i), {u}_COS_THETA_I_NODES, &t0);
+int i1 = ts_cell({p}_B_position(big_b), {u}_B_NODES, &t1);
+int i2 = ts_cell({p}_c_position(c), {u}_C_NODES, &t2);
+int n1 = {u}_B_NODES + 2, n2 = {u}_C_NODES + 2;
+ts_bspline_weights(t0, w0);
+ts_bspline_weights(t1, w1);
+ts_bspline_weights(t2, w2);
+float q = 0.0f;
+for (int a = 0; a < 4; a++)
+    for (int b = 0; b < 4; b++)
+        for (int d = 0; d < 4; d++) {{
+            int k = ((i0 + a) * n1 + i1 + b) * n2 + i2 + d;
+            q += w0[a] * w1[b] * w2[d] * {};
+        }}
+double bb = big_b, cc = c;
+double r0 = sqrt(fmax(-expm1(-(cc - 1.0) / 2.0 * log1p(bb * bb)), 0.0));
+return (float)(q * r0);
 }}
 
 "#,
-            v("k")
-        ),
-        TableId::Convolution => format!(
-            r#"/* T3's parameter-axis weights at node position x (docs/export.md, T3 step 2): writes the
+        v("k")
+    )
+}
+
+/// T3's lookup in C: the parameter-axis weights and C from T3b (as `ConvTable::at_tan`). The C lookups read the header's first exported precision
+/// (`value`, the C expression of stored value `k`) as the runtime does
+/// (docs/export.md); `p` is the identifier prefix, `u` its upper case.
+pub fn convolution(p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value_at(value, k);
+    format!(
+        r#"/* T3's parameter-axis weights at node position x (docs/export.md, T3 step 2): writes the
  * weights to w, the first node to *start and returns the node count (4, or 3 in an end cell). */
 static inline int {p}_axis_weights(float x, int nodes, float w[4], int *start) {{
-    float t;
-    int i = ts_cell(x, nodes, &t);
-    if (i >= 1 && i + 2 < nodes) {{
-        ts_catmull_rom_weights(t, w);
-        *start = i - 1;
-        return 4;
-    }}
-    if (i == 0) {{
-        w[0] = 0.5f * (t - 1.0f) * (t - 2.0f); w[1] = -t * (t - 2.0f); w[2] = 0.5f * t * (t - 1.0f);
-        *start = 0;
-    }} else {{
-        w[0] = 0.5f * t * (t - 1.0f); w[1] = (1.0f - t) * (1.0f + t); w[2] = 0.5f * t * (t + 1.0f);
-        *start = i - 1;
-    }}
-    w[3] = 0.0f;
-    return 3;
+float t;
+int i = ts_cell(x, nodes, &t);
+if (i >= 1 && i + 2 < nodes) {{
+    ts_catmull_rom_weights(t, w);
+    *start = i - 1;
+    return 4;
+}}
+if (i == 0) {{
+    w[0] = 0.5f * (t - 1.0f) * (t - 2.0f); w[1] = -t * (t - 2.0f); w[2] = 0.5f * t * (t - 1.0f);
+    *start = 0;
+}} else {{
+    w[0] = 0.5f * t * (t - 1.0f); w[1] = (1.0f - t) * (1.0f + t); w[2] = 0.5f * t * (t + 1.0f);
+    *start = i - 1;
+}}
+w[3] = 0.0f;
+return 3;
 }}
 /* C(theta_h; u, c, beta, p) from T3b at tau = tan(theta_h) (docs/export.md, T3 steps 1-5), as the
  * runtime's ConvTable::at_tan: 0 for non-finite input. */
 static inline float {p}_conv(double tau, float u, float c, float beta, float p) {{
-    if (!(isfinite(u) && isfinite(c) && isfinite(beta) && isfinite(p)) || isnan(tau)) return 0.0f;
-    c = fminf(fmaxf(c, {u}_C_LO), {u}_C_HI);
-    beta = fminf(fmaxf(beta, {u}_BETA_LO), {u}_BETA_HI);
-    p = fminf(fmaxf(p, {u}_P_LO), {u}_P_HI);
-    u = fmaxf(u, {u}_U_LO);
-    float factor = 1.0f;
-    if (u > {u}_U_HI) {{
-        /* I(u) / I(u_max), I(u) = (1 - (1 + 4u^2)^((1-c)/2)) / ((c - 1) u^2) */
-        double cm1 = (double)c - 1.0, uf = u, um = {u}_U_HI;
-        double iu = -expm1(-0.5 * cm1 * log1p(4.0 * uf * uf)) / (cm1 * uf * uf);
-        double im = -expm1(-0.5 * cm1 * log1p(4.0 * um * um)) / (cm1 * um * um);
-        double ratio = iu / im;
-        factor = isfinite(ratio) ? (float)ratio : 0.0f;
-        u = {u}_U_HI;
-    }}
-    float w[4][4];
-    int start[4], count[4];
-    count[0] = {p}_axis_weights({p}_u_position(u), {u}_U_NODES, w[0], &start[0]);
-    count[1] = {p}_axis_weights({p}_c_position(c), {u}_C_NODES, w[1], &start[1]);
-    count[2] = {p}_axis_weights({p}_beta_position(beta), {u}_BETA_NODES, w[2], &start[2]);
-    count[3] = {p}_axis_weights({p}_p_position(p), {u}_P_NODES, w[3], &start[3]);
-    int n = (int){u}_ANGLES;
-    double xi = {p}_normalised_angle(tau, u, beta, p);
-    float position = (float)(fmin(fmax(xi, 0.0), 1.0) * (double)(n - 1));
-    int k = (int)floorf(position);
-    if (k > n - 2) k = n - 2;
-    float t = position - (float)k;
-    int first = k - 1 < 0 ? 0 : (k - 1 > n - 4 ? n - 4 : k - 1);
-    float win[4] = {{0.0f, 0.0f, 0.0f, 0.0f}};
-    for (int a = 0; a < count[0]; a++)
-        for (int b = 0; b < count[1]; b++)
-            for (int e = 0; e < count[2]; e++)
-                for (int f = 0; f < count[3]; f++) {{
-                    int node = (((start[0] + a) * {u}_C_NODES + start[1] + b) * {u}_BETA_NODES
-                                + start[2] + e) * {u}_P_NODES + start[3] + f;
-                    float weight = w[0][a] * w[1][b] * w[2][e] * w[3][f];
-                    for (int j = 0; j < 4; j++) {{
-                        int idx = node * {u}_CHANNELS + 2 + first + j;
-                        win[j] += weight * {};
-                    }}
+if (!(isfinite(u) && isfinite(c) && isfinite(beta) && isfinite(p)) || isnan(tau)) return 0.0f;
+c = fminf(fmaxf(c, {u}_C_LO), {u}_C_HI);
+beta = fminf(fmaxf(beta, {u}_BETA_LO), {u}_BETA_HI);
+p = fminf(fmaxf(p, {u}_P_LO), {u}_P_HI);
+u = fmaxf(u, {u}_U_LO);
+float factor = 1.0f;
+if (u > {u}_U_HI) {{
+    /* I(u) / I(u_max), I(u) = (1 - (1 + 4u^2)^((1-c)/2)) / ((c - 1) u^2) */
+    double cm1 = (double)c - 1.0, uf = u, um = {u}_U_HI;
+    double iu = -expm1(-0.5 * cm1 * log1p(4.0 * uf * uf)) / (cm1 * uf * uf);
+    double im = -expm1(-0.5 * cm1 * log1p(4.0 * um * um)) / (cm1 * um * um);
+    double ratio = iu / im;
+    factor = isfinite(ratio) ? (float)ratio : 0.0f;
+    u = {u}_U_HI;
+}}
+float w[4][4];
+int start[4], count[4];
+count[0] = {p}_axis_weights({p}_u_position(u), {u}_U_NODES, w[0], &start[0]);
+count[1] = {p}_axis_weights({p}_c_position(c), {u}_C_NODES, w[1], &start[1]);
+count[2] = {p}_axis_weights({p}_beta_position(beta), {u}_BETA_NODES, w[2], &start[2]);
+count[3] = {p}_axis_weights({p}_p_position(p), {u}_P_NODES, w[3], &start[3]);
+int n = (int){u}_ANGLES;
+double xi = {p}_normalised_angle(tau, u, beta, p);
+float position = (float)(fmin(fmax(xi, 0.0), 1.0) * (double)(n - 1));
+int k = (int)floorf(position);
+if (k > n - 2) k = n - 2;
+float t = position - (float)k;
+int first = k - 1 < 0 ? 0 : (k - 1 > n - 4 ? n - 4 : k - 1);
+float win[4] = {{0.0f, 0.0f, 0.0f, 0.0f}};
+for (int a = 0; a < count[0]; a++)
+    for (int b = 0; b < count[1]; b++)
+        for (int e = 0; e < count[2]; e++)
+            for (int f = 0; f < count[3]; f++) {{
+                int node = (((start[0] + a) * {u}_C_NODES + start[1] + b) * {u}_BETA_NODES
+                            + start[2] + e) * {u}_P_NODES + start[3] + f;
+                float weight = w[0][a] * w[1][b] * w[2][e] * w[3][f];
+                for (int j = 0; j < 4; j++) {{
+                    int idx = node * {u}_CHANNELS + 2 + first + j;
+                    win[j] += weight * {};
                 }}
-    float v[4];
-    for (int j = 0; j < 4; j++) {{
-        int m = k - 1 + j;
-        m = m < 0 ? 0 : (m > n - 1 ? n - 1 : m);
-        v[j] = win[m - first > 3 ? 3 : m - first];
-    }}
-    float s_left = k == 0 ? v[2] - v[1] : v[1] - v[0];
-    float s_mid = v[2] - v[1];
-    float s_right = k + 2 >= n ? v[2] - v[1] : v[3] - v[2];
-    float d1 = 0.5f * (s_left + s_mid), d2 = 0.5f * (s_mid + s_right);
-    float t2 = t * t, t3 = t2 * t;
-    float ln_c = (2.0f * t3 - 3.0f * t2 + 1.0f) * v[1] + (t3 - 2.0f * t2 + t) * d1
-               + (-2.0f * t3 + 3.0f * t2) * v[2] + (t3 - t2) * d2;
-    float value = expf(ln_c) * factor;
-    return isfinite(value) ? value : 0.0f;
+            }}
+float v[4];
+for (int j = 0; j < 4; j++) {{
+    int m = k - 1 + j;
+    m = m < 0 ? 0 : (m > n - 1 ? n - 1 : m);
+    v[j] = win[m - first > 3 ? 3 : m - first];
+}}
+float s_left = k == 0 ? v[2] - v[1] : v[1] - v[0];
+float s_mid = v[2] - v[1];
+float s_right = k + 2 >= n ? v[2] - v[1] : v[3] - v[2];
+float d1 = 0.5f * (s_left + s_mid), d2 = 0.5f * (s_mid + s_right);
+float t2 = t * t, t3 = t2 * t;
+float ln_c = (2.0f * t3 - 3.0f * t2 + 1.0f) * v[1] + (t3 - 2.0f * t2 + t) * d1
+           + (-2.0f * t3 + 3.0f * t2) * v[2] + (t3 - t2) * d2;
+float value = expf(ln_c) * factor;
+return isfinite(value) ? value : 0.0f;
 }}
 
 "#,
-            v("idx")
-        ),
-        _ => String::new(),
-    }
+        v("idx")
+    )
 }
 
 /// The header of one table with the encoded precisions.
 pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
+    let export = &source.export;
     let header = source.table.header();
     let id = header.table_id;
     let stem = id.name();
@@ -340,7 +362,7 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
          \x20* Every array, axis and lookup is described in docs/export.md. */\n\
          #ifndef {upper}_H\n#define {upper}_H\n#include <math.h>\n#include <stdint.h>\n\n{COMMON}\n",
         id.description(),
-        interpolation(id)
+        export.interpolation
     );
     let _ = writeln!(out, "#define {upper}_CHANNELS {}", header.channels);
     for (name, value) in id.param_names().iter().zip(header.params) {
@@ -370,7 +392,9 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             axis.mapping.describe(axis.param, axis.param2),
             header.kernel.stored_per_axis(axis.nodes),
             match header.kernel {
-                twoscale::format::Kernel::Multilinear => "node values",
+                twoscale::format::Kernel::Multilinear | twoscale::format::Kernel::CatmullRom => {
+                    "node values"
+                }
                 twoscale::format::Kernel::CubicBSpline => "B-spline coefficients, nodes + 2",
             },
             axis.nodes,
@@ -382,16 +406,11 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             cells
         );
     }
-    if id == TableId::Convolution {
-        out.push_str(&normalised_angle(&p, &upper));
+    if let Some(constants) = export.c_constants {
+        out.push_str(&constants(&p, &upper));
     }
     if let Some(aux) = aux_array(source) {
-        array(
-            &mut out,
-            &format!("{p}_aux"),
-            &aux,
-            "k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) at each p node",
-        );
+        array(&mut out, &format!("{p}_aux"), &aux, id.descriptor().aux);
     }
     for e in encoded {
         if let Some((offset, step)) = e.unorm {
@@ -430,7 +449,7 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             _ => None,
         };
         if let Some(value) = value {
-            out.push_str(&lookups(id, &p, &upper, &value));
+            out.push_str(&(export.c_lookups)(&p, &upper, &value));
         }
     }
     let _ = writeln!(out, "#endif /* {upper}_H */");

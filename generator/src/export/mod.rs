@@ -18,6 +18,7 @@
 //! is refused with both figures.
 
 pub mod c;
+pub mod cli;
 pub mod npy;
 
 use std::fmt::Write as _;
@@ -26,7 +27,7 @@ use twoscale::format::write::{TableSpec, encode};
 use twoscale::format::{Kernel, Table, TableId, ValueType, quantise_node};
 use twoscale::interp::{coordinate_f64, node_value};
 
-use crate::tables::{self, Accuracy, TableKind};
+use crate::tables::{self, Accuracy, Budget, Export, TableKind};
 
 /// A precision of the exported values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,25 +83,27 @@ impl Format {
     }
 }
 
-/// The tables `export` knows (T4 is not exported).
-pub const EXPORTABLE: [TableId; 4] = [
-    TableId::SmithG1,
-    TableId::SigmaRatio,
-    TableId::DiffuseFresnel,
-    TableId::Convolution,
-];
+/// The tables `export` knows: those of the runtime's
+/// [`TableSet`](twoscale::TableSet), each with an [`Export`] in the registry
+/// (T4 is not exported; a unit test of [`tables`] checks both).
+pub const EXPORTABLE: [TableId; 4] = twoscale::table_set::TABLES;
 
-/// The table named `name` (a file stem or a unique prefix, as for `build`),
-/// if `export` supports it.
+/// The table named `name` (a file stem or a unique prefix, as for `build`:
+/// [`tables::select`]), if `export` supports it.
 pub fn table_by_name(name: &str) -> Result<&'static dyn TableKind, String> {
     let known = EXPORTABLE.map(TableId::name).join(", ");
-    if name.starts_with("t4") {
+    if name.starts_with(&format!("t{}", TableId::ShBrdf.number())) {
         return Err(format!(
             "'{name}': T4 (SH matrices) is not exported; exportable tables: {known}"
         ));
     }
-    tables::by_name(name)
+    let exportable: Vec<_> = tables::all()
+        .into_iter()
         .filter(|k| EXPORTABLE.contains(&k.id()))
+        .collect();
+    tables::select(name, &exportable)
+        .ok()
+        .and_then(|kinds| kinds.into_iter().next())
         .ok_or_else(|| format!("unknown table '{name}' (exportable: {known})"))
 }
 
@@ -113,11 +116,16 @@ pub struct Source<'a> {
     pub values: Vec<f32>,
     /// The array shape: stored values per axis, then channels if more than one.
     pub shape: Vec<usize>,
+    /// What the table's registry entry says of its export.
+    pub export: Export,
 }
 
 impl<'a> Source<'a> {
     /// Reads a table file of an exportable table.
     pub fn new(bytes: &'a [u8], id: TableId) -> Result<Source<'a>, String> {
+        let export = tables::by_id(id)
+            .and_then(|k| k.export())
+            .ok_or_else(|| format!("{} is not exported", id.name()))?;
         let table = Table::from_bytes_expecting(bytes, id).map_err(|e| e.to_string())?;
         let header = table.header();
         let mut shape: Vec<usize> = header
@@ -139,6 +147,7 @@ impl<'a> Source<'a> {
             table,
             values,
             shape,
+            export,
         })
     }
 
@@ -149,25 +158,16 @@ impl<'a> Source<'a> {
 }
 
 /// Half the table's accuracy target, in the units of its stored values: the
-/// largest rounding error an exported precision may add.
-///
-/// * T1: `|ΔG1| ≤ 1e-5` (target 2e-5); bilinear weights sum to 1.
-/// * T2: relative target 1e-4 on `r = q · r0`; the B-spline weights are
-///   non-negative and sum to 1, so `|Δq| ≤ max |Δcoefficient|`, and the
-///   budget is `0.5e-4 · min q` (min over the coefficients).
-/// * T5: `|ΔF_dr| ≤ 5e-7` (target 1e-6).
-/// * T3: no more than the file's own quantisation, half the largest per-node
-///   step in `ln C` (3.4e-4 in the shipped table): an export must not be
-///   coarser than what the runtime reads.
+/// largest rounding error an exported precision may add (the table's
+/// [`Budget`], documented on each table's `export()`).
 pub fn rounding_budget(source: &Source<'_>) -> f64 {
-    match source.id() {
-        TableId::SmithG1 => tables::t1::TARGET_MAX_ABS_ERROR / 2.0,
-        TableId::SigmaRatio => {
+    match source.export.budget {
+        Budget::Absolute(budget) => budget,
+        Budget::RelativeToMin(fraction) => {
             let min = source.values.iter().copied().fold(f32::INFINITY, f32::min);
-            tables::t2::TARGET_MAX_REL_ERROR / 2.0 * f64::from(min)
+            fraction * f64::from(min)
         }
-        TableId::DiffuseFresnel => tables::t5::TARGET_MAX_ABS_ERROR / 2.0,
-        TableId::Convolution | TableId::ShBrdf => {
+        Budget::HalfQuantisationStep => {
             source.table.quantised().map_or(0.0, |q| {
                 q.scales
                     .chunks_exact(2)
@@ -403,10 +403,10 @@ pub fn json(entries: &[(&Source<'_>, Vec<Encoded>)]) -> String {
         let _ = writeln!(
             out,
             "      \"interpolation\": {},",
-            json_string(interpolation(id))
+            json_string(source.export.interpolation)
         );
         let kernel = match header.kernel {
-            Kernel::Multilinear => "node values",
+            Kernel::Multilinear | Kernel::CatmullRom => "node values",
             Kernel::CubicBSpline => "cubic B-spline coefficients (nodes + 2 per axis)",
         };
         let _ = writeln!(out, "      \"stored\": {},", json_string(kernel));
@@ -451,8 +451,9 @@ pub fn json(entries: &[(&Source<'_>, Vec<Encoded>)]) -> String {
         if let Some(aux) = aux_array(source) {
             let _ = writeln!(
                 out,
-                "      \"aux\": {{\"file\": \"{stem}.aux.npy\", \"count\": {}, \"meaning\": \"k_p = Gamma(3/(2p)) / (pi Gamma(1/p)) at each p node\"}},",
-                aux.array.data.len()
+                "      \"aux\": {{\"file\": \"{stem}.aux.npy\", \"count\": {}, \"meaning\": {}}},",
+                aux.array.data.len(),
+                json_string(id.descriptor().aux)
             );
         }
         out.push_str("      \"precisions\": {\n");
@@ -497,26 +498,6 @@ pub fn json(entries: &[(&Source<'_>, Vec<Encoded>)]) -> String {
     }
     out.push_str("  }\n}\n");
     out
-}
-
-/// One-line summary of the interpolation a consumer must do (docs/export.md
-/// has the full recipe).
-pub fn interpolation(id: TableId) -> &'static str {
-    match id {
-        TableId::SmithG1 => {
-            "bilinear in (p, a_scaled) node positions; a_scaled = k_p * beta * tan(theta), k_p = Gamma(3/(2p))/(pi Gamma(1/p)); beyond the last a_scaled node Lambda = Lambda(last) + (a_scaled - last)"
-        }
-        TableId::SigmaRatio => {
-            "tricubic uniform B-spline on the coefficients (coefficient j of an axis sits at node j - 1); gives q = r/r0, multiply by r0 = sqrt(1 - (1 + B^2)^(-(c-1)/2))"
-        }
-        TableId::DiffuseFresnel => {
-            "cubic uniform B-spline on the coefficients (coefficient j sits at node j - 1)"
-        }
-        TableId::Convolution => {
-            "per parameter axis Catmull-Rom on nodes i-1..i+2 (quadratic in the first and last cell); channels 2..33: ln C at xi = k/31, Catmull-Rom along xi with one-sided end slopes; C = exp(ln C); channels 0, 1: ln s, ln(g^2 + g_offset)"
-        }
-        TableId::ShBrdf => "not exported",
-    }
 }
 
 /// A JSON string literal.

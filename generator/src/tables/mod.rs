@@ -13,10 +13,17 @@ pub mod t3;
 pub mod t4;
 pub mod t5;
 
-/// A table the generator knows how to build and verify.
+/// A table the generator knows how to build and verify: the generator's
+/// side of the table's [`TableDescriptor`](twoscale::format::TableDescriptor)
+/// (its id says which; [`all`] is the registry).
 pub trait TableKind: Sync {
     /// Which table.
     fn id(&self) -> TableId;
+
+    /// What `generator export` writes of it (`None`: not exported).
+    fn export(&self) -> Option<Export> {
+        None
+    }
 
     /// File name without `.tbl` (tables with one file per material override it).
     fn file_stem(&self) -> String {
@@ -58,7 +65,39 @@ pub struct SpotCheck {
     pub mismatched: Vec<usize>,
 }
 
-/// Every table, in build order.
+/// What `generator export` needs of a table beyond its file and its
+/// [`TableDescriptor`](twoscale::format::TableDescriptor).
+#[derive(Clone, Copy, Debug)]
+pub struct Export {
+    /// One-line summary of the interpolation a consumer must do
+    /// (docs/export.md has the full recipe).
+    pub interpolation: &'static str,
+    /// The largest rounding error an exported precision may add.
+    pub budget: Budget,
+    /// The C lookups (`crate::export::c`): identifier prefix, its upper
+    /// case, the C expression of stored value `(k)`.
+    pub c_lookups: fn(&str, &str, &str) -> String,
+    /// C definitions the lookups need beyond the axes (T3's normalised
+    /// angle), from the identifier prefix and its upper case.
+    pub c_constants: Option<fn(&str, &str) -> String>,
+}
+
+/// A table's rounding budget: half its accuracy target in the units of its
+/// stored values ([`crate::export::rounding_budget`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// At most this absolute error on a stored value.
+    Absolute(f64),
+    /// At most this fraction of the smallest stored value (a relative
+    /// target on a value interpolated with non-negative weights summing to 1).
+    RelativeToMin(f64),
+    /// No more than the file's own quantisation: half its largest per-node
+    /// step.
+    HalfQuantisationStep,
+}
+
+/// Every table the generator builds from no input but its own code, in
+/// build order (T4 is built per material: [`t4::ShBrdf`]).
 pub fn all() -> Vec<&'static dyn TableKind> {
     vec![
         &t1::SmithG1,
@@ -68,22 +107,52 @@ pub fn all() -> Vec<&'static dyn TableKind> {
     ]
 }
 
-/// The table with this name ([`TableId::name`]) or a unique prefix of it.
+/// The table of [`all`] with this id.
+pub fn by_id(id: TableId) -> Option<&'static dyn TableKind> {
+    all().into_iter().find(|k| k.id() == id)
+}
+
+/// The tables `name` selects among `candidates`: the one whose file stem
+/// it is, else those whose stems start with it if they are all of one table
+/// id (so `t4` selects every material's T4). The one name resolver of
+/// `build`, `verify`, `export` and [`by_name`].
+pub fn select<'a>(
+    name: &str,
+    candidates: &[&'a dyn TableKind],
+) -> Result<Vec<&'a dyn TableKind>, String> {
+    let exact: Vec<_> = candidates
+        .iter()
+        .filter(|t| t.file_stem() == name)
+        .copied()
+        .collect();
+    let matches: Vec<_> = if exact.is_empty() {
+        candidates
+            .iter()
+            .filter(|t| t.file_stem().starts_with(name))
+            .copied()
+            .collect()
+    } else {
+        exact
+    };
+    if matches.is_empty() || !matches.windows(2).all(|w| w[0].id() == w[1].id()) {
+        let known: Vec<_> = candidates.iter().map(|t| t.file_stem()).collect();
+        return Err(format!(
+            "unknown or ambiguous table '{name}' (known: {})",
+            known.join(", ")
+        ));
+    }
+    Ok(matches)
+}
+
+/// The table of [`all`] with this name ([`TableId::name`]) or a unique
+/// prefix of it ([`select`]).
 pub fn by_name(name: &str) -> Option<&'static dyn TableKind> {
-    let all = all();
-    if let Some(exact) = all.iter().find(|t| t.id().name() == name) {
-        return Some(*exact);
-    }
-    let mut matches = all.into_iter().filter(|t| t.id().name().starts_with(name));
-    match (matches.next(), matches.next()) {
-        (Some(one), None) => Some(one),
-        _ => None,
-    }
+    select(name, &all()).ok()?.into_iter().next()
 }
 
 /// File name of a table in a table directory.
 pub fn file_name(id: TableId) -> String {
-    format!("{}.tbl", id.name())
+    id.file_name()
 }
 
 /// Version string written into every header.
@@ -252,5 +321,44 @@ impl From<t3::ShardError> for BuildError {
 impl From<FormatError> for BuildError {
     fn from(e: FormatError) -> Self {
         BuildError::Format(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registry has one entry per descriptor (T4's are per material),
+    /// each of its own id, every table of the runtime's set among them, and
+    /// the exported ones are the set's.
+    #[test]
+    fn every_descriptor_has_its_registry_entry() {
+        for id in TableId::ALL {
+            let kind = by_id(id);
+            assert_eq!(kind.is_some(), id != TableId::ShBrdf, "{id:?}");
+            if let Some(kind) = kind {
+                assert_eq!(kind.id(), id);
+                assert_eq!(kind.file_stem(), id.descriptor().stem);
+                assert_eq!(kind.export().is_some(), id.descriptor().in_set, "{id:?}");
+                assert_eq!(by_name(id.name()).map(|k| k.id()), Some(id));
+            }
+        }
+        assert_eq!(all().len(), TableId::ALL.len() - 1);
+        for id in twoscale::table_set::TABLES {
+            assert!(by_id(id).is_some(), "{id:?}");
+        }
+    }
+
+    #[test]
+    fn names_resolve_by_stem_or_unique_prefix() {
+        assert_eq!(by_name("t3").map(|k| k.id()), Some(TableId::Convolution));
+        assert_eq!(
+            by_name("t2-sigma").map(|k| k.id()),
+            Some(TableId::SigmaRatio)
+        );
+        assert!(by_name("t").is_none());
+        let error = select("t9", &all()).err().unwrap_or_default();
+        assert!(error.contains("unknown or ambiguous table 't9'"), "{error}");
+        assert!(error.contains("t1-smith-g1"), "{error}");
     }
 }

@@ -11,11 +11,11 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping, SmithG1Params};
+use twoscale::format::{AxisHeader, Mapping, SmithG1Params};
 use twoscale::interp::node_value;
 use twoscale::{SmithG1Table, TableId};
 
-use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind};
+use super::{Accuracy, Budget, BuildError, Export, GENERATOR_VERSION, TableKind};
 use crate::reference::epd;
 use crate::rng::SplitMix64;
 
@@ -58,6 +58,16 @@ impl TableKind for SmithG1 {
         TableId::SmithG1
     }
 
+    /// `|ΔG1| ≤ 1e-5`, half the target 2e-5 (bilinear weights sum to 1).
+    fn export(&self) -> Option<Export> {
+        Some(Export {
+            interpolation: "bilinear in (p, a_scaled) node positions; a_scaled = k_p * beta * tan(theta), k_p = Gamma(3/(2p))/(pi Gamma(1/p)); beyond the last a_scaled node Lambda = Lambda(last) + (a_scaled - last)",
+            budget: Budget::Absolute(TARGET_MAX_ABS_ERROR / 2.0),
+            c_lookups: crate::export::c::smith_g1,
+            c_constants: None,
+        })
+    }
+
     fn work_items(&self) -> u64 {
         u64::from(P_AXIS.nodes) * u64::from(SCALED_AXIS.nodes)
     }
@@ -83,8 +93,8 @@ impl TableKind for SmithG1 {
         Ok(encode(&TableSpec {
             table_id: TableId::SmithG1,
             channels: 1,
-            kernel: Kernel::Multilinear,
-            value_type: twoscale::format::ValueType::F32,
+            kernel: TableId::SmithG1.descriptor().kernel,
+            value_type: TableId::SmithG1.descriptor().value_type,
             axes: &[P_AXIS, SCALED_AXIS],
             params: &SmithG1Params {
                 quadrature_rel_tol: epd::LAMBDA_TOL.rel,

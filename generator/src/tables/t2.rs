@@ -6,11 +6,11 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, Kernel, Mapping, SigmaRatioParams};
+use twoscale::format::{AxisHeader, Mapping, SigmaRatioParams};
 use twoscale::interp::node_value;
 use twoscale::{SigmaRatioTable, TableId};
 
-use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind};
+use super::{Accuracy, Budget, BuildError, Export, GENERATOR_VERSION, TableKind};
 use crate::bspline::prefilter;
 use crate::reference::kcorr;
 use crate::rng::SplitMix64;
@@ -71,6 +71,18 @@ impl TableKind for SigmaRatio {
         TableId::SigmaRatio
     }
 
+    /// Relative target 1e-4 on `r = q · r0`: the B-spline weights are
+    /// non-negative and sum to 1, so `|Δq| ≤ max |Δcoefficient|`, and the
+    /// budget is `0.5e-4 · min q`.
+    fn export(&self) -> Option<Export> {
+        Some(Export {
+            interpolation: "tricubic uniform B-spline on the coefficients (coefficient j of an axis sits at node j - 1); gives q = r/r0, multiply by r0 = sqrt(1 - (1 + B^2)^(-(c-1)/2))",
+            budget: Budget::RelativeToMin(TARGET_MAX_REL_ERROR / 2.0),
+            c_lookups: crate::export::c::sigma_ratio,
+            c_constants: None,
+        })
+    }
+
     fn work_items(&self) -> u64 {
         u64::from(COS_AXIS.nodes) * u64::from(B_AXIS.nodes) * u64::from(C_AXIS.nodes)
     }
@@ -100,8 +112,8 @@ impl TableKind for SigmaRatio {
         Ok(encode(&TableSpec {
             table_id: TableId::SigmaRatio,
             channels: 1,
-            kernel: Kernel::CubicBSpline,
-            value_type: twoscale::format::ValueType::F32,
+            kernel: TableId::SigmaRatio.descriptor().kernel,
+            value_type: TableId::SigmaRatio.descriptor().value_type,
             axes: &[COS_AXIS, B_AXIS, C_AXIS],
             params: &SigmaRatioParams {
                 quadrature_rel_tol: kcorr::SIGMA_RATIO_TOL.rel,

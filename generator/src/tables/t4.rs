@@ -19,7 +19,8 @@
 //!
 //! **Where the input tables come from** ([`input_dir`]): the directory the
 //! T4 files are written to (`build --out`) or read from (`verify DIR`) when it
-//! holds all four input files, else the workspace's `tables/`. `build` writes
+//! holds all four input files, else the tables compiled into the binary
+//! (feature `embedded`: the committed ones). `build` writes
 //! T1, T2, T5, T3 before T4 (the order of [`super::all`], then the materials),
 //! so a full build into an empty directory projects the tables just built.
 //!
@@ -37,7 +38,7 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AlignedBuf, AxisHeader, Kernel, Mapping, ShBrdfParams, aligned_copy};
+use twoscale::format::{AlignedBuf, AxisHeader, Mapping, ShBrdfParams, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
 use twoscale::{Complex, ShBrdfTable, TableBytes, TableId, TableSet, TwoScale};
 
@@ -46,18 +47,14 @@ use crate::analytic::{BeckmannCt, StandIn};
 use crate::materials::{Base, Material, Materials};
 use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
-use crate::sh::{IsotropicBrdf, default_quadrature, project};
+use crate::sh::{IsotropicBrdf, Runtime, default_quadrature, project};
 
-/// The workspace's table directory, where T4 falls back to for its inputs.
+/// The workspace's table directory (the studies and tests read it; the
+/// generator's defaults never do).
 pub const WORKSPACE_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
 
-/// The tables the two-scale model reads, in the order `build` writes them.
-pub const INPUTS: [TableId; 4] = [
-    TableId::SmithG1,
-    TableId::SigmaRatio,
-    TableId::DiffuseFresnel,
-    TableId::Convolution,
-];
+/// The tables the two-scale model reads: the runtime's set.
+pub const INPUTS: [TableId; 4] = twoscale::table_set::TABLES;
 
 /// Verification target: `max |f_SH − f| / max f` over the random pairs, with
 /// `f = ρ cos θi cos θo` (what the matrix represents; dividing by the cosines
@@ -91,23 +88,22 @@ impl Projected {
     }
 }
 
-/// `preferred` if it holds all of [`INPUTS`], else [`WORKSPACE_TABLES`].
-pub fn input_dir(preferred: &Path) -> PathBuf {
-    if INPUTS
+/// `preferred` if it holds all of [`INPUTS`], else `None`: the tables
+/// compiled into the binary ([`ModelInputs::embedded`]).
+pub fn input_dir(preferred: &Path) -> Option<PathBuf> {
+    INPUTS
         .iter()
         .all(|&id| preferred.join(file_name(id)).is_file())
-    {
-        preferred.to_path_buf()
-    } else {
-        PathBuf::from(WORKSPACE_TABLES)
-    }
+        .then(|| preferred.to_path_buf())
 }
 
-/// T1, T2, T5 and T3 read from a directory (owned, 64-byte aligned).
+/// T1, T2, T5 and T3 read from a directory or the binary (owned, 64-byte
+/// aligned).
 pub struct ModelInputs {
-    /// Where they were read from.
+    /// Where they were read from (a directory, or "the embedded tables").
     pub dir: PathBuf,
-    buffers: [AlignedBuf; 4],
+    /// The files of [`INPUTS`], in its order.
+    buffers: Vec<AlignedBuf>,
 }
 
 impl ModelInputs {
@@ -124,41 +120,65 @@ impl ModelInputs {
         };
         Ok(ModelInputs {
             dir: dir.to_path_buf(),
-            buffers: [
-                read(INPUTS[0])?,
-                read(INPUTS[1])?,
-                read(INPUTS[2])?,
-                read(INPUTS[3])?,
-            ],
+            buffers: INPUTS
+                .iter()
+                .map(|&id| read(id))
+                .collect::<Result<_, _>>()?,
         })
+    }
+
+    /// Copies of the tables compiled into the binary (feature `embedded`).
+    pub fn embedded() -> Result<ModelInputs, BuildError> {
+        let read = |id: TableId| {
+            crate::table_source::embedded(id)
+                .map(aligned_copy)
+                .ok_or_else(|| BuildError::Input {
+                    path: file_name(id),
+                    message: "not in the output directory, and this generator has no \
+                              embedded tables (T4 projects the two-scale model, which reads it)"
+                        .into(),
+                })
+        };
+        Ok(ModelInputs {
+            dir: PathBuf::from("the embedded tables"),
+            buffers: INPUTS
+                .iter()
+                .map(|&id| read(id))
+                .collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// The inputs of [`Projected::TwoScale`] for directory `preferred`:
+    /// read from [`input_dir`]`(preferred)`, else the embedded tables.
+    pub fn for_dir(preferred: &Path) -> Result<ModelInputs, BuildError> {
+        match input_dir(preferred) {
+            Some(dir) => ModelInputs::load(&dir),
+            None => ModelInputs::embedded(),
+        }
     }
 
     /// Validates the four files as the runtime's table set.
     pub fn parse(&self) -> Result<TableSet<'_>, BuildError> {
-        let [t1, t2, t5, t3] = &self.buffers;
-        TableSet::from_bytes(TableBytes {
-            smith: t1.bytes(),
-            sigma_ratio: t2.bytes(),
-            convolution: t3.bytes(),
-            diffuse_fresnel: t5.bytes(),
-        })
-        .map_err(|e| BuildError::Input {
+        let bytes = TableBytes::try_from_fn(|id| {
+            let k = INPUTS.iter().position(|&input| input == id);
+            k.and_then(|k| self.buffers.get(k))
+                .map(AlignedBuf::bytes)
+                .ok_or(())
+        });
+        let bytes = bytes.map_err(|()| BuildError::Input {
+            path: self.dir.display().to_string(),
+            message: "a table of the set is missing".to_string(),
+        })?;
+        TableSet::from_bytes(bytes).map_err(|e| BuildError::Input {
             path: self.dir.display().to_string(),
             message: e.to_string(),
         })
     }
 }
 
-/// The runtime two-scale model as an [`IsotropicBrdf`]: `ρ(wi, wo)` =
-/// `TwoScale::eval` at the directions rounded to f32, widened to f64.
-#[derive(Clone)]
-pub struct TwoScaleBrdf<'a>(pub TwoScale<'a>);
-
-impl IsotropicBrdf for TwoScaleBrdf<'_> {
-    fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
-        f64::from(self.0.eval(wi.map(|v| v as f32), wo.map(|v| v as f32)))
-    }
-}
+/// The runtime two-scale model as an [`IsotropicBrdf`] (through its
+/// [`twoscale::Bxdf`] interface).
+pub type TwoScaleBrdf<'a> = Runtime<TwoScale<'a>>;
 
 /// The runtime layer of `material` at `channel`: the surface, the base with
 /// that channel's albedo, the Lambertian term.
@@ -191,7 +211,7 @@ pub fn two_scale_brdf<'a>(
     tables: &Tables<'a>,
 ) -> TwoScaleBrdf<'a> {
     let eta = Complex::new(material.n[channel] as f32, material.k[channel] as f32);
-    TwoScaleBrdf(TwoScale::new(
+    Runtime(TwoScale::new(
         tables,
         runtime_layer(material, channel),
         wavelength as f32,
@@ -268,7 +288,7 @@ fn with_source<T>(
 ) -> Result<T, BuildError> {
     match projected {
         Projected::TwoScale { dir } => {
-            let inputs = ModelInputs::load(&input_dir(dir))?;
+            let inputs = ModelInputs::for_dir(dir)?;
             let parsed = inputs.parse()?;
             f(Some(&parsed.brdf_tables()))
         }
@@ -375,8 +395,8 @@ impl TableKind for ShBrdf {
         Ok(encode(&TableSpec {
             table_id: TableId::ShBrdf,
             channels: channels as u32,
-            kernel: Kernel::Multilinear,
-            value_type: twoscale::format::ValueType::F32,
+            kernel: TableId::ShBrdf.descriptor().kernel,
+            value_type: TableId::ShBrdf.descriptor().value_type,
             axes: &[axis],
             params: &params.to_values(),
             grid: &grid,

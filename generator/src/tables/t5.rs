@@ -15,11 +15,11 @@
 use indicatif::{ParallelProgressIterator, ProgressBar};
 use rayon::prelude::*;
 use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, DiffuseFresnelParams, Kernel, Mapping};
+use twoscale::format::{AxisHeader, DiffuseFresnelParams, Mapping};
 use twoscale::interp::node_value;
 use twoscale::{DiffuseFresnelTable, TableId};
 
-use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind};
+use super::{Accuracy, Budget, BuildError, Export, GENERATOR_VERSION, TableKind};
 use crate::bspline::prefilter;
 use crate::reference::fresnel;
 use crate::rng::SplitMix64;
@@ -54,6 +54,16 @@ impl TableKind for DiffuseFresnel {
         TableId::DiffuseFresnel
     }
 
+    /// `|ΔF_dr| ≤ 5e-7`, half the target 1e-6.
+    fn export(&self) -> Option<Export> {
+        Some(Export {
+            interpolation: "cubic uniform B-spline on the coefficients (coefficient j sits at node j - 1)",
+            budget: Budget::Absolute(TARGET_MAX_ABS_ERROR / 2.0),
+            c_lookups: crate::export::c::diffuse_fresnel,
+            c_constants: None,
+        })
+    }
+
     fn work_items(&self) -> u64 {
         u64::from(ETA_AXIS.nodes)
     }
@@ -72,8 +82,8 @@ impl TableKind for DiffuseFresnel {
         Ok(encode(&TableSpec {
             table_id: TableId::DiffuseFresnel,
             channels: 1,
-            kernel: Kernel::CubicBSpline,
-            value_type: twoscale::format::ValueType::F32,
+            kernel: TableId::DiffuseFresnel.descriptor().kernel,
+            value_type: TableId::DiffuseFresnel.descriptor().value_type,
             axes: &[ETA_AXIS],
             params: &DiffuseFresnelParams {
                 quadrature_rel_tol: fresnel::DIFFUSE_TOL.rel,
