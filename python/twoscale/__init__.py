@@ -23,14 +23,7 @@ from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
 from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
 __all__ = [
-    "BASES",
-    "Material",
-    "OPTIONS",
-    "RGB_WAVELENGTHS",
-    "fit",
-    "lookup",
-    "merl",
-    "reference",
+    "BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference",
 ]
 
 

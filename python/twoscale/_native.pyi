@@ -6,7 +6,6 @@ these stubs give the types. Arrays of directions are ``(..., 3)``: anything
 conversion.
 """
 
-from collections.abc import Sequence
 from typing import final
 
 import numpy as np
@@ -41,7 +40,7 @@ class Material:
         *,
         beta: float,
         p: float,
-        eta: Sequence[Sequence[float]],
+        eta: list[tuple[float, float]],
         sigma_s: float = 0.0,
         b: float = 1.0,
         c: float = 2.0,
@@ -135,12 +134,14 @@ def brdf(
     reference: bool,
     clamp: bool = False,
 ) -> NDArray[np.float64]: ...
+
+# The MERL file format (python/src/merl.rs, used by twoscale.merl).
+MERL_SCALE: list[float]
+MERL_FILE_BYTES: int
+
 def merl_decode(data: bytes, scaled: bool) -> NDArray[np.float64]: ...
 def merl_encode(values: NDArray[np.float64], scaled: bool) -> bytes: ...
 def merl_index(wi: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.int64]: ...
 def merl_bin_centres(
     bins: NDArray[np.int64] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-
-MERL_SCALE: list[float]
-MERL_FILE_BYTES: int
