@@ -82,10 +82,10 @@ def test_shapes_that_do_not_broadcast_are_named():
 
 def public_callables():
     """(qualified name, object) of every public function, method and getter
-    of the extension, lookup and reference (twoscale.merl and twoscale.fit
-    document themselves)."""
+    of the package, the extension, lookup and reference (twoscale.merl
+    documents its functions in its module docstring)."""
     out = []
-    for module in (twoscale._native, lookup, reference):
+    for module in (twoscale, twoscale._native, lookup, reference):
         for name in getattr(module, "__all__", dir(module)):
             obj = getattr(module, name)
             if not name.startswith("_") and (inspect.isroutine(obj) or inspect.isclass(obj)):
