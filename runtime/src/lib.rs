@@ -33,6 +33,7 @@ pub mod smith;
 pub mod table_set;
 #[cfg(test)]
 mod test_rng;
+mod visible;
 
 pub use brdf::{Rgb, TwoScale};
 pub use conv::{ConvFitTable, ConvTable, Convolution};
