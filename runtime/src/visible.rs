@@ -112,8 +112,14 @@ impl VisibleSlopeBake {
         // r_max: the radial variable r^{2p} is Gamma(1/p); leave TAIL_MASS out.
         let y_max = GammaShape::new(a_shape).inverse_two_tailed(1.0 - TAIL_MASS, TAIL_MASS);
         let r_max = math::powf(y_max, 0.5 / p);
-        // σ: a quarter of the radius of mean r^{2p} (dense nodes in the core).
-        let sigma = 0.25 * math::powf(a_shape, 0.5 / p);
+        // σ: for p < 1 a quarter of the radius of mean r^{2p} (nodes dense in
+        // the peaked core, geometric in the heavy tail); for p ≥ 1 twice
+        // r_max (nodes nearly even: the flat top and the steep edge).
+        let sigma = if p >= 1.0 {
+            2.0 * r_max
+        } else {
+            0.25 * math::powf(a_shape, 0.5 / p)
+        };
         let span = math::log2_axis((1.0 + r_max / sigma) as f32);
         let node = |k: usize, n: usize| {
             if k == 0 {
@@ -473,5 +479,43 @@ mod tests {
             worst.3
         );
         assert!(q(0.99) < 3e-5 && worst.0 < 1e-3, "{worst:?}");
+    }
+
+    /// The tables' cost in variance: the relative variance of `D(m) / pdf`
+    /// (the weight of exact visible-normal sampling is `∝ D / pdf_vis`, so
+    /// this is what the tables add to it), 10⁵ samples per case, p from 0.3
+    /// to 4, β ∈ {0.05, 0.5}, θi up to 85°: at most 3.6e-5 (p = 0.3).
+    #[test]
+    fn tables_add_little_variance() {
+        let mut rng = Lcg(3);
+        let mut worst = (0.0f64, 0.0f32, 0.0f32, 0.0f64);
+        for p in [0.3f32, 0.6, 1.0, 2.0, 4.0] {
+            for beta in [0.05f32, 0.5] {
+                let bake = VisibleSlopeBake::new(beta, p);
+                for theta in [0.0f64, 45.0, 85.0] {
+                    let wi = unit(theta, 0.3);
+                    let (mut s1, mut s2, n) = (0.0, 0.0, 100_000);
+                    for _ in 0..n {
+                        let u = [rng.next(), rng.next()];
+                        let Some(m) = bake.sample(wi, u) else {
+                            continue;
+                        };
+                        let tan2 = (m[0] * m[0] + m[1] * m[1]) / (m[2] * m[2]);
+                        let beta2 = f64::from(beta) * f64::from(beta);
+                        let d = (-(tan2 / beta2).powf(f64::from(p))).exp() / m[2].powi(4);
+                        let w = d / bake.pdf(wi, reflect(wi, m));
+                        s1 += w;
+                        s2 += w * w;
+                    }
+                    let (m1, m2) = (s1 / f64::from(n), s2 / f64::from(n));
+                    let overhead = m2 / (m1 * m1) - 1.0;
+                    if overhead > worst.0 {
+                        worst = (overhead, p, beta, theta);
+                    }
+                }
+            }
+        }
+        std::eprintln!("tables' relative variance: worst {worst:?}");
+        assert!(worst.0 < 1e-4, "{worst:?}");
     }
 }
