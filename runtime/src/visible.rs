@@ -273,17 +273,8 @@ impl VisibleSlopeBake {
             return None;
         }
         let target = u[0] * norm;
-        // The last node j ≤ j_end with Φ_j ≤ target.
-        let (mut lo, mut hi) = (0usize, j_end);
-        while lo < hi {
-            let mid = (lo + hi).div_ceil(2);
-            if self.phi_node(c, s, mid) <= target {
-                lo = mid;
-            } else {
-                hi = mid - 1;
-            }
-        }
-        let j = lo;
+        // The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0).
+        let j = last_at_most(j_end + 1, |j| self.phi_node(c, s, j) <= target);
         let (x0, h, p0, k) = self.x_cell(j);
         let tau_max = if j == j_end { tau_end } else { h };
         let rest = target - self.phi_node(c, s, j);
@@ -296,16 +287,7 @@ impl VisibleSlopeBake {
         let (di, dn) = (&self.dens[i], &self.dens[i + 1]);
         let signed = 2.0 * u[1] - 1.0;
         let q = signed.abs() * blend(ci[COLS - 1], cn[COLS - 1]);
-        let (mut lo, mut hi) = (0usize, COLS - 2);
-        while lo < hi {
-            let mid = (lo + hi).div_ceil(2);
-            if blend(ci[mid], cn[mid]) <= q {
-                lo = mid;
-            } else {
-                hi = mid - 1;
-            }
-        }
-        let kk = lo;
+        let kk = last_at_most(COLS - 1, |k| blend(ci[k], cn[k]) <= q);
         let w = self.cols[kk + 1] - self.cols[kk];
         let g0 = blend(f64::from(di[kk]), f64::from(dn[kk]));
         let g1 = blend(f64::from(di[kk + 1]), f64::from(dn[kk + 1]));
@@ -363,6 +345,23 @@ impl VisibleSlopeBake {
     }
 }
 
+/// The last index `k < n` with `below(k)` (`below` true at 0 and
+/// monotone), by halving without data-dependent branches.
+#[inline]
+fn last_at_most(n: usize, below: impl Fn(usize) -> bool) -> usize {
+    let (mut base, mut len) = (0usize, n);
+    while len > 1 {
+        let half = len / 2;
+        base = if below(base + half) {
+            base + half
+        } else {
+            base
+        };
+        len -= half;
+    }
+    base
+}
+
 /// `∫ f` of samples `f` at `x` (trapezoid: exact for piecewise linear `f`).
 fn trapezoid<const N: usize>(x: &[f64; N], f: &[f64; N]) -> f64 {
     let mut sum = 0.0;
@@ -379,9 +378,13 @@ fn solve_cell(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau_max: f64, rest: f64)
     let a = c - s * x0;
     let density = |t: f64| (a - s * t) * (p0 + k * t);
     let (mut lo, mut hi) = (0.0, tau_max);
+    // Start from the root without the cubic term: f0 t + b t²/2 = rest.
     let f0 = density(0.0);
-    let mut t = if f0 > 0.0 {
-        (rest / f0).min(tau_max)
+    let b = a * k - s * p0;
+    let disc = f0 * f0 + 2.0 * b * rest;
+    let denom = f0 + math::sqrt(disc.max(0.0));
+    let mut t = if denom > 0.0 {
+        (2.0 * rest / denom).max(0.0).min(tau_max)
     } else {
         0.5 * tau_max
     };
@@ -397,7 +400,7 @@ fn solve_cell(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau_max: f64, rest: f64)
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
-        if (next - t).abs() <= 1e-14 * (x0.abs() + tau_max) {
+        if (next - t).abs() <= 1e-13 * (x0.abs() + tau_max) {
             return next;
         }
         t = next;
