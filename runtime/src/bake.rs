@@ -32,9 +32,8 @@
 
 use crate::conv::{ConvSlice, catmull_rom_weights};
 use crate::fresnel::{Complex, QConstants, QFactors, fresnel};
-use crate::gamma::GammaShape;
 use crate::kcorr::SigmaRatioTable;
-use crate::math::{self, BELOW_ONE};
+use crate::math;
 use crate::smith::SmithShape;
 use zerocopy::FromZeros;
 
@@ -364,105 +363,6 @@ impl MaskingBake {
     }
 }
 
-/// Nodes of [`SlopeQuantileBake`].
-const QUANTILE_NODES: usize = 512;
-/// The logit range of [`SlopeQuantileBake`]: `ln(u/(1 − u))` of the smallest
-/// positive f32 (−103.3) and of [`BELOW_ONE`] (16.6).
-const LOGIT_RANGE: (f64, f64) = (-104.0, 16.7);
-
-/// The EPD sampler's polar quantile at the material's (β, p) (HP17 49-50):
-/// `tan θm = β y^{1/(2p)}` with `y = P⁻¹(1/p, u₀)` the Gamma(1/p) quantile,
-/// as a function of `v = ln(u₀/(1 − u₀))`. Writing `ln y = p v + G(v)`,
-///
-/// ```text
-/// tan θm = β exp(v/2 + G(v)/(2p)),   G'(v) = u₀(1 − u₀) Γ(1/p) / (y^{1/p} e^{−y}) − p
-/// ```
-///
-/// `G` is smooth and bounded (→ `p ln Γ(1 + 1/p)` as `u₀ → 0`, `ln y` grows
-/// like `ln v` as `u₀ → 1`), so cubic Hermite interpolation with the exact
-/// slopes on nodes even in `v` reproduces [`crate::epd::Epd::sample_tan_theta`]
-/// closely (measured by the test beside it) for one log and one exp per
-/// sample instead of a Newton solve of the incomplete gamma function.
-#[derive(Clone, Debug, FromZeros)]
-pub(crate) struct SlopeQuantileBake {
-    ln_beta: f64,
-    /// `1/(2p)`.
-    half_shape: f64,
-    /// `[G, h G']` per node (`h` the node spacing).
-    nodes: [[f64; 2]; QUANTILE_NODES],
-}
-
-impl SlopeQuantileBake {
-    /// Tabulates the quantile for `(β, p)` as [`crate::epd::Epd`] clamps
-    /// them, in place.
-    pub fn init(&mut self, beta: f32, p: f32) {
-        let p = f64::from(p);
-        let shape = GammaShape::new(1.0 / p);
-        let h = (LOGIT_RANGE.1 - LOGIT_RANGE.0) / (QUANTILE_NODES - 1) as f64;
-        for (k, node) in self.nodes.iter_mut().enumerate() {
-            let (g, slope) = exact_g_and_slope(p, &shape, LOGIT_RANGE.0 + k as f64 * h);
-            *node = [g, h * slope];
-        }
-        self.ln_beta = math::ln(f64::from(beta));
-        self.half_shape = 0.5 / p;
-    }
-
-    /// The bake of [`SlopeQuantileBake::init`] in new storage.
-    #[cfg(test)]
-    pub fn new(beta: f32, p: f32) -> Self {
-        let mut bake = Self::new_zeroed();
-        bake.init(beta, p);
-        bake
-    }
-
-    /// `tan θm` at `u₀` (clamped to [0, [`BELOW_ONE`]]; 0 gives the normal).
-    #[inline]
-    pub fn tan_theta(&self, u0: f32) -> f32 {
-        let u = f64::from(u0.max(0.0).min(BELOW_ONE));
-        if !(u > 0.0) {
-            return 0.0;
-        }
-        let v = math::ln(u / (1.0 - u));
-        let g = self.g_and_slope(v).0;
-        (math::exp(self.ln_beta + 0.5 * v + self.half_shape * g) as f32).min(f32::MAX)
-    }
-
-    /// The cubic Hermite interpolant of `G` at `v` (clamped to the range),
-    /// and its derivative `G'(v)`.
-    #[inline]
-    fn g_and_slope(&self, v: f64) -> (f64, f64) {
-        let last = (QUANTILE_NODES - 1) as f64;
-        let h = (LOGIT_RANGE.1 - LOGIT_RANGE.0) / last;
-        let x = ((v - LOGIT_RANGE.0) / h).max(0.0).min(last);
-        let i = (x as usize).min(QUANTILE_NODES - 2);
-        let t = x - i as f64;
-        let ([g0, m0], [g1, m1]) = (self.nodes[i], self.nodes[i + 1]);
-        let (t2, t3) = (t * t, t * t * t);
-        let g = (2.0 * t3 - 3.0 * t2 + 1.0) * g0
-            + (t3 - 2.0 * t2 + t) * m0
-            + (3.0 * t2 - 2.0 * t3) * g1
-            + (t3 - t2) * m1;
-        let slope = ((6.0 * t2 - 6.0 * t) * (g0 - g1)
-            + (3.0 * t2 - 4.0 * t + 1.0) * m0
-            + (3.0 * t2 - 2.0 * t) * m1)
-            / h;
-        (g, slope)
-    }
-}
-
-/// `G(v)` and `G'(v)` of [`SlopeQuantileBake`] by solving for the quantile
-/// (`shape` is Gamma(1/p)).
-fn exact_g_and_slope(p: f64, shape: &GammaShape, v: f64) -> (f64, f64) {
-    let (a, ln_gamma_a) = (1.0 / p, shape.ln_gamma());
-    // u = 1/(1 + e^−v), 1 − u = 1/(1 + e^v), each without cancellation.
-    let y = shape.inverse_two_tailed(1.0 / (1.0 + math::exp(-v)), 1.0 / (1.0 + math::exp(v)));
-    let ln_y = math::ln(y);
-    // ln(u(1 − u)) = −|v| − 2 ln(1 + e^−|v|).
-    let ln_u_1mu = -v.abs() - 2.0 * math::ln_1p(math::exp(-v.abs()));
-    let slope = math::exp(ln_u_1mu - (a * ln_y - y - ln_gamma_a)) - p;
-    (ln_y - p * v, slope)
-}
-
 /// `ln C` for one material and wavelength over `(u, sin θh)` (module
 /// documentation).
 #[derive(Clone, Debug, FromZeros)]
@@ -694,75 +594,6 @@ mod tests {
             worst.3
         );
         assert!(worst.0 < 5e-6, "{worst:?}");
-    }
-
-    /// The tabulated EPD quantile against the sampler's Newton solve
-    /// (`Epd::sample_tan_theta`) over p ∈ [0.2, 5] and u₀ from 1e-30 to
-    /// [`BELOW_ONE`].
-    #[test]
-    fn slope_quantile_matches_the_solved_quantile() {
-        let set = TableSet::embedded();
-        let mut rng = Lcg(11);
-        let mut worst = (0.0f64, 0.0f32, 0.0f32);
-        for p in [0.2f32, 0.25, 0.35, 0.5, 0.75, 1.0, 1.3, 2.0, 3.0, 4.0, 5.0] {
-            let ndf = crate::epd::Epd::new(0.3, p, &set.smith);
-            let bake = SlopeQuantileBake::new(ndf.beta(), ndf.p());
-            let mut check = |u0: f32| {
-                let (exact, baked) = (ndf.sample_tan_theta(u0), bake.tan_theta(u0));
-                let e = if exact > 0.0 {
-                    (f64::from(baked) / f64::from(exact) - 1.0).abs()
-                } else {
-                    f64::from(baked)
-                };
-                if e > worst.0 {
-                    worst = (e, p, u0);
-                }
-            };
-            for _ in 0..4000 {
-                check(rng.next() as f32);
-            }
-            for k in 1..=60 {
-                check(10f32.powi(-k / 2));
-                check(1.0 - 2f32.powi(-k.min(24)));
-            }
-            check(0.0);
-            check(BELOW_ONE);
-        }
-        std::eprintln!(
-            "tabulated quantile: worst {:.2e} at p {}, u0 {:e}",
-            worst.0,
-            worst.1,
-            worst.2
-        );
-        assert!(worst.0 < 1e-6, "{worst:?}");
-    }
-
-    /// The sampler's density is `D cos θm` times `(1/2 + G'/(2p))` exact over
-    /// tabulated (`d ln tan θm / dv`): its relative error is `|ΔG'| / (p + G')`.
-    /// Checked against the exact `G'` (the formula the nodes use) between nodes.
-    #[test]
-    fn slope_quantile_density_matches_d_cos() {
-        let mut rng = Lcg(5);
-        let mut worst = (0.0f64, 0.0f64, 0.0f64);
-        for p in [0.2f64, 0.35, 0.5, 1.0, 2.0, 5.0] {
-            let bake = SlopeQuantileBake::new(0.3, p as f32);
-            let shape = GammaShape::new(1.0 / p);
-            for _ in 0..20_000 {
-                let v = LOGIT_RANGE.0 + rng.next() * (LOGIT_RANGE.1 - LOGIT_RANGE.0);
-                let exact = exact_g_and_slope(p, &shape, v).1;
-                let e = (bake.g_and_slope(v).1 - exact).abs() / (p + exact);
-                if e > worst.0 {
-                    worst = (e, p, v);
-                }
-            }
-        }
-        std::eprintln!(
-            "tabulated quantile's density: worst {:.2e} at p {}, v {:.2}",
-            worst.0,
-            worst.1,
-            worst.2
-        );
-        assert!(worst.0 < 1e-4, "{worst:?}");
     }
 
     /// F, Q̄'s factors and σrel from the direction bake against the direct

@@ -1,6 +1,7 @@
 //! The two-scale BRDF of Holzschuch & Pacanowski 2017 (docs/model.md §2.5–§2.7):
-//! evaluation, importance sampling and the pdf of the sampler (its density
-//! to 3e-5: the specular lobe's quantile is tabulated, docs/model.md §2.1), at one
+//! evaluation, importance sampling and the pdf of the sampler (the density it
+//! draws: the specular lobe's visible normals come from a tabulated density
+//! that `pdf` evaluates, docs/model.md §2.1), at one
 //! wavelength ([`TwoScale`]) and at the three default RGB wavelengths
 //! ([`Rgb`]).
 //!
@@ -48,14 +49,14 @@
 
 use crate::bake::{
     ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, RadialNormBake,
-    SlopeQuantileBake,
 };
 use crate::conv::{ConvSlice, Convolution};
-use crate::epd::{Epd, normal_at};
+use crate::epd::Epd;
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
+use crate::visible::VisibleSlopeBake;
 use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
@@ -308,10 +309,11 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 }
 
 /// What a [`TwoScale`] bakes for its material and wavelength (F, Q̄'s
-/// factors and σrel over `cos θ`, G1 over the slope, the sampler's EPD
-/// quantile, and C over `(u, θh)` when the source of C is T3b; module
-/// `bake`): 45 KB of plain numbers (C 18 KB, the direction bake 12 KB, the
-/// quantile 8 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
+/// factors and σrel over `cos θ`, G1 over the slope, the sampler's
+/// visible-slope density, and C over `(u, θh)` when the source of C is T3b;
+/// modules `bake` and `visible`): 77 KB of plain numbers (the visible-slope
+/// tables 40 KB, C 18 KB, the direction bake 12 KB, G1 4 KB, the
+/// diffraction sampler's `1/M` 2 KB).
 ///
 /// All zeros is a valid (empty) value, so storage can be allocated zeroed on
 /// the heap (`ChannelBake::boxed`, feature `std`) or provided by the caller
@@ -322,8 +324,8 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 pub struct ChannelBake {
     /// G1 at the material's (β, p).
     masking: MaskingBake,
-    /// The specular sampler's `tan θm` quantile at the material's (β, p).
-    slope_quantile: SlopeQuantileBake,
+    /// The specular sampler's visible-slope tables at the material's (β, p).
+    visible: VisibleSlopeBake,
     /// F, Q̄'s factors and σrel/σs over `cos θ`.
     direction: DirectionBake,
     /// `1/M(sin θi)` of the diffraction sampler.
@@ -395,7 +397,7 @@ pub struct TwoScale<'a, B = ChannelBake> {
 
 /// What [`TwoScale::new`] derives from the surface alone, independent of the
 /// wavelength: made once for the three channels of [`Rgb`] (G1 and the
-/// quantile are baked once, into the first channel, and copied).
+/// visible-slope tables are baked once, into the first channel, and copied).
 struct SurfaceBakes<'a> {
     ndf: Epd<'a>,
     /// Sanitised surface (β, p as the EPD clamps them; σs = 0 when c ≤ 1).
@@ -433,11 +435,11 @@ impl<'a> SurfaceBakes<'a> {
         }
     }
 
-    /// Bakes G1 and the sampler's quantile into `bake`.
+    /// Bakes G1 and the sampler's visible-slope tables into `bake`.
     fn bake_into(&self, tables: &Tables<'a>, bake: &mut ChannelBake) {
         let (beta, p) = (self.ndf.beta(), self.ndf.p());
         bake.masking.init(beta, &tables.smith.shape(p));
-        bake.slope_quantile.init(beta, p);
+        bake.visible.init(beta, p);
     }
 }
 
@@ -585,7 +587,7 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// Bakes, in place, what depends on the wavelength: the direction bake
-    /// and its lobe weights, `1/M` and C (G1 and the quantile are
+    /// and its lobe weights, `1/M` and C (G1 and the visible-slope tables are
     /// [`SurfaceBakes::bake_into`]'s).
     fn bake_wavelength(&mut self, tables: &Tables<'a>, shared: &SurfaceBakes<'a>, eta: Complex) {
         let (surface, big_b, q) = (self.surface, self.big_b, self.q);
@@ -940,12 +942,24 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// [`TwoScale::pdf`] at a pair's geometry (the specular density from its D).
     fn pdf_at(&self, geometry: &Geometry) -> f64 {
+        self.pdf_with_specular(geometry, self.specular_pdf(geometry))
+    }
+
+    /// The specular lobe's density at a pair (wavelength independent).
+    #[inline]
+    fn specular_pdf(&self, geometry: &Geometry) -> f64 {
+        self.bake().visible.pdf(geometry.wi, geometry.wo)
+    }
+
+    /// [`TwoScale::pdf_at`] given the specular lobe's density `specular`
+    /// (which [`Rgb`] computes once for its channels).
+    fn pdf_with_specular(&self, geometry: &Geometry, specular: f64) -> f64 {
         let w = self.weights(geometry.wi[2]);
         let mut total = 0.0;
-        for (k, lobe) in [Lobe::Specular, Lobe::Diffraction, Lobe::Base]
-            .into_iter()
-            .enumerate()
-        {
+        if w[0] > 0.0 {
+            total += w[0] * specular;
+        }
+        for (k, lobe) in [(1, Lobe::Diffraction), (2, Lobe::Base)] {
             if w[k] > 0.0 {
                 total += w[k] * self.lobe_pdf(lobe, geometry);
             }
@@ -955,7 +969,9 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// The solid-angle density of [`TwoScale::sample_lobe`] for one lobe:
     ///
-    /// * specular: `D(h) cos θh / (4 i·h)` (reflection about an EPD normal, HP17 49-50);
+    /// * specular: the density of reflecting `i` about a visible EPD normal
+    ///   (the tabulated `D_vis`, `crate::visible`: `P2_tab g_tab / (8 N_tab β²
+    ///   |i'| cos⁴θh)`, docs/model.md §2.1), 0 where `i·h ≤ 0`;
     /// * diffraction (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
@@ -972,18 +988,9 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// [`TwoScale::pdf_lobe`] at a pair's geometry.
     fn lobe_pdf(&self, lobe: Lobe, geometry: &Geometry) -> f64 {
-        let Geometry {
-            wi,
-            wo,
-            cos_d,
-            cos_h,
-            d,
-            ..
-        } = *geometry;
+        let Geometry { wi, wo, .. } = *geometry;
         match lobe {
-            // D(h) cos θh / (4 i·h)
-            Lobe::Specular if cos_d > 0.0 => cos_h / (4.0 * cos_d) * d,
-            Lobe::Specular => 0.0,
+            Lobe::Specular => self.specular_pdf(geometry),
             Lobe::Diffraction => self.diffraction_pdf(wi, wo),
             Lobe::Base => wo[2] / PI,
         }
@@ -1039,7 +1046,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// direction falls at or below the horizon. Its density is
     /// [`TwoScale::pdf_lobe`].
     ///
-    /// * specular: `m` from the EPD (HP17 49-50), `o = 2(i·m)m − i`;
+    /// * specular: `m` a visible normal of the EPD (the tabulated visible-slope
+    ///   sampler of docs/model.md §2.1, `u` its two uniforms), `o = 2(i·m)m − i`;
     /// * diffraction (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
     ///   `ψ = (2u₁ − 1) φmax(r)`, `d = r (cos(φi + ψ), sin(φi + ψ))`,
     ///   `o_p = d − i_p`. (HP17 54-55) write the same arc as `φf = φi + π ± φmax`
@@ -1052,9 +1060,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
-                // Epd::sample with the tabulated quantile.
-                let tan = self.bake().slope_quantile.tan_theta(u[0] as f32);
-                let m = normal_at(tan, u[1] as f32).map(f64::from);
+                let m = self.bake().visible.sample(wi, u)?;
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
@@ -1103,8 +1109,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// (and is rescaled), `u[1], u[2]` drive [`TwoScale::sample_lobe`].
     /// Returns the direction, [`TwoScale::pdf`] there (> 0) and ρ there;
     /// `None` when nothing can be sampled (see `sample_lobe`). The specular
-    /// lobe's polar angle comes from the material's tabulated EPD quantile,
-    /// whose density is `D cos θm` within 3e-5 (docs/model.md §2.1).
+    /// lobe draws visible normals from the material's tabulated visible-slope
+    /// density, which `pdf` evaluates (docs/model.md §2.1).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
         let (o, lobe) = self.sample_direction(i, u)?;
         // pdf(i, o) and eval(i, o) from one geometry.
@@ -1207,7 +1213,7 @@ impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
         material: &Material,
         options: Options,
     ) -> Self {
-        // G1, the quantile and C's slice do not depend on the wavelength.
+        // G1, the visible-slope tables and C's slice do not depend on the wavelength.
         let shared = SurfaceBakes::new(tables, material.layer.surface);
         let mut k = 0;
         let mut channels = bakes.map(|bake| {
@@ -1229,7 +1235,7 @@ impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
         for channel in rest {
             let bake = channel.bake.borrow_mut();
             bake.masking.clone_from(&first.masking);
-            bake.slope_quantile.clone_from(&first.slope_quantile);
+            bake.visible.clone_from(&first.visible);
         }
         for (channel, eta) in channels.iter_mut().zip(material.eta_rgb) {
             channel.bake_wavelength(tables, &shared, eta);
@@ -1263,10 +1269,12 @@ impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
 
     /// [`Rgb::pdf`] at a pair's geometry.
     fn pdf_at(&self, geometry: &Geometry) -> f64 {
+        // The channels share the surface, hence the specular density.
+        let specular = self.channels[0].specular_pdf(geometry);
         let sum: f64 = self
             .channels
             .iter()
-            .map(|ch| f64::from(finite_or_zero(ch.pdf_at(geometry))))
+            .map(|ch| f64::from(finite_or_zero(ch.pdf_with_specular(geometry, specular))))
             .sum();
         sum / 3.0
     }

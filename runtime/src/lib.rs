@@ -36,6 +36,7 @@ pub mod table_set;
 #[cfg(test)]
 mod test_rng;
 pub mod validate;
+mod visible;
 
 pub use brdf::{Rgb, TwoScale};
 pub use bxdf::{Bxdf, BxdfFlags, BxdfSample};
