@@ -29,7 +29,7 @@ use twoscale::brdf::{
     SigmaRelMode, Surface,
 };
 use twoscale::validate::{self, Invalid, Named};
-use twoscale::{Complex, Convolution, Rgb, TableSet, TwoScale};
+use twoscale::{Bxdf, Complex, Convolution, Rgb, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
 use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 
@@ -375,7 +375,7 @@ impl Material {
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
         let v = vectors([("wi", wi), ("wo", wo)])?;
         let ([wi, wo], model) = (&v.rows, &*self.model);
-        let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k])));
+        let values = py.detach(|| rows(v.len(), |k| Bxdf::eval(model, wi[k], wo[k])));
         Ok(shaped_vectors(py, &v.shape, values))
     }
 
@@ -390,7 +390,7 @@ impl Material {
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
         let v = vectors([("wi", wi), ("wo", wo)])?;
         let ([wi, wo], model) = (&v.rows, &*self.model);
-        let values = py.detach(|| rows(v.len(), |k| model.pdf(wi[k], wo[k])));
+        let values = py.detach(|| rows(v.len(), |k| Bxdf::pdf(model, wi[k], wo[k])));
         Ok(shaped(py, &v.shape, values))
     }
 
@@ -410,7 +410,7 @@ impl Material {
         let v = vectors([("wi", wi), ("u", u)])?;
         let ([wi, u], model) = (&v.rows, &*self.model);
         let samples = py.detach(|| {
-            rows(v.len(), |k| match model.sample(wi[k], u[k]) {
+            rows(v.len(), |k| match Bxdf::sample(model, wi[k], u[k]) {
                 Some(s) => (s.o, s.pdf, s.value.map(|x| x * s.o[2] / s.pdf)),
                 None => ([0.0; 3], 0.0, [0.0; 3]),
             })
@@ -827,7 +827,7 @@ fn brdf<'py>(
         validate::wavelength(lam).map_err(invalid)?;
     }
     let model = TwoScale::new(&TABLES.brdf_tables(), layer, lam, eta, options);
-    let values = py.detach(|| rows(v.len(), |j| f64::from(model.eval(wi[j], wo[j]))));
+    let values = py.detach(|| rows(v.len(), |j| f64::from(Bxdf::eval(&model, wi[j], wo[j]))));
     Ok(shaped(py, &v.shape, values))
 }
 
