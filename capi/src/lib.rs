@@ -20,7 +20,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
 use twoscale::brdf::{
-    BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
+    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
     RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
 };
 use twoscale::format::{FormatError, TableId, aligned_copy};
@@ -341,18 +341,22 @@ fn invalid(error: Invalid) -> Fail {
     )
 }
 
-/// `TS_ERR_INVALID` for an enumeration field holding none of its constants
-/// (`names`: each constant's name and value).
-fn unknown_constant(field: &str, value: i32, names: &[(&str, i32)]) -> Fail {
+/// The runtime value of the enumeration field `field` holding `value`:
+/// `choices` are each C constant's name, value and runtime value (matched by
+/// value, not by position); any other value is `TS_ERR_INVALID`, listing them.
+fn constant<T: Copy>(field: &str, value: i32, choices: &[(&str, i32, T)]) -> Result<T, Fail> {
+    if let Some(&(_, _, v)) = choices.iter().find(|(_, c, _)| *c == value) {
+        return Ok(v);
+    }
     let mut accepted = String::new();
-    for (k, (name, v)) in names.iter().enumerate() {
+    for (k, (name, v, _)) in choices.iter().enumerate() {
         let sep = if k == 0 { "" } else { ", " };
         accepted.push_str(&format!("{sep}{name} ({v})"));
     }
-    Fail::new(
+    Err(Fail::new(
         TS_ERR_INVALID,
         format!("ts_material_desc.{field} = {value} is not one of {accepted}"),
-    )
+    ))
 }
 
 impl ts_material_desc {
@@ -361,78 +365,72 @@ impl ts_material_desc {
     /// `TS_ERR_INVALID`, naming the field.
     fn to_model(self) -> Result<(Material, Options), Fail> {
         let albedo = self.base_albedo;
-        let base = match self.base {
-            TS_BASE_CONDUCTOR => BaseLayer::Conductor,
-            TS_BASE_PLASTIC => BaseLayer::Plastic { albedo },
-            TS_BASE_SUBSURFACE => BaseLayer::Subsurface { albedo },
-            other => {
-                return Err(unknown_constant(
-                    "base",
-                    other,
-                    &[
-                        ("TS_BASE_CONDUCTOR", TS_BASE_CONDUCTOR),
-                        ("TS_BASE_PLASTIC", TS_BASE_PLASTIC),
-                        ("TS_BASE_SUBSURFACE", TS_BASE_SUBSURFACE),
-                    ],
-                ));
-            }
-        };
-        let masking = match self.masking {
-            TS_MASKING_SEPARABLE => Masking::Separable,
-            TS_MASKING_HEIGHT_CORRELATED => Masking::HeightCorrelated,
-            other => {
-                return Err(unknown_constant(
-                    "masking",
-                    other,
-                    &[
-                        ("TS_MASKING_SEPARABLE", TS_MASKING_SEPARABLE),
-                        ("TS_MASKING_HEIGHT_CORRELATED", TS_MASKING_HEIGHT_CORRELATED),
-                    ],
-                ));
-            }
-        };
-        let sigma_rel = match self.sigma_rel {
-            TS_SIGMA_REL_INCIDENT => SigmaRelMode::Incident,
-            TS_SIGMA_REL_SYMMETRISED => SigmaRelMode::Symmetrised,
-            other => {
-                return Err(unknown_constant(
-                    "sigma_rel",
-                    other,
-                    &[
-                        ("TS_SIGMA_REL_INCIDENT", TS_SIGMA_REL_INCIDENT),
-                        ("TS_SIGMA_REL_SYMMETRISED", TS_SIGMA_REL_SYMMETRISED),
-                    ],
-                ));
-            }
-        };
-        let colour = match self.colour {
-            TS_COLOUR_PHYSICAL => ColourTerms::Physical,
-            TS_COLOUR_WHITE => ColourTerms::White,
-            other => {
-                return Err(unknown_constant(
-                    "colour",
-                    other,
-                    &[
-                        ("TS_COLOUR_PHYSICAL", TS_COLOUR_PHYSICAL),
-                        ("TS_COLOUR_WHITE", TS_COLOUR_WHITE),
-                    ],
-                ));
-            }
-        };
-        let halo_weight = match self.halo_weight {
-            TS_HALO_PRINTED => HaloWeight::Printed,
-            TS_HALO_INCIDENT => HaloWeight::Incident,
-            other => {
-                return Err(unknown_constant(
-                    "halo_weight",
-                    other,
-                    &[
-                        ("TS_HALO_PRINTED", TS_HALO_PRINTED),
-                        ("TS_HALO_INCIDENT", TS_HALO_INCIDENT),
-                    ],
-                ));
-            }
-        };
+        let base = constant(
+            "base",
+            self.base,
+            &[
+                ("TS_BASE_CONDUCTOR", TS_BASE_CONDUCTOR, BaseKind::Conductor),
+                ("TS_BASE_PLASTIC", TS_BASE_PLASTIC, BaseKind::Plastic),
+                (
+                    "TS_BASE_SUBSURFACE",
+                    TS_BASE_SUBSURFACE,
+                    BaseKind::Subsurface,
+                ),
+            ],
+        )?
+        .with_albedo(albedo);
+        let masking = constant(
+            "masking",
+            self.masking,
+            &[
+                (
+                    "TS_MASKING_SEPARABLE",
+                    TS_MASKING_SEPARABLE,
+                    Masking::Separable,
+                ),
+                (
+                    "TS_MASKING_HEIGHT_CORRELATED",
+                    TS_MASKING_HEIGHT_CORRELATED,
+                    Masking::HeightCorrelated,
+                ),
+            ],
+        )?;
+        let sigma_rel = constant(
+            "sigma_rel",
+            self.sigma_rel,
+            &[
+                (
+                    "TS_SIGMA_REL_INCIDENT",
+                    TS_SIGMA_REL_INCIDENT,
+                    SigmaRelMode::Incident,
+                ),
+                (
+                    "TS_SIGMA_REL_SYMMETRISED",
+                    TS_SIGMA_REL_SYMMETRISED,
+                    SigmaRelMode::Symmetrised,
+                ),
+            ],
+        )?;
+        let colour = constant(
+            "colour",
+            self.colour,
+            &[
+                (
+                    "TS_COLOUR_PHYSICAL",
+                    TS_COLOUR_PHYSICAL,
+                    ColourTerms::Physical,
+                ),
+                ("TS_COLOUR_WHITE", TS_COLOUR_WHITE, ColourTerms::White),
+            ],
+        )?;
+        let halo_weight = constant(
+            "halo_weight",
+            self.halo_weight,
+            &[
+                ("TS_HALO_PRINTED", TS_HALO_PRINTED, HaloWeight::Printed),
+                ("TS_HALO_INCIDENT", TS_HALO_INCIDENT, HaloWeight::Incident),
+            ],
+        )?;
         let options = Options {
             masking,
             sigma_rel,
