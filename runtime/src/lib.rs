@@ -30,6 +30,7 @@ pub mod math;
 pub mod merl;
 #[cfg(feature = "std")]
 pub mod mmap;
+pub mod optical;
 pub mod sh;
 pub mod smith;
 pub mod table_set;

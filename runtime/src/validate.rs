@@ -133,6 +133,31 @@ pub fn eta(names: (&'static str, &'static str), eta: Complex) -> Result<(), Inva
     check(names.1, widen(eta.im), Domain::AtLeast(0.0), "")
 }
 
+/// Checks optical-constant rows `(λ µm, n, k)` ([`crate::optical::Tabulated`]):
+/// at least one row; λ finite, > 0 and strictly increasing (each row's λ must
+/// be above the previous one's); each `n + ik` as [`eta`].
+pub fn optical_constants(rows: &[[f32; 3]]) -> Result<(), Invalid> {
+    check(
+        "rows",
+        rows.len() as f64,
+        Domain::AtLeast(1.0),
+        "(lambda, n, k) rows",
+    )?;
+    let mut previous = 0.0f64;
+    for row in rows {
+        let lambda = widen(row[0]);
+        check(
+            "lambda",
+            lambda,
+            Domain::Above(previous),
+            "µm, increasing rows",
+        )?;
+        eta(("n", "k"), Complex::new(row[1], row[2]))?;
+        previous = lambda;
+    }
+    Ok(())
+}
+
 impl Surface {
     /// Checks the surface against the model's domain: β in
     /// [`BETA_RANGE`], p in [`P_RANGE`] (T1's), `σs ≥ 0`, `b ≥ 0` and
