@@ -290,13 +290,20 @@ mod tests {
         assert!(Tabulated::new(&[[f32::INFINITY, 1.0, 1.0]]).is_err());
     }
 
-    /// Gold's hand-interpolated RGB indices of `crate::materials` agree with
-    /// the table (they were read from the same rows, rounded to 3–4 digits).
+    /// The gold presets' RGB indices agree with a hand interpolation of
+    /// Johnson & Christy's rows (0.645 µm: 1.88 eV 0.14 + 3.697i, 2.01 eV
+    /// 0.21 + 3.272i; 0.526 µm: 2.26 eV 0.43 + 2.455i, 2.38 eV 0.62 +
+    /// 2.081i; 0.444 µm: 2.75 eV 1.38 + 1.914i, 2.88 eV 1.45 + 1.948i),
+    /// rounded to 3–4 digits.
     #[test]
-    fn gold_rgb_constants_agree_with_the_table() {
-        let t = Tabulated::shipped(&AU_JOHNSON);
-        let at = Ior::Tabulated(t).at_rgb();
-        for (a, b) in at.iter().zip(crate::materials::GOLD_ETA) {
+    fn gold_rgb_indices_agree_with_a_hand_interpolation() {
+        let by_hand = [
+            Complex::new(0.163, 3.56),
+            Complex::new(0.584, 2.15),
+            Complex::new(1.403, 1.925),
+        ];
+        let gold = crate::materials::preset("gold-hp17-geometry").unwrap();
+        for (a, b) in gold.eta_rgb.iter().zip(by_hand) {
             assert!(
                 (a.re - b.re).abs() < 0.006 && (a.im - b.im).abs() < 0.006,
                 "{a:?} {b:?}"
