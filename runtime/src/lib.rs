@@ -17,6 +17,7 @@
 mod bake;
 pub mod brdf;
 pub mod bxdf;
+pub mod colour;
 pub mod conv;
 pub mod epd;
 pub mod format;
