@@ -12,6 +12,7 @@
 
 mod brdf_instructions;
 mod common;
+mod rgb_integration;
 mod t3_angle;
 mod t3_axes;
 mod t3_direct_cost;
@@ -250,6 +251,17 @@ enum Study {
         #[arg(long)]
         operation: Option<String>,
     },
+    /// RGB by integration over the spectrum against the paper's three
+    /// wavelengths, and few-wavelength candidates
+    /// (docs/design/rgb-integration.md).
+    RgbIntegration {
+        /// Direction pairs per preset (half uniform, half sampled).
+        #[arg(long, default_value_t = 4000)]
+        pairs: usize,
+        /// Seed of the pairs.
+        #[arg(long, default_value_t = 26)]
+        seed: u64,
+    },
     /// Wall time per call of the BRDF's operations and the GGX baselines,
     /// interleaved batches, minimum over rounds (docs/design/speed.md).
     BrdfTiming {
@@ -360,6 +372,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
+        Study::RgbIntegration { pairs, seed } => rgb_integration::run(pairs, seed),
         Study::BrdfTiming { rounds, batch } => brdf_instructions::timing(rounds, batch),
         Study::BrdfInstructions { calls, operation } => match operation {
             Some(op) => brdf_instructions::run_calls(&op, calls),
