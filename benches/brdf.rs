@@ -15,9 +15,9 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use suite::brdf::NarrowNdfConvolution;
-use suite::cost::{BATCH, Inputs, LAMBDA, NICKEL_LIKE, ggx, nickel, rgb_preset};
-use twoscale::brdf::{Options, Rgb, TwoScale};
-use twoscale::materials::{HP17_NICKEL_SURFACE, PRESETS};
+use suite::cost::{BATCH, Inputs, LAMBDA, NICKEL_LIKE, RGB_PRESET, ggx, nickel, rgb_preset};
+use twoscale::brdf::{IntegratedRgb, Options, Rgb, TwoScale};
+use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 use twoscale::{Convolution, TableSet};
 
 fn brdf(c: &mut Criterion) {
@@ -109,6 +109,20 @@ fn brdf(c: &mut Criterion) {
             sum
         })
     });
+    // The same preset in linear sRGB by integration over the spectrum
+    // (docs/design/rgb-integration.md): 8 wavelengths and the colour weights.
+    let tables = set.brdf_tables();
+    let spectral = materials::spectral(RGB_PRESET).expect("preset");
+    let integrated = IntegratedRgb::boxed(&tables, &spectral, Options::default());
+    group.bench_function("two_scale_eval_rgb_integrated_t3b", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += integrated.eval(black_box(i), black_box(o))[1];
+            }
+            sum
+        })
+    });
     group.bench_function("ggx_vndf_sample_and_eval", |b| {
         b.iter(|| {
             let mut sum = 0.0f32;
@@ -141,6 +155,11 @@ fn brdf(c: &mut Criterion) {
                 black_box(&PRESETS[0].1),
                 Options::default(),
             )
+        })
+    });
+    setup.bench_function("rgb_integrated_preset", |b| {
+        b.iter(|| {
+            IntegratedRgb::boxed(&set.brdf_tables(), black_box(&spectral), Options::default())
         })
     });
     setup.finish();

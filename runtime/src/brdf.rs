@@ -61,6 +61,9 @@ use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
 
+mod integrated;
+pub use integrated::{INTEGRATED_COUNT, INTEGRATED_WAVELENGTHS, IntegratedRgb};
+
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];
 
