@@ -108,7 +108,7 @@ def _material(props):
                 "twoscale BSDF: filename= gives the whole material, options included; "
                 f"remove {', '.join(others)}"
             )
-        path = mi.Thread.thread().file_resolver().resolve(props["filename"])
+        path = mi.file_resolver().resolve(props["filename"])
         return twoscale.Material.from_toml(str(path))
     if "material" in props:
         return twoscale.Material.preset(props["material"], **options)
