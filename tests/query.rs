@@ -141,7 +141,10 @@ fn out_of_domain_rows_are_refused_or_clamped_and_marked() {
     let summary = query::run(
         "g1",
         &TableSource::Dir(suite::tables_dir()),
-        &query::Options { clamp: true },
+        &query::Options {
+            clamp: true,
+            ..query::Options::default()
+        },
         input.as_bytes(),
         &mut out,
         &mut err,
@@ -153,4 +156,104 @@ fn out_of_domain_rows_are_refused_or_clamped_and_marked() {
     assert_eq!(lines[0], "p,a,table,reference,in_domain");
     assert!(lines[1].starts_with("0.15,0.5,") && lines[1].ends_with(",false"));
     assert!(lines[2].starts_with("1,0.5,") && lines[2].ends_with(",true"));
+}
+
+/// `query brdf --material FILE`: `table` is the channel of the RGB model the
+/// C API and Python build from the same file, bit for bit, and `reference`
+/// the f64 reference of that channel; other quantities and materials the
+/// reference does not cover are refused before any row.
+#[test]
+fn brdf_of_a_material_file_is_the_rgb_model() {
+    use twoscale::desc::MaterialDesc;
+    let text = "[material]\nbeta = 0.2\np = 1.3\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n\
+                sigma_s = 0.03\nb = 2.0\nc = 2.5\nsigma_rel = \"symmetrised\"\n";
+    let desc = MaterialDesc::from_toml_str(text).unwrap();
+    let options = query::Options {
+        material: Some(desc),
+        ..query::Options::default()
+    };
+    let source = TableSource::Dir(suite::tables_dir());
+    let run = |quantity: &str, options: &query::Options, input: &str| {
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let result = query::run(
+            quantity,
+            &source,
+            options,
+            input.as_bytes(),
+            &mut out,
+            &mut err,
+        );
+        (
+            result,
+            String::from_utf8(out).unwrap(),
+            String::from_utf8(err).unwrap(),
+        )
+    };
+    let pairs = [
+        ([0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
+        ([0.1, 0.2, 0.97], [-0.3, -0.1, 0.95]),
+        ([0.8, 0.0, 0.6], [-0.7, 0.3, 0.648]),
+    ];
+    let mut input = String::from("channel,ix,iy,iz,ox,oy,oz\n");
+    for (i, o) in pairs {
+        for ch in 0..3 {
+            let v: Vec<String> = i
+                .iter()
+                .chain(&o)
+                .map(|x| f64::from(*x).to_string())
+                .collect();
+            input.push_str(&format!("{ch},{}\n", v.join(",")));
+        }
+    }
+    input.push_str("3,0,0,1,0,0,1\n");
+    let (result, out, err) = run("brdf", &options, &input);
+    assert_eq!(
+        result.unwrap(),
+        query::Summary {
+            answered: 9,
+            bad: 1
+        }
+    );
+    assert!(err.contains("channel = 3: must be 0, 1 or 2"), "{err}");
+    let set = twoscale::TableSet::open(suite::tables_dir()).unwrap();
+    let model = set.set().rgb(&desc.material, desc.options);
+    let params = generator::reference::brdf::Params::rgb(&desc.material).unwrap();
+    let rows: Vec<&str> = out.lines().skip(1).collect();
+    for (k, row) in rows.iter().enumerate() {
+        let (i, o) = pairs[k / 3];
+        let ch = k % 3;
+        let fields: Vec<&str> = row.split(',').collect();
+        let table: f32 = fields[7].parse().unwrap();
+        assert_eq!(table.to_bits(), model.eval(i, o)[ch].to_bits(), "{row}");
+        let reference: f64 = fields[8].parse().unwrap();
+        let want = generator::reference::brdf::two_scale(
+            &params[ch],
+            i.map(f64::from),
+            o.map(f64::from),
+            &desc.options,
+        )
+        .unwrap()
+        .total();
+        assert_eq!(reference, want, "{row}");
+    }
+    let (result, ..) = run("g1", &options, "p,a\n1,1\n");
+    assert!(matches!(
+        result,
+        Err(query::QueryError::MaterialUnsupported(_))
+    ));
+    let plastic = MaterialDesc::from_toml_str(
+        "[material]\nbeta = 0.2\np = 1\neta = [[1.5, 0], [1.5, 0], [1.5, 0]]\n\
+         base = \"plastic\"\nalbedo = 0.5\n",
+    )
+    .unwrap();
+    let options = query::Options {
+        material: Some(plastic),
+        ..query::Options::default()
+    };
+    let (result, ..) = run("brdf", &options, "channel,ix,iy,iz,ox,oy,oz\n");
+    let message = result.unwrap_err().to_string();
+    assert_eq!(
+        message,
+        "--material: the f64 reference covers conductors without a Lambertian term"
+    );
 }

@@ -30,10 +30,9 @@ p = 1.0
 sigma_s = 0.0
 b = 1.0
 c = 2.0
-n = [1.5, 1.5]
-k = [0.0, 0.0]
+eta = [[1.5, 0.0], [1.5, 0.0]]
 base = "plastic"
-albedo = [0.5, 0.2]
+albedo = 0.5
 band_limit = 10
 "#;
 
@@ -271,8 +270,8 @@ fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
     let tables = parsed.brdf_tables();
     let text = ROUGH
         .replace("base = \"plastic\"", "base = \"conductor\"")
-        .replace("albedo = [0.5, 0.2]\n", "")
-        .replace("k = [0.0, 0.0]", "k = [3.0, 3.0]");
+        .replace("albedo = 0.5\n", "")
+        .replace("[[1.5, 0.0], [1.5, 0.0]]", "[[1.5, 3.0], [1.5, 3.0]]");
     let l = 8;
     let mut asymmetry = Vec::new();
     for sigma_s in ["0.0", "0.05"] {

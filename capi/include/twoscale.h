@@ -76,6 +76,12 @@
 #define TS_ERR_PANIC 7
 
 /**
+ * A material description is not TOML, or not the schema: an unknown,
+ * missing or mistyped key (the message gives the line and the key).
+ */
+#define TS_ERR_PARSE 8
+
+/**
  * `ts_material_desc.base`: a conductor (no base layer).
  */
 #define TS_BASE_CONDUCTOR 0
@@ -369,6 +375,36 @@ int ts_rgb_wavelengths(float *out);
  */
 int ts_material_desc_preset(const char *name,
                             ts_material_desc *out);
+
+/**
+ * Fills `out` (and `out->size`) with the material of the TOML text `toml`:
+ * a material file, whose `[material]` table has the keys of Python's
+ * `twoscale.Material` (`beta`, `p`, `eta = [[n, k], [n, k], [n, k]]`, and
+ * optionally `sigma_s`, `b`, `c`, `base`, `albedo`, `lambertian`,
+ * `masking`, `sigma_rel`, `colour`, `halo_weight`) and an optional
+ * `[metrics]` table, not read (what `python -m twoscale.fit` writes;
+ * docs/fitting.md). `TS_ERR_PARSE`: not TOML, or an unknown, missing or
+ * mistyped key; `TS_ERR_INVALID`: a value outside its domain. The message
+ * is the one Rust and Python give for the same text. `out` is left
+ * unchanged on failure.
+ *
+ * # Safety
+ *
+ * `toml` is NULL or NUL-terminated; `out` is NULL or writable.
+ */
+int ts_material_desc_from_toml(const char *toml,
+                               ts_material_desc *out);
+
+/**
+ * `ts_material_desc_from_toml` of the file at `path` (UTF-8 text);
+ * `TS_ERR_IO` if it cannot be read. Messages start with the path.
+ *
+ * # Safety
+ *
+ * `path` is NULL or NUL-terminated; `out` is NULL or writable.
+ */
+int ts_material_desc_from_toml_file(const char *path,
+                                    ts_material_desc *out);
 
 /**
  * The shipped preset `name` with the paper's options. NULL on failure

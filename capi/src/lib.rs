@@ -23,6 +23,7 @@ use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
     RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
 };
+use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
 use twoscale::table_set::TABLES;
@@ -46,6 +47,9 @@ pub const TS_ERR_TABLES: c_int = 5;
 pub const TS_ERR_IO: c_int = 6;
 /// Internal error: a panic inside the library was caught (a bug; please report).
 pub const TS_ERR_PANIC: c_int = 7;
+/// A material description is not TOML, or not the schema: an unknown,
+/// missing or mistyped key (the message gives the line and the key).
+pub const TS_ERR_PARSE: c_int = 8;
 
 /// `ts_material_desc.base`: a conductor (no base layer).
 pub const TS_BASE_CONDUCTOR: i32 = 0;
@@ -213,6 +217,18 @@ impl From<TableSetError> for Fail {
     }
 }
 
+impl From<DescError> for Fail {
+    /// The runtime's message, unchanged (Rust and Python show the same).
+    fn from(error: DescError) -> Fail {
+        let code = match error.kind {
+            DescErrorKind::Io => TS_ERR_IO,
+            DescErrorKind::Syntax => TS_ERR_PARSE,
+            DescErrorKind::Refused => TS_ERR_INVALID,
+        };
+        Fail(code, error.message)
+    }
+}
+
 thread_local! {
     /// This thread's last failure: its status code and message.
     static LAST_ERROR: RefCell<(c_int, CString)> = RefCell::new((TS_OK, CString::default()));
@@ -306,6 +322,26 @@ fn triples(n: usize) -> Result<usize, Fail> {
     n.checked_mul(3)
         .filter(|len| *len <= isize::MAX as usize / size_of::<f32>())
         .ok_or_else(|| Fail::new(TS_ERR_INVALID, format!("n = {n} is too large")))
+}
+
+/// The path in the C string `s` (its bytes on Unix, UTF-8 elsewhere).
+///
+/// # Safety
+///
+/// `s` is NULL or a NUL-terminated string.
+unsafe fn path(s: *const c_char, what: &str) -> Result<PathBuf, Fail> {
+    non_null(s, what)?;
+    // SAFETY: non-null; the caller passes a NUL-terminated string.
+    let s = unsafe { CStr::from_ptr(s) };
+    #[cfg(unix)]
+    let path =
+        PathBuf::from(<std::ffi::OsStr as std::os::unix::ffi::OsStrExt>::from_bytes(s.to_bytes()));
+    #[cfg(not(unix))]
+    let path = PathBuf::from(
+        s.to_str()
+            .map_err(|e| Fail::new(TS_ERR_INVALID, format!("{what} is not UTF-8: {e}")))?,
+    );
+    Ok(path)
 }
 
 fn utf8<'s>(s: *const c_char, what: &str) -> Result<&'s str, Fail> {
@@ -576,18 +612,8 @@ pub extern "C" fn ts_tables_embedded() -> *mut ts_tables {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ts_tables_open(dir: *const c_char) -> *mut ts_tables {
     handle(|| {
-        non_null(dir, "dir")?;
-        // SAFETY: non-null; the caller passes a NUL-terminated string.
-        let dir = unsafe { CStr::from_ptr(dir) };
-        #[cfg(unix)]
-        let dir = PathBuf::from(
-            <std::ffi::OsStr as std::os::unix::ffi::OsStrExt>::from_bytes(dir.to_bytes()),
-        );
-        #[cfg(not(unix))]
-        let dir = PathBuf::from(
-            dir.to_str()
-                .map_err(|e| Fail::new(TS_ERR_INVALID, format!("dir is not UTF-8: {e}")))?,
-        );
+        // SAFETY: forwarded caller contract.
+        let dir = unsafe { path(dir, "dir")? };
         Ok(new_tables(TableSet::open(dir)?))
     })
 }
@@ -710,17 +736,78 @@ pub unsafe extern "C" fn ts_material_desc_preset(
 ) -> c_int {
     status(|| {
         let name = utf8(name, "name")?;
-        non_null(out, "out")?;
-        if !out.is_aligned() {
-            return Err(Fail::new(TS_ERR_MISALIGNED, "out is misaligned"));
-        }
         let material = twoscale::materials::preset(name).ok_or_else(|| {
             Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name })
         })?;
-        let desc = ts_material_desc::from_model(&material, Options::default());
-        // SAFETY: non-null, aligned, writable by the caller's contract.
-        unsafe { out.write(desc) };
-        Ok(())
+        let desc = MaterialDesc {
+            material,
+            options: Options::default(),
+        };
+        // SAFETY: forwarded caller contract.
+        unsafe { write_desc(out, &desc) }
+    })
+}
+
+/// Writes `desc` to `out` (checked: not NULL, aligned).
+///
+/// # Safety
+///
+/// `out` is NULL or writable.
+unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc) -> Result<(), Fail> {
+    non_null(out, "out")?;
+    if !out.is_aligned() {
+        return Err(Fail::new(TS_ERR_MISALIGNED, "out is misaligned"));
+    }
+    let desc = ts_material_desc::from_model(&desc.material, desc.options);
+    // SAFETY: non-null, aligned, writable by the caller's contract.
+    unsafe { out.write(desc) };
+    Ok(())
+}
+
+/// Fills `out` (and `out->size`) with the material of the TOML text `toml`:
+/// a material file, whose `[material]` table has the keys of Python's
+/// `twoscale.Material` (`beta`, `p`, `eta = [[n, k], [n, k], [n, k]]`, and
+/// optionally `sigma_s`, `b`, `c`, `base`, `albedo`, `lambertian`,
+/// `masking`, `sigma_rel`, `colour`, `halo_weight`) and an optional
+/// `[metrics]` table, not read (what `python -m twoscale.fit` writes;
+/// docs/fitting.md). `TS_ERR_PARSE`: not TOML, or an unknown, missing or
+/// mistyped key; `TS_ERR_INVALID`: a value outside its domain. The message
+/// is the one Rust and Python give for the same text. `out` is left
+/// unchanged on failure.
+///
+/// # Safety
+///
+/// `toml` is NULL or NUL-terminated; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_material_desc_from_toml(
+    toml: *const c_char,
+    out: *mut ts_material_desc,
+) -> c_int {
+    status(|| {
+        let text = utf8(toml, "toml")?;
+        let desc = MaterialDesc::from_toml_str(text)?;
+        // SAFETY: forwarded caller contract.
+        unsafe { write_desc(out, &desc) }
+    })
+}
+
+/// `ts_material_desc_from_toml` of the file at `path` (UTF-8 text);
+/// `TS_ERR_IO` if it cannot be read. Messages start with the path.
+///
+/// # Safety
+///
+/// `path` is NULL or NUL-terminated; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_material_desc_from_toml_file(
+    path: *const c_char,
+    out: *mut ts_material_desc,
+) -> c_int {
+    status(|| {
+        // SAFETY: forwarded caller contract.
+        let path = unsafe { self::path(path, "path")? };
+        let desc = MaterialDesc::from_toml_file(path)?;
+        // SAFETY: forwarded caller contract.
+        unsafe { write_desc(out, &desc) }
     })
 }
 
@@ -1090,6 +1177,50 @@ mod tests {
                 }
                 Ok(_) => panic!("accepted: {desc:?} (want {want})"),
             }
+        }
+    }
+
+    /// A material file reads into the description of the runtime's
+    /// material, and each fault keeps the runtime's message, with its code.
+    #[test]
+    fn toml_descriptions_are_the_runtimes() {
+        let text = "[material]\nbeta = 0.2\np = 0.8\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n\
+                    sigma_s = 0.03\nb = 2.0\nlambertian = 0.05\nsigma_rel = \"symmetrised\"\n\
+                    [metrics]\nrmse = [0.1, 0.1, 0.1]\n";
+        let c_text = CString::new(text).expect("no NUL");
+        let mut out = ts_material_desc::default();
+        // SAFETY: a NUL-terminated string and a writable description.
+        let status = unsafe { ts_material_desc_from_toml(c_text.as_ptr(), &mut out) };
+        assert_eq!(status, TS_OK);
+        let want = MaterialDesc::from_toml_str(text).expect("valid");
+        assert_eq!(out.to_model().ok(), Some((want.material, want.options)));
+        let eta = "eta = [[1, 0], [1, 0], [1, 0]]";
+        let cases = [
+            (
+                format!("[material]\nbeta = 20\np = 1\n{eta}"),
+                TS_ERR_INVALID,
+            ),
+            (
+                format!("[material]\nbeta = 0.1\np = 1\n{eta}\nbase = \"wood\""),
+                TS_ERR_INVALID,
+            ),
+            (format!("[material]\nbeta = 0.1\n{eta}"), TS_ERR_PARSE),
+            (
+                format!("[material]\nbeta = 0.1\np = 1\n{eta}\n[fit]"),
+                TS_ERR_PARSE,
+            ),
+        ];
+        for (text, code) in cases {
+            let c_text = CString::new(text.as_str()).expect("no NUL");
+            // SAFETY: as above.
+            let status = unsafe { ts_material_desc_from_toml(c_text.as_ptr(), &mut out) };
+            assert_eq!(status, code, "{text}");
+            // SAFETY: the last error is a NUL-terminated string.
+            let message = unsafe { CStr::from_ptr(ts_last_error()) }
+                .to_str()
+                .expect("UTF-8");
+            let want = MaterialDesc::from_toml_str(&text).expect_err("refused");
+            assert_eq!(message, want.message);
         }
     }
 

@@ -6,6 +6,8 @@
 use std::fmt;
 use std::path::PathBuf;
 
+use twoscale::desc::DescError;
+
 use crate::materials::MaterialsError;
 use crate::plot::PlotError;
 use crate::query::QueryError;
@@ -44,6 +46,8 @@ pub enum Error {
     Usage(String),
     /// The materials file is unreadable or invalid.
     Materials(MaterialsError),
+    /// A material file (`query --material`) is unreadable or invalid.
+    Material(DescError),
     /// A table file could not be read or is malformed.
     Tables(TableFileError),
     /// A table could not be built, verified or spot-checked.
@@ -110,6 +114,7 @@ impl fmt::Display for Error {
             }
             Error::Usage(message) => write!(f, "{message}"),
             Error::Materials(e) => write!(f, "{e}"),
+            Error::Material(e) => write!(f, "{e}"),
             Error::Tables(e) => write!(f, "{e}"),
             Error::Table { table, source } => write!(f, "{table}: {source}"),
             Error::Shard(e) => write!(f, "T3 shards: {e}"),
@@ -129,6 +134,7 @@ impl std::error::Error for Error {
             Error::File { source, .. } => Some(source),
             Error::Usage(_) => None,
             Error::Materials(e) => Some(e),
+            Error::Material(e) => Some(e),
             Error::Tables(e) => Some(e),
             Error::Table { source, .. } => Some(source),
             Error::Shard(e) => Some(e),

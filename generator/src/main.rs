@@ -206,6 +206,13 @@ enum Command {
         /// (false for those rows).
         #[arg(long)]
         clamp: bool,
+        /// `brdf` of the material of this material file (TOML: a
+        /// `[material]` table, what `python -m twoscale.fit` writes; a
+        /// conductor without a Lambertian term, as the reference covers):
+        /// the rows then give `channel,ix,iy,iz,ox,oy,oz` (channel 0, 1, 2:
+        /// red, green, blue) and `table` is the RGB model's channel.
+        #[arg(long, value_name = "FILE")]
+        material: Option<PathBuf>,
     },
 }
 
@@ -323,7 +330,13 @@ fn main() -> ExitCode {
             quantity,
             tables,
             clamp,
-        } => query(&quantity, &TableSource::new(tables), clamp),
+            material,
+        } => query(
+            &quantity,
+            &TableSource::new(tables),
+            clamp,
+            material.as_deref(),
+        ),
     };
     match result {
         Ok(code) => code,
@@ -401,14 +414,23 @@ fn selected<'a>(names: &[String], t4: &'a [ShBrdf]) -> Result<Vec<&'a dyn TableK
 }
 
 /// `query`: stdin to stdout; exit status 1 if a row was not answered.
-fn query(quantity: &str, tables: &TableSource, clamp: bool) -> Result<ExitCode, Error> {
+fn query(
+    quantity: &str,
+    tables: &TableSource,
+    clamp: bool,
+    material: Option<&Path>,
+) -> Result<ExitCode, Error> {
+    let material = material
+        .map(twoscale::desc::MaterialDesc::from_toml_file)
+        .transpose()
+        .map_err(Error::Material)?;
     let stdin = std::io::stdin();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let summary = generator::query::run(
         quantity,
         tables,
-        &generator::query::Options { clamp },
+        &generator::query::Options { clamp, material },
         BufReader::new(stdin.lock()),
         &mut out,
         std::io::stderr(),

@@ -7,25 +7,34 @@
 //!
 //! [[material]]
 //! name = "nickel"          # file t4-nickel.tbl; [a-z0-9-], unique
-//! beta = 0.0598            # EPD width β (HP17 34-35), (0, 1]
-//! p = 1.0                  # EPD shape p, [0.2, 5]
-//! sigma_s = 0.0273         # RMS height of the nano-roughness σs, µm, ≥ 0
-//! b = 4.8418               # correlation length of the K-correlation spectrum, µm, > 0
-//! c = 2.0                  # K-correlation exponent, (1, 100]
-//! n = [2.0, 1.8, 1.7]      # complex index n + ik per wavelength
-//! k = [3.8, 3.3, 2.8]
-//! base = "conductor"       # or "plastic" / "subsurface" (then `albedo` per wavelength, and k = 0)
-//! lambertian = 0.0         # optional Lambertian term k_d ∈ [0, 1] (adds k_d/π); default 0
+//! beta = 0.0598            # the material's keys, as a material file's [material]
+//! p = 1.0                  # (twoscale::desc): beta, p, eta, sigma_s, b, c, base,
+//! sigma_s = 0.0273         # albedo, lambertian, with their defaults
+//! b = 4.8418
+//! eta = [[2.0, 3.8], [1.8, 3.3], [1.7, 2.8]]   # n + ik, one pair per wavelength
 //! band_limit = 48          # T4 band limit L, [2, 127]; absent: no T4 file for the material
 //! filter = { start = 40, width = 8 }   # optional half-Gaussian band filter (WAT92 §2.5)
+//!
+//! [[material]]
+//! preset = "gold-rough"    # a shipped preset (twoscale::materials): its name and
+//! band_limit = 24          # parameters; only band_limit and filter with it
 //! ```
 //!
-//! Unknown keys, missing fields and out-of-range values are errors that name
-//! the material and the field.
+//! A material's keys are the one schema of a material description
+//! ([`twoscale::desc`]: Python's `twoscale.Material` keywords, the fit's
+//! output), read and validated by the runtime, so a value is refused here
+//! as everywhere else. `name`, `preset`, `band_limit` and `filter` are this
+//! file's own. T4 projects the model with the default options, so the
+//! option keys (`masking`, …) are refused here. Unknown keys, missing
+//! fields and out-of-range values are errors that name the material and the
+//! field.
 
 use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
+use twoscale::Complex;
+use twoscale::brdf::{Layer, Options};
+use twoscale::desc::KeywordTable;
 
 use crate::sh::BandFilter;
 
@@ -41,58 +50,16 @@ pub struct Materials {
     pub materials: Vec<Material>,
 }
 
-/// Base layer under the microfacet interface (docs/model.md §2.6).
-#[derive(Clone, Debug, PartialEq)]
-pub enum Base {
-    /// No base: a conductor.
-    Conductor,
-    /// A varnish of index `n` (real) over a diffuse layer of albedo ρd per
-    /// wavelength (HP17 42-43).
-    Plastic {
-        /// ρd per wavelength, in [0, 1).
-        albedo: Vec<f64>,
-    },
-    /// A varnish of index `n` (real) over a scattering medium of
-    /// single-scattering albedo α per wavelength (HP17 44-47).
-    Subsurface {
-        /// α per wavelength, in [0, 1).
-        albedo: Vec<f64>,
-    },
-}
-
-impl Base {
-    /// The albedo (ρd or α) at `channel`, 0 for a conductor.
-    pub fn albedo(&self, channel: usize) -> f64 {
-        match self {
-            Base::Conductor => 0.0,
-            Base::Plastic { albedo } | Base::Subsurface { albedo } => albedo[channel],
-        }
-    }
-}
-
 /// One material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// Name, `[a-z0-9-]+`; the T4 file is `t4-<name>.tbl`.
     pub name: String,
-    /// EPD width β.
-    pub beta: f64,
-    /// EPD shape p.
-    pub p: f64,
-    /// σs, µm.
-    pub sigma_s: f64,
-    /// b, µm.
-    pub b: f64,
-    /// c.
-    pub c: f64,
-    /// Real part of the index, per wavelength.
-    pub n: Vec<f64>,
-    /// Imaginary part of the index, per wavelength.
-    pub k: Vec<f64>,
-    /// Base layer.
-    pub base: Base,
-    /// Lambertian term `k_d ∈ [0, 1]` (adds `k_d/π`; 0 if absent from the file).
-    pub lambertian: f64,
+    /// The surface, base layer and Lambertian term, validated by the runtime
+    /// (`Layer::validate`).
+    pub layer: Layer,
+    /// The index `n + ik` at each wavelength.
+    pub eta: Vec<Complex>,
     /// T4 band limit L; `None`: no T4 file (a lobe too narrow for SH).
     pub band_limit: Option<usize>,
     /// Optional half-Gaussian band filter of T4.
@@ -116,29 +83,23 @@ impl std::error::Error for MaterialsError {}
 struct RawFile {
     wavelengths: Vec<f64>,
     #[serde(default)]
-    material: Vec<RawMaterial>,
+    material: Vec<toml::Table>,
 }
 
-#[derive(Deserialize, Default)]
+/// The keys of a `[[material]]` that are this file's, not the material's.
+#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawMaterial {
+struct FileKeys {
     /// A shipped preset of the runtime (`twoscale::materials::PRESETS`):
-    /// its name and parameters, with no model field of its own.
+    /// its name and parameters, with no material key of its own.
     preset: Option<String>,
     name: Option<String>,
-    beta: Option<f64>,
-    p: Option<f64>,
-    sigma_s: Option<f64>,
-    b: Option<f64>,
-    c: Option<f64>,
-    n: Option<Vec<f64>>,
-    k: Option<Vec<f64>>,
-    base: Option<String>,
-    albedo: Option<Vec<f64>>,
-    lambertian: Option<f64>,
     band_limit: Option<usize>,
     filter: Option<RawFilter>,
 }
+
+/// The keys [`FileKeys`] takes out of a `[[material]]` table.
+const FILE_KEYS: [&str; 4] = ["preset", "name", "band_limit", "filter"];
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -189,9 +150,8 @@ impl Materials {
             }
         }
         let mut materials: Vec<Material> = Vec::new();
-        for m in raw.material {
-            let m = m.resolve_preset(&raw.wavelengths)?;
-            let material = m.validate(channels)?;
+        for (index, table) in raw.material.into_iter().enumerate() {
+            let material = Material::from_table(table, index, &raw.wavelengths)?;
             if materials.iter().any(|other| other.name == material.name) {
                 return Err(MaterialsError(format!(
                     "material '{}' is defined twice",
@@ -207,111 +167,38 @@ impl Materials {
     }
 }
 
-fn in_range(
-    name: &str,
-    field: &str,
-    value: f64,
-    lo: f64,
-    hi: f64,
-    open_lo: bool,
-) -> Result<(), MaterialsError> {
-    let ok = value.is_finite() && value <= hi && if open_lo { value > lo } else { value >= lo };
-    if ok {
-        Ok(())
-    } else {
-        let bracket = if open_lo { '(' } else { '[' };
-        Err(MaterialsError(format!(
-            "material '{name}': {field} = {value} is outside {bracket}{lo}, {hi}]"
-        )))
-    }
-}
-
-impl RawMaterial {
-    /// A `preset = "…"` entry with the runtime preset's parameters filled in
-    /// (the presets are defined once, in `twoscale::materials`); other
-    /// entries unchanged.
-    fn resolve_preset(self, wavelengths: &[f64]) -> Result<RawMaterial, MaterialsError> {
-        let Some(preset) = self.preset else {
-            return Ok(self);
-        };
-        let err = |m: String| Err(MaterialsError(format!("preset '{preset}': {m}")));
-        let Some(material) = twoscale::materials::preset(&preset) else {
-            let names: Vec<_> = twoscale::materials::PRESETS
-                .iter()
-                .map(|(n, _)| *n)
-                .collect();
-            return err(format!("not a shipped preset ({})", names.join(", ")));
-        };
-        let rgb = twoscale::brdf::RGB_WAVELENGTHS.map(f64::from);
-        if wavelengths.len() != 3
-            || wavelengths
-                .iter()
-                .zip(rgb)
-                .any(|(a, b)| (a - b).abs() > 1e-6)
-        {
-            return err(format!(
-                "presets are defined at the RGB wavelengths {rgb:?} µm"
-            ));
+impl Material {
+    /// The material of `[[material]]` number `index` (from 0): the file's
+    /// keys taken out, the rest read as a material description
+    /// ([`twoscale::desc`]) with one index per wavelength.
+    fn from_table(
+        mut table: toml::Table,
+        index: usize,
+        wavelengths: &[f64],
+    ) -> Result<Material, MaterialsError> {
+        let mut own = toml::Table::new();
+        for key in FILE_KEYS {
+            if let Some(value) = table.remove(key) {
+                own.insert(key.to_string(), value);
+            }
         }
-        let own = [
-            self.name.is_some(),
-            self.beta.is_some(),
-            self.p.is_some(),
-            self.sigma_s.is_some(),
-            self.b.is_some(),
-            self.c.is_some(),
-            self.n.is_some(),
-            self.k.is_some(),
-            self.base.is_some(),
-            self.albedo.is_some(),
-            self.lambertian.is_some(),
-        ];
-        if own.into_iter().any(|given| given) {
-            return err("give only band_limit and filter with a preset".into());
-        }
-        let layer = material.layer;
-        let s = layer.surface;
-        let (base, albedo) = match layer.base {
-            twoscale::brdf::BaseLayer::Conductor => ("conductor", None),
-            twoscale::brdf::BaseLayer::Plastic { albedo } => ("plastic", Some(albedo)),
-            twoscale::brdf::BaseLayer::Subsurface { albedo } => ("subsurface", Some(albedo)),
+        let own: FileKeys = own
+            .try_into()
+            .map_err(|e| MaterialsError(format!("[[material]] {}: {e}", index + 1)))?;
+        let (name, layer, eta) = match own.preset {
+            Some(preset) if own.name.is_none() => from_preset(&preset, &table, wavelengths)?,
+            Some(preset) => {
+                return Err(MaterialsError(format!(
+                    "preset '{preset}': give only band_limit and filter with a preset"
+                )));
+            }
+            None => {
+                let name = own.name.unwrap_or_default();
+                let (layer, eta) = keywords(&name, table, wavelengths.len())?;
+                (name, layer, eta)
+            }
         };
-        Ok(RawMaterial {
-            name: Some(preset.clone()),
-            beta: Some(f64::from(s.beta)),
-            p: Some(f64::from(s.p)),
-            sigma_s: Some(f64::from(s.sigma_s)),
-            b: Some(f64::from(s.b)),
-            c: Some(f64::from(s.c)),
-            n: Some(material.eta_rgb.iter().map(|e| f64::from(e.re)).collect()),
-            k: Some(material.eta_rgb.iter().map(|e| f64::from(e.im)).collect()),
-            base: Some(base.into()),
-            albedo: albedo.map(|a| vec![f64::from(a); 3]),
-            lambertian: Some(f64::from(layer.lambertian)),
-            band_limit: self.band_limit,
-            filter: self.filter,
-            preset: None,
-        })
-    }
-
-    fn validate(self, channels: usize) -> Result<Material, MaterialsError> {
-        let name = self.name.unwrap_or_default();
-        let need = |field: &str, value: Option<f64>| {
-            value.ok_or_else(|| MaterialsError(format!("material '{name}': missing field {field}")))
-        };
-        let (beta, p, sigma_s, b, c) = (
-            need("beta", self.beta)?,
-            need("p", self.p)?,
-            need("sigma_s", self.sigma_s)?,
-            need("b", self.b)?,
-            need("c", self.c)?,
-        );
-        let missing =
-            |field: &str| MaterialsError(format!("material '{name}': missing field {field}"));
-        let n = self.n.ok_or_else(|| missing("n"))?;
-        let k = self.k.ok_or_else(|| missing("k"))?;
-        let base_kind = self.base.ok_or_else(|| missing("base"))?;
-        let lambertian = self.lambertian.unwrap_or(0.0);
+        let err = |m: String| Err(MaterialsError(format!("material '{name}': {m}")));
         if name.is_empty()
             || !name
                 .bytes()
@@ -321,78 +208,21 @@ impl RawMaterial {
                 "material name '{name}' must be non-empty and use only a-z, 0-9 and '-'"
             )));
         }
-        in_range(&name, "beta", beta, 0.0, 1.0, true)?;
-        in_range(&name, "p", p, 0.2, 5.0, false)?;
-        in_range(&name, "sigma_s", sigma_s, 0.0, 1.0, false)?;
-        in_range(&name, "b", b, 0.0, 1000.0, true)?;
-        in_range(&name, "c", c, 1.0, 100.0, true)?;
-        for (field, values) in [("n", &n), ("k", &k)] {
-            if values.len() != channels {
-                return Err(MaterialsError(format!(
-                    "material '{name}': {field} has {} values, one per wavelength ({channels}) needed",
-                    values.len()
-                )));
-            }
-        }
-        for &v in &n {
-            in_range(&name, "n", v, 0.0, 10.0, true)?;
-        }
-        for &v in &k {
-            in_range(&name, "k", v, 0.0, 20.0, false)?;
-        }
-        let base = match (base_kind.as_str(), self.albedo) {
-            ("conductor", None) => Base::Conductor,
-            ("conductor", Some(_)) => {
-                return Err(MaterialsError(format!(
-                    "material '{name}': albedo is only for base = \"plastic\" or \"subsurface\""
-                )));
-            }
-            (kind @ ("plastic" | "subsurface"), Some(albedo)) => {
-                if albedo.len() != channels {
-                    return Err(MaterialsError(format!(
-                        "material '{name}': albedo has {} values, one per wavelength ({channels}) needed",
-                        albedo.len()
-                    )));
-                }
-                for &a in &albedo {
-                    in_range(&name, "albedo", a, 0.0, 0.999, false)?;
-                }
-                if k.iter().any(|&k| k != 0.0) || n.iter().any(|&n| n < 1.0) {
-                    return Err(MaterialsError(format!(
-                        "material '{name}': a {kind} base's varnish needs a real index n ≥ 1 (k = 0)"
-                    )));
-                }
-                if kind == "plastic" {
-                    Base::Plastic { albedo }
-                } else {
-                    Base::Subsurface { albedo }
-                }
-            }
-            (kind @ ("plastic" | "subsurface"), None) => {
-                return Err(MaterialsError(format!(
-                    "material '{name}': base = \"{kind}\" needs an albedo per wavelength"
-                )));
-            }
-            (other, _) => {
-                return Err(MaterialsError(format!(
-                    "material '{name}': unknown base '{other}' (conductor, plastic or subsurface)"
-                )));
-            }
-        };
-        in_range(&name, "lambertian", lambertian, 0.0, 1.0, false)?;
         let max = twoscale::sh::MAX_BAND_LIMIT;
-        if let Some(l) = self.band_limit
+        if let Some(l) = own.band_limit
             && !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&l)
         {
-            return Err(MaterialsError(format!(
-                "material '{name}': band_limit = {l} is outside [2, {max}]"
-            )));
+            return err(format!("band_limit = {l} is outside [2, {max}]"));
         }
-        let filter = match self.filter {
+        let filter = match own.filter {
             None => None,
             Some(f) => {
-                in_range(&name, "filter.start", f.start, 0.0, max as f64, false)?;
-                in_range(&name, "filter.width", f.width, 0.0, 1000.0, true)?;
+                if !(f.start.is_finite() && (0.0..=max as f64).contains(&f.start)) {
+                    return err(format!("filter.start = {} is outside [0, {max}]", f.start));
+                }
+                if !(f.width.is_finite() && f.width > 0.0 && f.width <= 1000.0) {
+                    return err(format!("filter.width = {} is outside (0, 1000]", f.width));
+                }
                 Some(BandFilter {
                     start: f.start,
                     width: f.width,
@@ -401,24 +231,79 @@ impl RawMaterial {
         };
         Ok(Material {
             name,
-            beta,
-            p,
-            sigma_s,
-            b,
-            c,
-            n,
-            k,
-            base,
-            lambertian,
-            band_limit: self.band_limit,
+            layer,
+            eta,
+            band_limit: own.band_limit,
             filter,
         })
     }
 }
 
+/// The layer and indices of the material keys in `table` (`name` for the
+/// messages), validated by the runtime ([`twoscale::desc::Keywords::layer`]);
+/// options other than the default are refused (T4 projects the default).
+fn keywords(
+    name: &str,
+    table: toml::Table,
+    channels: usize,
+) -> Result<(Layer, Vec<Complex>), MaterialsError> {
+    let err = |m: &dyn fmt::Display| MaterialsError(format!("material '{name}': {m}"));
+    let keywords: KeywordTable = table.try_into().map_err(|e| err(&e))?;
+    let (layer, options) = keywords.keywords().layer(channels).map_err(|e| err(&e))?;
+    if options != Options::default() {
+        return Err(err(
+            &"T4 projects the model with the default options: remove masking, sigma_rel, \
+              colour and halo_weight",
+        ));
+    }
+    let eta = keywords
+        .eta
+        .iter()
+        .map(|&[n, k]| Complex::new(n, k))
+        .collect();
+    Ok((layer, eta))
+}
+
+/// The name, layer and RGB indices of shipped preset `preset` (defined once,
+/// in `twoscale::materials`); `rest` must hold no material key.
+fn from_preset(
+    preset: &str,
+    rest: &toml::Table,
+    wavelengths: &[f64],
+) -> Result<(String, Layer, Vec<Complex>), MaterialsError> {
+    let err = |m: String| Err(MaterialsError(format!("preset '{preset}': {m}")));
+    let Some(material) = twoscale::materials::preset(preset) else {
+        let names: Vec<_> = twoscale::materials::PRESETS
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        return err(format!("not a shipped preset ({})", names.join(", ")));
+    };
+    let rgb = twoscale::brdf::RGB_WAVELENGTHS.map(f64::from);
+    if wavelengths.len() != 3
+        || wavelengths
+            .iter()
+            .zip(rgb)
+            .any(|(a, b)| (a - b).abs() > 1e-6)
+    {
+        return err(format!(
+            "presets are defined at the RGB wavelengths {rgb:?} µm"
+        ));
+    }
+    if !rest.is_empty() {
+        return err("give only band_limit and filter with a preset".into());
+    }
+    Ok((
+        preset.to_string(),
+        material.layer,
+        material.eta_rgb.to_vec(),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use twoscale::brdf::BaseLayer;
 
     const GOOD: &str = r#"
 wavelengths = [0.645, 0.526, 0.444]
@@ -429,8 +314,7 @@ p = 1.0
 sigma_s = 0.03
 b = 4.8
 c = 2.0
-n = [2.0, 1.8, 1.7]
-k = [3.8, 3.3, 2.8]
+eta = [[2.0, 3.8], [1.8, 3.3], [1.7, 2.8]]
 base = "conductor"
 band_limit = 16
 "#;
@@ -444,8 +328,33 @@ band_limit = 16
         let m = Materials::parse(GOOD).unwrap();
         assert_eq!(m.wavelengths, vec![0.645, 0.526, 0.444]);
         assert_eq!(m.materials.len(), 1);
-        assert_eq!(m.materials[0].base, Base::Conductor);
-        assert_eq!(m.materials[0].filter, None);
+        let ni = &m.materials[0];
+        assert_eq!(ni.layer.base, BaseLayer::Conductor);
+        assert_eq!(ni.layer.surface.beta, 0.06);
+        assert_eq!(ni.eta[1], Complex::new(1.8, 3.3));
+        assert_eq!(ni.filter, None);
+    }
+
+    /// A material file's `[material]` table (the fit's output) is a
+    /// `[[material]]` of this file once named: one schema.
+    #[test]
+    fn a_material_file_table_is_an_entry() {
+        let table = r#"beta = 0.1
+p = 1.2
+eta = [[1.5, 0.0], [1.5, 0.0], [1.5, 0.0]]
+sigma_s = 0.01
+b = 3.0
+base = "plastic"
+albedo = 0.6
+lambertian = 0.1
+"#;
+        let file = format!("[material]\n{table}\n[metrics]\nrmse = [0.1, 0.1, 0.1]\n");
+        let desc = twoscale::desc::MaterialDesc::from_toml_str(&file).unwrap();
+        let entry =
+            format!("wavelengths = [0.645, 0.526, 0.444]\n[[material]]\nname = \"fit\"\n{table}");
+        let m = Materials::parse(&entry).unwrap();
+        assert_eq!(m.materials[0].layer, desc.material.layer);
+        assert_eq!(m.materials[0].eta, desc.material.eta_rgb.to_vec());
     }
 
     #[test]
@@ -457,41 +366,25 @@ band_limit = 16
     }
 
     /// The repository file holds exactly the runtime presets
-    /// (`twoscale::materials::PRESETS`): same names, and every value equal
-    /// once rounded to the runtime's f32.
+    /// (`twoscale::materials::PRESETS`): same names and parameters.
     #[test]
     fn preset_entries_take_the_runtime_presets() {
-        use twoscale::brdf::{BaseLayer, RGB_WAVELENGTHS};
+        use twoscale::brdf::RGB_WAVELENGTHS;
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
         let file = Materials::load(Path::new(path)).unwrap();
-        let f = |v: f64| v as f32;
         assert_eq!(
-            file.wavelengths.iter().map(|&w| f(w)).collect::<Vec<_>>(),
+            file.wavelengths
+                .iter()
+                .map(|&w| w as f32)
+                .collect::<Vec<_>>(),
             RGB_WAVELENGTHS
         );
         let names: Vec<&str> = file.materials.iter().map(|m| m.name.as_str()).collect();
         let preset_names: Vec<&str> = twoscale::materials::PRESETS.iter().map(|p| p.0).collect();
         assert_eq!(names, preset_names);
         for (m, (name, preset)) in file.materials.iter().zip(twoscale::materials::PRESETS) {
-            let layer = preset.layer;
-            let s = layer.surface;
-            assert_eq!(
-                [f(m.beta), f(m.p), f(m.sigma_s), f(m.b), f(m.c)],
-                [s.beta, s.p, s.sigma_s, s.b, s.c],
-                "{name}: surface"
-            );
-            assert_eq!(f(m.lambertian), layer.lambertian, "{name}: lambertian");
-            for c in 0..3 {
-                let eta = preset.eta_rgb[c];
-                assert_eq!([f(m.n[c]), f(m.k[c])], [eta.re, eta.im], "{name}: η[{c}]");
-                let albedo = f(m.base.albedo(c));
-                let base = match m.base {
-                    Base::Conductor => BaseLayer::Conductor,
-                    Base::Plastic { .. } => BaseLayer::Plastic { albedo },
-                    Base::Subsurface { .. } => BaseLayer::Subsurface { albedo },
-                };
-                assert_eq!(base, layer.base, "{name}: base at channel {c}");
-            }
+            assert_eq!(m.layer, preset.layer, "{name}");
+            assert_eq!(m.eta, preset.eta_rgb.to_vec(), "{name}");
         }
     }
 
@@ -505,39 +398,51 @@ band_limit = 16
         );
         let e = error_of(&format!("{head}preset = \"marble\"\nbeta = 0.1\n"));
         assert!(e.contains("only band_limit and filter"), "{e}");
+        let e = error_of(&format!("{head}preset = \"marble\"\nname = \"m\"\n"));
+        assert!(e.contains("only band_limit and filter"), "{e}");
         let e = error_of("wavelengths = [0.5]\n[[material]]\npreset = \"marble\"\n");
         assert!(e.contains("RGB wavelengths"), "{e}");
     }
 
+    /// Values are refused with the runtime's messages (`twoscale::validate`),
+    /// named by the material.
     #[test]
     fn rejects_unknown_keys_missing_fields_and_bad_values() {
-        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\ncolour = 1"));
-        assert!(e.contains("unknown field") && e.contains("colour"), "{e}");
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\ncolor = 1"));
+        assert!(e.contains("unknown field") && e.contains("color"), "{e}");
         let e = error_of(&GOOD.replace("beta = 0.06\n", ""));
         assert!(e.contains("missing field") && e.contains("beta"), "{e}");
-        let e = error_of(&GOOD.replace("beta = 0.06", "beta = 1.5"));
-        assert!(e.contains("'ni'") && e.contains("beta"), "{e}");
+        let e = error_of(&GOOD.replace("beta = 0.06", "beta = 15"));
+        assert_eq!(e, "material 'ni': beta = 15: must be in [0.0001, 10]");
         let e = error_of(&GOOD.replace("c = 2.0", "c = 1.0"));
-        assert!(e.contains("c = 1"), "{e}");
-        let e = error_of(&GOOD.replace("k = [3.8, 3.3, 2.8]", "k = [3.8, 3.3]"));
-        assert!(e.contains("k has 2 values"), "{e}");
+        assert_eq!(e, "material 'ni': c = 1: must be finite and > 1");
+        let e = error_of(&GOOD.replace(", [1.7, 2.8]]", "]"));
+        assert_eq!(
+            e,
+            "material 'ni': eta must be three (n, k) pairs (red, green, blue), got 2"
+        );
         let e = error_of(&GOOD.replace("band_limit = 16", "band_limit = 500"));
         assert!(e.contains("band_limit"), "{e}");
         let e = error_of(&GOOD.replace("\"conductor\"", "\"wood\""));
-        assert!(e.contains("unknown base"), "{e}");
+        assert_eq!(
+            e,
+            "material 'ni': base must be one of 'conductor', 'plastic' or 'subsurface', got 'wood'"
+        );
         let e = error_of(&GOOD.replace("\"conductor\"", "\"plastic\""));
-        assert!(e.contains("needs an albedo"), "{e}");
+        assert_eq!(e, "material 'ni': base 'plastic' needs an albedo");
         let subsurface = GOOD.replace(
             "base = \"conductor\"",
-            "base = \"subsurface\"\nalbedo = [0.9, 0.9, 0.9]",
+            "base = \"subsurface\"\nalbedo = 0.9",
         );
-        let e = error_of(&subsurface);
-        assert!(e.contains("real index"), "{e}");
-        let dielectric = subsurface.replace("k = [3.8, 3.3, 2.8]", "k = [0.0, 0.0, 0.0]");
-        let m = Materials::parse(&dielectric).unwrap();
-        assert_eq!(m.materials[0].base.albedo(2), 0.9);
+        let m = Materials::parse(&subsurface).unwrap();
+        assert_eq!(
+            m.materials[0].layer.base,
+            BaseLayer::Subsurface { albedo: 0.9 }
+        );
         let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\nlambertian = 1.5"));
-        assert!(e.contains("lambertian"), "{e}");
+        assert_eq!(e, "material 'ni': lambertian = 1.5: must be in [0, 1]");
+        let e = error_of(&GOOD.replace("c = 2.0", "c = 2.0\nmasking = \"height-correlated\""));
+        assert!(e.contains("default options"), "{e}");
         let m = Materials::parse(&GOOD.replace("band_limit = 16\n", "")).unwrap();
         assert_eq!(m.materials[0].band_limit, None);
         let e = error_of(&GOOD.replace("name = \"ni\"", "name = \"Ni 2\""));
@@ -546,5 +451,10 @@ band_limit = 16
         assert!(error_of(&twice).contains("twice"));
         let e = error_of(&GOOD.replace("[0.645, 0.526, 0.444]", "[]"));
         assert!(e.contains("wavelengths"), "{e}");
+        let two = GOOD.replace("[0.645, 0.526, 0.444]", "[0.645, 0.526]");
+        assert_eq!(
+            error_of(&two),
+            "material 'ni': eta must be 2 (n, k) pairs, one per wavelength, got 3"
+        );
     }
 }

@@ -11,8 +11,11 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
+use twoscale::brdf::ChannelBake;
+use twoscale::desc::MaterialDesc;
 use twoscale::{
-    ConvTable, Convolution, DiffuseFresnelTable, SigmaRatioTable, SmithG1Table, TableId, TableSet,
+    ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table, TableId,
+    TableSet,
 };
 
 use twoscale::validate::{self, Invalid, Shortest, Shortest32};
@@ -255,6 +258,12 @@ pub enum QueryError {
     /// `--clamp` was given for a quantity that is not the lookup of one
     /// table.
     ClampUnsupported(Quantity),
+    /// `--material` was given for another quantity than `brdf`.
+    MaterialUnsupported(Quantity),
+    /// The material of `--material` is one the reference does not cover.
+    Uncovered(brdf::Uncovered),
+    /// The quantity's tables lack one the model reads (a bug of `run`).
+    MissingTables,
     /// The input has no header line.
     EmptyInput,
     /// The input could not be read.
@@ -285,6 +294,14 @@ impl fmt::Display for QueryError {
                  {}'s parameters are always validated",
                 q.name()
             ),
+            QueryError::MaterialUnsupported(q) => write!(
+                f,
+                "--material applies to brdf (its rows then give {}), not {}",
+                MATERIAL_COLUMNS.join(","),
+                q.name()
+            ),
+            QueryError::Uncovered(e) => write!(f, "--material: {e}"),
+            QueryError::MissingTables => write!(f, "the table files were not opened"),
             QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
             QueryError::Read(e) => write!(f, "reading input: {e}"),
             QueryError::MissingColumn { column, needs } => {
@@ -413,6 +430,8 @@ pub enum RowError {
     /// The reference cannot be computed at this point (outside its domain,
     /// or a quadrature failed).
     Reference(String),
+    /// A `channel` that is not 0, 1 or 2.
+    Channel(f64),
     /// The quantity reads tables that were not opened (a bug of `run`).
     NoTables,
 }
@@ -436,6 +455,11 @@ impl fmt::Display for RowError {
                 invalid,
             } => write!(f, "{column} = {}: {invalid}", Shortest(*value)),
             RowError::Reference(e) => write!(f, "reference: {e}"),
+            RowError::Channel(c) => write!(
+                f,
+                "channel = {}: must be 0, 1 or 2 (red, green, blue)",
+                Shortest(*c)
+            ),
             RowError::NoTables => write!(f, "the table files were not opened"),
         }
     }
@@ -443,12 +467,46 @@ impl fmt::Display for RowError {
 
 impl std::error::Error for RowError {}
 
-/// How `run` treats rows outside a table's domain.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How `run` treats rows outside a table's domain, and the material of a
+/// `brdf` query.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Options {
     /// Answer them at the clamped point (as the renderer-facing lookups
     /// do) and add the column `in_domain`, instead of reporting them.
     pub clamp: bool,
+    /// `brdf` of this material (a material file, `--material FILE`): the
+    /// rows give [`MATERIAL_COLUMNS`], `table` is the channel of the RGB
+    /// model (`twoscale::Rgb`, as the C API and Python build it).
+    pub material: Option<MaterialDesc>,
+}
+
+/// The input columns of `brdf` with a material: the channel (0, 1, 2: red,
+/// green, blue at `RGB_WAVELENGTHS`) and the two directions.
+pub const MATERIAL_COLUMNS: [&str; 7] = ["channel", "ix", "iy", "iz", "ox", "oy", "oz"];
+
+/// The RGB model of a `brdf --material` query and the reference's
+/// parameters of each channel.
+struct MaterialModel<'a> {
+    model: Rgb<'a, Box<ChannelBake>>,
+    params: [brdf::Params; 3],
+    options: twoscale::brdf::Options,
+}
+
+impl MaterialModel<'_> {
+    /// `table` and `reference` of a row of [`MATERIAL_COLUMNS`].
+    fn evaluate(&self, x: &[f64]) -> Result<Vec<String>, RowError> {
+        let channel = x[0];
+        let ch = [0.0, 1.0, 2.0]
+            .iter()
+            .position(|&c| c == channel)
+            .ok_or(RowError::Channel(channel))?;
+        let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
+        let f = |v: f64| v as f32;
+        let value = self.model.eval(i.map(f), o.map(f))[ch];
+        let reference = brdf::two_scale(&self.params[ch], i, o, &self.options)
+            .map_err(|e| RowError::Reference(e.to_string()))?;
+        Ok(vec![short32(value), short(reference.total())])
+    }
 }
 
 /// Outcome of a query run.
@@ -477,7 +535,17 @@ pub fn run(
     if options.clamp && !quantity.clamps() {
         return Err(QueryError::ClampUnsupported(quantity));
     }
-    let columns = quantity.columns();
+    let params = match &options.material {
+        Some(_) if quantity != Quantity::Brdf => {
+            return Err(QueryError::MaterialUnsupported(quantity));
+        }
+        Some(desc) => Some(brdf::Params::rgb(&desc.material).map_err(QueryError::Uncovered)?),
+        None => None,
+    };
+    let columns: &'static [&'static str] = match params {
+        Some(_) => &MATERIAL_COLUMNS,
+        None => quantity.columns(),
+    };
     let mut lines = input.lines().enumerate();
     let header = loop {
         match lines.next() {
@@ -513,6 +581,18 @@ pub fn run(
         .collect::<Result<Vec<_>, _>>()
         .map_err(QueryError::Tables)?;
     let views = Tables::parse(&files, tables).map_err(QueryError::Tables)?;
+    let set = match params {
+        Some(_) => Some(views.set().map_err(|_| QueryError::MissingTables)?),
+        None => None,
+    };
+    let material = match (&options.material, params, &set) {
+        (Some(desc), Some(params), Some(set)) => Some(MaterialModel {
+            model: Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options),
+            params,
+            options: desc.options,
+        }),
+        _ => None,
+    };
 
     let rows: Vec<(usize, String)> = lines
         .map(|(n, line)| (n + 1, line.unwrap_or_default()))
@@ -539,7 +619,10 @@ pub fn run(
         if let Some((&column, &value)) = columns.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(RowError::NotFinite { column, value });
         }
-        let (out, in_domain) = quantity.evaluate(&views, &values, options.clamp)?;
+        let (out, in_domain) = match &material {
+            Some(material) => (material.evaluate(&values)?, true),
+            None => quantity.evaluate(&views, &values, options.clamp)?,
+        };
         let mut row = format!("{},{}", fields.join(","), out.join(","));
         if options.clamp {
             row.push_str(if in_domain { ",true" } else { ",false" });

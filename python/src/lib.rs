@@ -20,7 +20,7 @@ use std::sync::LazyLock;
 
 use numpy::ndarray::{Array1, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rayon::prelude::*;
@@ -28,6 +28,7 @@ use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options,
     SigmaRelMode, Surface,
 };
+use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
 use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Bxdf, Complex, Convolution, Rgb, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
@@ -190,18 +191,10 @@ fn shaped_vectors<'py, T: numpy::Element>(
     shaped(py, &full, values.into_iter().flatten().collect())
 }
 
-/// The value of option `T` called `given` (None: the runtime's default).
+/// The value of option `T` called `given` (None: the runtime's default),
+/// refused with the runtime's message (`validate::named`).
 fn named<T: Named + Default>(given: Option<&str>) -> PyResult<T> {
-    match given {
-        None => Ok(T::default()),
-        Some(name) => T::from_name(name).ok_or_else(|| {
-            value_error(format!(
-                "{} must be one of {}, got '{name}'",
-                T::OPTION,
-                T::choices()
-            ))
-        }),
-    }
+    validate::named(given).map_err(|e| value_error(e.to_string()))
 }
 
 /// The options named by the keywords; None keeps the runtime's default.
@@ -224,6 +217,15 @@ fn names<T: Named>() -> Vec<&'static str> {
     T::NAMES.iter().map(|(n, _)| *n).collect()
 }
 
+/// A refused material file as `OSError` (unreadable) or `ValueError`, with
+/// the runtime's message.
+fn desc_error(error: DescError) -> PyErr {
+    match error.kind {
+        DescErrorKind::Io => PyOSError::new_err(error.message),
+        DescErrorKind::Syntax | DescErrorKind::Refused => value_error(error.message),
+    }
+}
+
 /// A parameter outside the runtime's domain as a `ValueError` with the
 /// runtime's message.
 fn invalid(error: Invalid) -> PyErr {
@@ -237,8 +239,8 @@ type SampleArrays<'py> = (
     Bound<'py, PyArrayDyn<f32>>,
 );
 
-/// Material(*, beta, p, eta, sigma_s=0, b=1, c=2, base="conductor",
-/// albedo=None, lambertian=0, masking=None, sigma_rel=None, colour=None,
+/// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
+/// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
 /// halo_weight=None): the RGB two-scale model of one material, built once
 /// (the runtime bakes its per-material tables) and evaluated over arrays of
 /// directions.
@@ -248,8 +250,11 @@ type SampleArrays<'py> = (
 /// (n, k) pairs, red, green, blue at `RGB_WAVELENGTHS` (0.645, 0.526,
 /// 0.444 µm); `base`: one of `BASES`; `albedo`: the base layer's, in [0, 1]
 /// (plastic or subsurface only); `lambertian`: the weight k_d in [0, 1] of a
-/// Lambertian term. The options take one of their names in `OPTIONS`; None
-/// is the runtime's default (the paper's model). Parameters outside their
+/// Lambertian term. A keyword left out (None) takes the runtime's default:
+/// sigma_s = 0 (no diffraction), b = 1 µm, c = 2, base "conductor",
+/// lambertian = 0, and for the options (names in `OPTIONS`) the paper's
+/// model. The keywords are the keys of a material file's `[material]`
+/// table (`from_toml`), read by the same code. Parameters outside their
 /// domain raise `ValueError` with the runtime's message.
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
@@ -274,62 +279,67 @@ impl Material {
 #[pymethods]
 impl Material {
     #[new]
-    #[pyo3(signature = (*, beta, p, eta, sigma_s=0.0, b=1.0, c=2.0, base=None,
-        albedo=None, lambertian=0.0, masking=None, sigma_rel=None, colour=None,
+    #[pyo3(signature = (*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
+        albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
         halo_weight=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         beta: f32,
         p: f32,
         eta: Vec<[f32; 2]>, // any sequence of (n, k) sequences: tuples, or lists from TOML
-        sigma_s: f32,
-        b: f32,
-        c: f32,
+        sigma_s: Option<f32>,
+        b: Option<f32>,
+        c: Option<f32>,
         base: Option<&str>,
         albedo: Option<f32>,
-        lambertian: f32,
+        lambertian: Option<f32>,
         masking: Option<&str>,
         sigma_rel: Option<&str>,
         colour: Option<&str>,
         halo_weight: Option<&str>,
     ) -> PyResult<Self> {
-        let eta_rgb: [[f32; 2]; 3] = eta.try_into().map_err(|e: Vec<_>| {
-            value_error(format!(
-                "eta must be three (n, k) pairs (red, green, blue), got {}",
-                e.len()
-            ))
-        })?;
-        let kind: BaseKind = named(base)?;
-        let albedo = match (kind, albedo) {
-            (BaseKind::Conductor, None) => 0.0,
-            (BaseKind::Conductor, Some(_)) => {
-                return Err(value_error(format!(
-                    "albedo= is for the base layers with a diffuse albedo, not '{}'",
-                    kind.name()
-                )));
-            }
-            (_, Some(albedo)) => albedo,
-            (_, None) => {
-                return Err(value_error(format!("base '{}' needs albedo=", kind.name())));
-            }
+        // The keywords are a material description's keys (`twoscale::desc`):
+        // one reading, with its defaults and messages, for Python and TOML.
+        let keywords = Keywords {
+            beta,
+            p,
+            eta: &eta,
+            sigma_s,
+            b,
+            c,
+            base,
+            albedo,
+            lambertian,
+            masking,
+            sigma_rel,
+            colour,
+            halo_weight,
         };
-        let material = twoscale::brdf::Material {
-            layer: Layer {
-                surface: Surface {
-                    beta,
-                    p,
-                    sigma_s,
-                    b,
-                    c,
-                },
-                base: kind.with_albedo(albedo),
-                lambertian,
-            },
-            eta_rgb: eta_rgb.map(|[n, k]| Complex::new(n, k)),
-        };
-        material.validate().map_err(invalid)?;
-        let options = options(masking, sigma_rel, colour, halo_weight)?;
-        Ok(Material::build(material, options))
+        let desc = keywords
+            .material()
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(Material::build(desc.material, desc.options))
+    }
+
+    /// from_toml(path): the material of a material file (TOML: a
+    /// `[material]` table whose keys are this class's keywords, and an
+    /// optional `[metrics]` table, not read), as `python -m twoscale.fit`
+    /// writes it. Read by the runtime (`twoscale::desc`), as the C API and
+    /// the generator read it: a refused file raises `ValueError` (`OSError`
+    /// if it cannot be read) with their message, which starts with the path.
+    #[staticmethod]
+    fn from_toml(path: std::path::PathBuf) -> PyResult<Self> {
+        MaterialDesc::from_toml_file(path)
+            .map(|d| Material::build(d.material, d.options))
+            .map_err(desc_error)
+    }
+
+    /// from_toml_string(text): `from_toml` of the text of a material file.
+    #[staticmethod]
+    fn from_toml_string(text: &str) -> PyResult<Self> {
+        MaterialDesc::from_toml_str(text)
+            .map(|d| Material::build(d.material, d.options))
+            .map_err(desc_error)
     }
 
     /// preset(name, *, masking=None, sigma_rel=None, colour=None,
@@ -443,25 +453,10 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let layer = self.material.layer;
-        if layer.base != BaseLayer::Conductor || layer.lambertian != 0.0 {
-            return Err(value_error(
-                "the f64 reference covers conductors without a Lambertian term",
-            ));
-        }
+        let params =
+            ref_brdf::Params::rgb(&self.material).map_err(|e| value_error(e.to_string()))?;
         let v = vectors([("wi", wi), ("wo", wo)])?;
         let [wi, wo] = &v.rows;
-        let s = layer.surface;
-        let params: [ref_brdf::Params; 3] = std::array::from_fn(|ch| ref_brdf::Params {
-            beta: s.beta.into(),
-            p: s.p.into(),
-            sigma_s: s.sigma_s.into(),
-            b: s.b.into(),
-            c: s.c.into(),
-            n: self.material.eta_rgb[ch].re.into(),
-            k: self.material.eta_rgb[ch].im.into(),
-            lambda: twoscale::brdf::RGB_WAVELENGTHS[ch].into(),
-        });
         let options = self.options;
         let values = py.detach(|| {
             (0..v.len() * 3)

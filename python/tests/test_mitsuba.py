@@ -237,3 +237,47 @@ def test_register_needs_a_variant_and_the_module_loads_on_first_use():
     )
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_material_file(tmp_path):
+    """``filename`` loads a material file (a fit's TOML), found through
+    Mitsuba's file resolver as scene files find theirs; it gives the whole
+    material, so another material parameter with it is refused."""
+    path = tmp_path / "params.toml"
+    path.write_text(
+        "[material]\nbeta = 0.12\np = 1.4\neta = [[0.2, 3.9], [0.45, 2.5], [1.4, 1.9]]\n"
+        "sigma_s = 0.03\nb = 2.5\nc = 2.2\nlambertian = 0.02\nsigma_rel = \"symmetrised\"\n"
+        "\n[metrics]\nrmse = [0.01, 0.01, 0.01]\n",
+        encoding="utf-8",
+    )
+    material = twoscale.Material.from_toml(path)
+    explicit = mi.load_dict(tm.bsdf_dict(material))
+    from_dict = mi.load_dict({"type": "twoscale", "filename": str(path)})
+    resolver = mi.file_resolver()
+    saved = [str(resolver[k]) for k in range(len(resolver))]
+    resolver.prepend(str(tmp_path))
+    try:
+        from_xml = mi.load_string(
+            '<bsdf version="3.0.0" type="twoscale"><string name="filename" value="params.toml"/></bsdf>'
+        )
+    finally:
+        resolver.clear()
+        for entry in saved:
+            resolver.append(entry)
+    assert repr(material) in str(from_dict) and str(from_dict) == str(from_xml)
+    cam = np.array([[np.sin(0.7), 0.0, np.cos(0.7)]] * 64)
+    rng = np.random.default_rng(5)
+    light = rng.normal(size=(64, 3))
+    light[:, 2] = np.abs(light[:, 2])
+    light /= np.linalg.norm(light, axis=1, keepdims=True)
+    si, ctx = make_si(cam), mi.BSDFContext()
+    wo = mi.Vector3f(np.ascontiguousarray(light.T.astype(np.float32)))
+    want = np.asarray(explicit.eval(ctx, si, wo))
+    assert want.max() > 0
+    for bsdf in (from_dict, from_xml):
+        np.testing.assert_array_equal(np.asarray(bsdf.eval(ctx, si, wo)), want)
+    with pytest.raises(Exception, match="filename= gives the whole material, options included; remove masking"):
+        mi.load_dict({"type": "twoscale", "filename": str(path), "masking": "height-correlated"})
+    with pytest.raises(Exception, match=r"\[material\] p = 9: must be in \[0.2, 5\]"):
+        path.write_text("[material]\nbeta = 0.1\np = 9\neta = [[1, 0], [1, 0], [1, 0]]\n", encoding="utf-8")
+        mi.load_dict({"type": "twoscale", "filename": str(path)})

@@ -198,9 +198,9 @@ def test_bad_keywords_raise_value_error():
         twoscale.Material.preset("nope")
     with pytest.raises(ValueError, match="eta must be three"):
         twoscale.Material(beta=0.1, p=1, eta=GOLD[:2])
-    with pytest.raises(ValueError, match="base 'plastic' needs albedo="):
+    with pytest.raises(ValueError, match="base 'plastic' needs an albedo"):
         twoscale.Material(beta=0.1, p=1, eta=GOLD, base="plastic")
-    with pytest.raises(ValueError, match="albedo= is for the base layers with a diffuse albedo"):
+    with pytest.raises(ValueError, match="albedo is for the base layers with a diffuse albedo"):
         twoscale.Material(beta=0.1, p=1, eta=GOLD, albedo=0.5)
     with pytest.raises(ValueError, match="base must be one of 'conductor', 'plastic' or 'subsurface', got 'glass'"):
         twoscale.Material(beta=0.1, p=1, eta=GOLD, base="glass")

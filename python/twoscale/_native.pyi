@@ -6,6 +6,7 @@ these stubs give the types. Arrays of directions are ``(..., 3)``: anything
 conversion.
 """
 
+import os
 from typing import final
 
 import numpy as np
@@ -41,12 +42,12 @@ class Material:
         beta: float,
         p: float,
         eta: list[tuple[float, float]],
-        sigma_s: float = 0.0,
-        b: float = 1.0,
-        c: float = 2.0,
+        sigma_s: float | None = None,
+        b: float | None = None,
+        c: float | None = None,
         base: str | None = None,
         albedo: float | None = None,
-        lambertian: float = 0.0,
+        lambertian: float | None = None,
         masking: str | None = None,
         sigma_rel: str | None = None,
         colour: str | None = None,
@@ -63,6 +64,10 @@ class Material:
     ) -> Material: ...
     @staticmethod
     def presets() -> list[str]: ...
+    @staticmethod
+    def from_toml(path: str | os.PathLike[str]) -> Material: ...
+    @staticmethod
+    def from_toml_string(text: str) -> Material: ...
     def eval(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float32]: ...
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float32]: ...
     def sample(

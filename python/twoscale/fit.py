@@ -458,12 +458,11 @@ def fit(
 
 
 def load(path) -> Material:
-    """The material of a fit's TOML (its ``[material]`` table); for Mitsuba,
-    ``mi.load_dict(twoscale.mitsuba.bsdf_dict(load(path)))``."""
-    import tomllib
-
-    with open(path, "rb") as f:
-        return Material(**tomllib.load(f)["material"])
+    """The material of a fit's TOML (its ``[material]`` table), read by the
+    runtime as the C API and the generator read it
+    (:meth:`twoscale.Material.from_toml`); for Mitsuba,
+    ``{"type": "twoscale", "filename": path}``."""
+    return Material.from_toml(path)
 
 
 def main(argv=None):

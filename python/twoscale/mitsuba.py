@@ -2,7 +2,33 @@
 
 Call :func:`register` once after ``mi.set_variant(...)``; then
 ``{"type": "twoscale", "material": "gold-rough"}`` (a preset, options as
-string keywords) or explicit parameters (see :func:`bsdf_dict`) load it.
+string keywords), ``{"type": "twoscale", "filename": "params.toml"}`` (a
+material file, e.g. a fit's) or explicit parameters (see :func:`bsdf_dict`)
+load it. In a scene file: ``<bsdf type="twoscale"><string name="filename"
+value="params.toml"/></bsdf>``.
+
+**Parameters** (one of ``material``, ``filename`` or ``beta``/``p``/``eta``):
+
+============== ======== ====================================================
+name           type     meaning
+============== ======== ====================================================
+``material``   string   a shipped preset (``twoscale.Material.presets()``)
+``filename``   string   a material file (TOML, docs/fitting.md), read by
+                        :meth:`twoscale.Material.from_toml` after Mitsuba's
+                        file resolver; it gives every parameter and option,
+                        so no other parameter may be given with it
+``beta``, ``p`` float   the EPD's width and shape
+``eta``        string   ``"n k, n k, n k"``: the index, red, green, blue
+``sigma_s``,   float    the nano-roughness (µm, µm, exponent); defaults 0, 1, 2
+``b``, ``c``
+``base``       string   ``conductor`` (default), ``plastic``, ``subsurface``
+``albedo``     float    the base's albedo (plastic and subsurface only)
+``lambertian`` float    k_d of a Lambertian term (default 0)
+``masking``,   string   the options (``twoscale.OPTIONS``; default: the
+``sigma_rel``,          paper's model), with ``material`` or explicit
+``colour``,             parameters
+``halo_weight``
+============== ======== ====================================================
 
 **Direction convention.** Mitsuba's ``si.wi`` points towards the camera
 (the viewer), and the ``wo`` of ``eval``/``pdf``/``sample`` towards the light.
@@ -75,11 +101,21 @@ def _parse_eta(text):
 def _material(props):
     """The twoscale.Material described by a plugin's properties."""
     options = {k: props[k] for k in OPTION_KEYS if k in props}
+    if "filename" in props:
+        others = [k for k in ("material", "eta", "base", *FLOAT_KEYS, *OPTION_KEYS) if k in props]
+        if others:
+            raise ValueError(
+                "twoscale BSDF: filename= gives the whole material, options included; "
+                f"remove {', '.join(others)}"
+            )
+        path = mi.file_resolver().resolve(props["filename"])
+        return twoscale.Material.from_toml(str(path))
     if "material" in props:
         return twoscale.Material.preset(props["material"], **options)
     keywords = {k: float(props[k]) for k in FLOAT_KEYS if k in props}
     if "eta" not in props:
-        raise ValueError("twoscale BSDF: give material= (a preset) or beta=, p=, eta=, ...")
+        raise ValueError("twoscale BSDF: give material= (a preset), filename= (a material file) "
+                         "or beta=, p=, eta=, ...")
     keywords["eta"] = _parse_eta(props["eta"])
     if "base" in props:
         keywords["base"] = props["base"]

@@ -19,6 +19,7 @@ pub mod brdf;
 pub mod bxdf;
 pub mod colour;
 pub mod conv;
+pub mod desc;
 pub mod epd;
 pub mod format;
 pub mod fresnel;

@@ -309,6 +309,126 @@ impl Named for BaseKind {
     ];
 }
 
+/// The value of option `T` called `given`; `None` is `T`'s default.
+pub fn named<T: Named + Default>(given: Option<&str>) -> Result<T, UnknownName<'_>> {
+    match given {
+        None => Ok(T::default()),
+        Some(name) => T::from_name(name).ok_or(UnknownName {
+            option: T::OPTION,
+            name,
+            choices: |f| write!(f, "{}", T::choices()),
+        }),
+    }
+}
+
+/// A name that is none of an option's values ([`named`]).
+///
+/// Displays as `base must be one of 'conductor', 'plastic' or 'subsurface',
+/// got 'glass'`.
+#[derive(Clone, Copy)]
+pub struct UnknownName<'a> {
+    /// The option ([`Named::OPTION`]).
+    pub option: &'static str,
+    /// The name given.
+    pub name: &'a str,
+    /// Writes the option's names ([`Named::choices`]).
+    choices: fn(&mut fmt::Formatter<'_>) -> fmt::Result,
+}
+
+impl PartialEq for UnknownName<'_> {
+    /// The option and the name (the choices follow from the option).
+    fn eq(&self, other: &Self) -> bool {
+        self.option == other.option && self.name == other.name
+    }
+}
+
+impl fmt::Debug for UnknownName<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("UnknownName")
+            .field("option", &self.option)
+            .field("name", &self.name)
+            .finish()
+    }
+}
+
+impl fmt::Display for UnknownName<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} must be one of ", self.option)?;
+        (self.choices)(f)?;
+        write!(f, ", got '{}'", self.name)
+    }
+}
+
+/// Why a material given by its named parts (Python's keywords, a TOML
+/// table: [`crate::desc::Keywords`]) is refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Refused<'a> {
+    /// A number outside its domain.
+    Invalid(Invalid),
+    /// A name that is none of an option's values.
+    UnknownName(UnknownName<'a>),
+    /// `eta` holds another number of `(n, k)` pairs than there are channels.
+    EtaCount {
+        /// Pairs given.
+        found: usize,
+        /// Channels.
+        expected: usize,
+    },
+    /// An albedo given with `base = "conductor"`, which has no base layer.
+    AlbedoOnConductor,
+    /// A plastic or subsurface base without its albedo.
+    MissingAlbedo(BaseKind),
+}
+
+impl From<Invalid> for Refused<'_> {
+    fn from(invalid: Invalid) -> Self {
+        Refused::Invalid(invalid)
+    }
+}
+
+impl<'a> From<UnknownName<'a>> for Refused<'a> {
+    fn from(unknown: UnknownName<'a>) -> Self {
+        Refused::UnknownName(unknown)
+    }
+}
+
+impl fmt::Display for Refused<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Refused::Invalid(e) => write!(f, "{e}"),
+            Refused::UnknownName(e) => write!(f, "{e}"),
+            Refused::EtaCount { found, expected: 3 } => write!(
+                f,
+                "eta must be three (n, k) pairs (red, green, blue), got {found}"
+            ),
+            Refused::EtaCount { found, expected } => write!(
+                f,
+                "eta must be {expected} (n, k) pairs, one per wavelength, got {found}"
+            ),
+            Refused::AlbedoOnConductor => write!(
+                f,
+                "albedo is for the base layers with a diffuse albedo, not '{}'",
+                BaseKind::Conductor.name()
+            ),
+            Refused::MissingAlbedo(kind) => write!(f, "base '{}' needs an albedo", kind.name()),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Refused<'_> {}
+
+/// The base layer of `kind` with `albedo`: a plastic or subsurface base needs
+/// one, a conductor takes none. (Its range is [`Layer::validate`]'s.)
+pub fn base_layer(kind: BaseKind, albedo: Option<f32>) -> Result<BaseLayer, Refused<'static>> {
+    match (kind, albedo) {
+        (BaseKind::Conductor, None) => Ok(BaseLayer::Conductor),
+        (BaseKind::Conductor, Some(_)) => Err(Refused::AlbedoOnConductor),
+        (kind, Some(albedo)) => Ok(kind.with_albedo(albedo)),
+        (kind, None) => Err(Refused::MissingAlbedo(kind)),
+    }
+}
+
 /// `x` as the `f64` of its shortest decimal form (`0.15f32` → `0.15`, not
 /// `0.15000000596046448`), so that messages show the number the user gave.
 /// NaN and infinities are kept.

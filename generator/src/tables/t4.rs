@@ -36,7 +36,7 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use twoscale::brdf::{BaseLayer, Layer, Options, Surface, Tables};
+use twoscale::brdf::{BaseLayer, Options, Tables};
 use twoscale::format::write::{TableSpec, encode};
 use twoscale::format::{AlignedBuf, AxisHeader, Mapping, ShBrdfParams, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
@@ -44,7 +44,7 @@ use twoscale::{Complex, ShBrdfTable, TableBytes, TableId, TableSet, TwoScale};
 
 use super::{Accuracy, BuildError, GENERATOR_VERSION, TableKind, file_name};
 use crate::analytic::{BeckmannCt, StandIn};
-use crate::materials::{Base, Material, Materials};
+use crate::materials::{Material, Materials};
 use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
 use crate::sh::{IsotropicBrdf, Runtime, default_quadrature, project};
@@ -180,28 +180,6 @@ impl ModelInputs {
 /// [`twoscale::Bxdf`] interface).
 pub type TwoScaleBrdf<'a> = Runtime<TwoScale<'a>>;
 
-/// The runtime layer of `material` at `channel`: the surface, the base with
-/// that channel's albedo, the Lambertian term.
-pub fn runtime_layer(material: &Material, channel: usize) -> Layer {
-    let f = |v: f64| v as f32;
-    let albedo = f(material.base.albedo(channel));
-    Layer {
-        surface: Surface {
-            beta: f(material.beta),
-            p: f(material.p),
-            sigma_s: f(material.sigma_s),
-            b: f(material.b),
-            c: f(material.c),
-        },
-        base: match material.base {
-            Base::Conductor => BaseLayer::Conductor,
-            Base::Plastic { .. } => BaseLayer::Plastic { albedo },
-            Base::Subsurface { .. } => BaseLayer::Subsurface { albedo },
-        },
-        lambertian: f(material.lambertian),
-    }
-}
-
 /// The two-scale model of `material` at `channel` (wavelength `wavelength`
 /// µm), default options, reading `tables`.
 pub fn two_scale_brdf<'a>(
@@ -210,12 +188,11 @@ pub fn two_scale_brdf<'a>(
     wavelength: f64,
     tables: &Tables<'a>,
 ) -> TwoScaleBrdf<'a> {
-    let eta = Complex::new(material.n[channel] as f32, material.k[channel] as f32);
     Runtime(TwoScale::new(
         tables,
-        runtime_layer(material, channel),
+        material.layer,
         wavelength as f32,
-        eta,
+        material.eta[channel],
         Options::default(),
     ))
 }
@@ -224,30 +201,31 @@ pub fn two_scale_brdf<'a>(
 /// the complex Fresnel factor, the plastic base; an error for a subsurface
 /// base or a Lambertian term, which it does not model.
 pub fn stand_in_brdf(material: &Material, channel: usize) -> Result<StandIn, BuildError> {
-    let eta = Complex64::new(material.n[channel], material.k[channel]);
+    let eta = material.eta[channel];
+    let eta = Complex64::new(f64::from(eta.re), f64::from(eta.im));
     let unsupported = |what: &str| BuildError::Input {
         path: format!("material {}", material.name),
         message: format!("the Beckmann stand-in has no {what}"),
     };
-    if material.lambertian != 0.0 {
+    if material.layer.lambertian != 0.0 {
         return Err(unsupported("Lambertian term"));
     }
-    let base_factor = match &material.base {
-        Base::Conductor => 0.0,
-        Base::Subsurface { .. } => return Err(unsupported("subsurface base")),
-        Base::Plastic { albedo } => {
-            let n = material.n[channel];
+    let base_factor = match material.layer.base {
+        BaseLayer::Conductor => 0.0,
+        BaseLayer::Subsurface { .. } => return Err(unsupported("subsurface base")),
+        BaseLayer::Plastic { albedo } => {
+            let n = eta.re;
             let f_dr = fresnel::diffuse_internal(n).map_err(|source| BuildError::Quadrature {
                 at: format!("T4 {} F_dr,int(η = {n})", material.name),
                 source,
             })?;
-            let rho_d = albedo[channel];
+            let rho_d = f64::from(albedo);
             rho_d / (std::f64::consts::PI * n * n * (1.0 - rho_d * f_dr))
         }
     };
     Ok(StandIn {
         lobe: BeckmannCt {
-            alpha: material.beta,
+            alpha: f64::from(material.layer.surface.beta),
             eta: Some(eta),
         },
         base_factor,
@@ -315,25 +293,25 @@ impl ShBrdf {
 
     fn aux(&self, phi_nodes: usize) -> Vec<f32> {
         let m = &self.material;
-        let base_albedo = match &m.base {
-            Base::Conductor => 0.0,
-            Base::Plastic { albedo } | Base::Subsurface { albedo } => {
-                albedo.iter().sum::<f64>() / albedo.len() as f64
-            }
+        let base_albedo = match m.layer.base {
+            BaseLayer::Conductor => 0.0,
+            BaseLayer::Plastic { albedo } | BaseLayer::Subsurface { albedo } => albedo,
         };
+        let s = m.layer.surface;
         let mut aux = vec![
             self.projected.model().code() as f32,
             phi_nodes as f32,
-            m.beta as f32,
-            m.p as f32,
-            m.sigma_s as f32,
-            m.b as f32,
-            m.c as f32,
-            base_albedo as f32,
+            s.beta,
+            s.p,
+            s.sigma_s,
+            s.b,
+            s.c,
+            base_albedo,
         ];
         for c in 0..3 {
-            aux.push(m.n.get(c).copied().unwrap_or(0.0) as f32);
-            aux.push(m.k.get(c).copied().unwrap_or(0.0) as f32);
+            let eta = m.eta.get(c).copied().unwrap_or(Complex::new(0.0, 0.0));
+            aux.push(eta.re);
+            aux.push(eta.im);
         }
         debug_assert_eq!(aux.len(), AUX_NAMES.len());
         aux

@@ -14,7 +14,9 @@
 use std::f64::consts::PI;
 use std::fmt;
 
-use twoscale::brdf::{ColourTerms, HaloWeight, Masking, Options, SigmaRelMode};
+use twoscale::brdf::{
+    BaseLayer, ColourTerms, HaloWeight, Masking, Material, Options, RGB_WAVELENGTHS, SigmaRelMode,
+};
 
 use crate::quad::QuadError;
 use crate::reference::conv::ConvError;
@@ -83,6 +85,42 @@ pub struct Params {
     /// Wavelength (µm).
     pub lambda: f64,
 }
+
+impl Params {
+    /// The parameters of each channel of an RGB `material` (red, green, blue
+    /// at [`RGB_WAVELENGTHS`]), if the reference covers it: a conductor
+    /// without a Lambertian term.
+    pub fn rgb(material: &Material) -> Result<[Params; 3], Uncovered> {
+        let layer = material.layer;
+        if layer.base != BaseLayer::Conductor || layer.lambertian != 0.0 {
+            return Err(Uncovered);
+        }
+        let s = layer.surface;
+        Ok(std::array::from_fn(|ch| Params {
+            beta: s.beta.into(),
+            p: s.p.into(),
+            sigma_s: s.sigma_s.into(),
+            b: s.b.into(),
+            c: s.c.into(),
+            n: material.eta_rgb[ch].re.into(),
+            k: material.eta_rgb[ch].im.into(),
+            lambda: RGB_WAVELENGTHS[ch].into(),
+        }))
+    }
+}
+
+/// A material the reference does not cover ([`Params::rgb`]): a base layer
+/// or a Lambertian term.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Uncovered;
+
+impl fmt::Display for Uncovered {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("the f64 reference covers conductors without a Lambertian term")
+    }
+}
+
+impl std::error::Error for Uncovered {}
 
 /// The three terms of ρ (sr⁻¹): `A_spec ρ_CT`, `ρ_CTD`, and their sum.
 #[derive(Clone, Copy, Debug, PartialEq)]
