@@ -16,7 +16,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use suite::brdf::NarrowNdfConvolution;
 use suite::cost::{BATCH, Inputs, LAMBDA, NICKEL_LIKE, RGB_PRESET, ggx, nickel, rgb_preset};
-use twoscale::brdf::{IntegratedRgb, Options, Rgb, TwoScale};
+use twoscale::brdf::{IntegratedRgb, Options, Rgb, Spectral, TwoScale};
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 use twoscale::{Convolution, TableSet};
 
@@ -112,13 +112,36 @@ fn brdf(c: &mut Criterion) {
     // The same preset in linear sRGB by integration over the spectrum
     // (docs/design/rgb-integration.md): 8 wavelengths and the colour weights.
     let tables = set.brdf_tables();
-    let spectral = materials::spectral(RGB_PRESET).expect("preset");
-    let integrated = IntegratedRgb::boxed(&tables, &spectral, Options::default());
+    let gold_spectral = materials::spectral(RGB_PRESET).expect("preset");
+    let integrated = IntegratedRgb::boxed(&tables, &gold_spectral, Options::default());
     group.bench_function("two_scale_eval_rgb_integrated_t3b", |b| {
         b.iter(|| {
             let mut sum = 0.0f32;
             for &(i, o) in &pairs {
                 sum += integrated.eval(black_box(i), black_box(o))[1];
+            }
+            sum
+        })
+    });
+    // Any wavelength from one construction (HP17's nickel geometry with
+    // nickel's measured index, the `nickel` preset), at λ = LAMBDA, and at
+    // four wavelengths per call.
+    let nickel_spectral = materials::spectral("nickel").expect("preset");
+    let spectral = Spectral::boxed(&tables, &nickel_spectral, Options::default());
+    group.bench_function("two_scale_eval_spectral_t3b", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += spectral.eval(black_box(i), black_box(o), LAMBDA);
+            }
+            sum
+        })
+    });
+    group.bench_function("two_scale_eval4_spectral_t3b", |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += spectral.eval4(black_box(i), black_box(o), [0.45, 0.53, 0.61, 0.69])[1];
             }
             sum
         })
@@ -157,9 +180,22 @@ fn brdf(c: &mut Criterion) {
             )
         })
     });
+    setup.bench_function("spectral_preset", |b| {
+        b.iter(|| {
+            Spectral::boxed(
+                &set.brdf_tables(),
+                black_box(&nickel_spectral),
+                Options::default(),
+            )
+        })
+    });
     setup.bench_function("rgb_integrated_preset", |b| {
         b.iter(|| {
-            IntegratedRgb::boxed(&set.brdf_tables(), black_box(&spectral), Options::default())
+            IntegratedRgb::boxed(
+                &set.brdf_tables(),
+                black_box(&gold_spectral),
+                Options::default(),
+            )
         })
     });
     setup.finish();

@@ -62,7 +62,9 @@ use core::f64::consts::PI;
 use zerocopy::FromZeros;
 
 mod integrated;
+mod spectral;
 pub use integrated::{INTEGRATED_COUNT, INTEGRATED_WAVELENGTHS, IntegratedRgb};
+pub use spectral::{SPECTRAL_COUNT, SPECTRAL_WAVELENGTHS, Spectral};
 
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];

@@ -121,6 +121,45 @@ impl ColourBake {
     }
 }
 
+/// The models of `material` at `wavelengths`, with `η(λ_k)`, baked into
+/// `bakes` in place; G1 and the visible-slope tables (wavelength
+/// independent) are baked once and copied.
+pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
+    bakes: [B; N],
+    tables: &Tables<'a>,
+    material: &SpectralMaterial<'_>,
+    options: Options,
+    wavelengths: &[f32; N],
+) -> [TwoScale<'a, B>; N] {
+    let shared = SurfaceBakes::new(tables, material.layer.surface);
+    let mut k = 0;
+    let mut nodes = bakes.map(|bake| {
+        let lambda = wavelengths[k];
+        k += 1;
+        TwoScale::around(
+            bake,
+            tables,
+            &shared,
+            material.layer,
+            lambda,
+            material.eta.at(lambda),
+            options,
+        )
+    });
+    let (first, rest) = nodes.split_at_mut(1);
+    let first = first[0].bake.borrow_mut();
+    shared.bake_into(tables, first);
+    for node in rest {
+        let bake = node.bake.borrow_mut();
+        bake.masking.clone_from(&first.masking);
+        bake.visible.clone_from(&first.visible);
+    }
+    for (node, &lambda) in nodes.iter_mut().zip(wavelengths) {
+        node.bake_wavelength(tables, &shared, material.eta.at(lambda));
+    }
+    nodes
+}
+
 /// The two-scale BRDF in linear sRGB by integration over the spectrum
 /// (module documentation): one [`TwoScale`] per wavelength of
 /// [`INTEGRATED_WAVELENGTHS`] sharing the surface's bakes, and the colour
@@ -153,32 +192,7 @@ impl<'a, B: BorrowMut<ChannelBake>> IntegratedRgb<'a, B> {
         material: &SpectralMaterial<'_>,
         options: Options,
     ) -> Self {
-        let shared = SurfaceBakes::new(tables, material.layer.surface);
-        let mut k = 0;
-        let mut nodes = bakes.map(|bake| {
-            let lambda = INTEGRATED_WAVELENGTHS[k];
-            k += 1;
-            TwoScale::around(
-                bake,
-                tables,
-                &shared,
-                material.layer,
-                lambda,
-                material.eta.at(lambda),
-                options,
-            )
-        });
-        let (first, rest) = nodes.split_at_mut(1);
-        let first = first[0].bake.borrow_mut();
-        shared.bake_into(tables, first);
-        for node in rest {
-            let bake = node.bake.borrow_mut();
-            bake.masking.clone_from(&first.masking);
-            bake.visible.clone_from(&first.visible);
-        }
-        for (node, lambda) in nodes.iter_mut().zip(INTEGRATED_WAVELENGTHS) {
-            node.bake_wavelength(tables, &shared, material.eta.at(lambda));
-        }
+        let nodes = models_at(bakes, tables, material, options, &INTEGRATED_WAVELENGTHS);
         let colour = ColourBake::new(material, options.colour == ColourTerms::White);
         IntegratedRgb { nodes, colour }
     }

@@ -1,0 +1,175 @@
+//! The model at any wavelength of [0.36, 0.83] µm from one construction
+//! (docs/model.md §2.10): models at [`SPECTRAL_WAVELENGTHS`] sharing the
+//! surface's bakes, their surface lobes divided by F(θd) at their
+//! wavelength, interpolated linearly in λ and multiplied by F(θd) at λ:
+//!
+//! ```text
+//! ρ(i,o,λ) ≈ F(η(λ), θd) Σ_k hat_k(λ) [ρ_spec + ρ_CTD](λ_k)/F(η(λ_k), θd) + Σ_k hat_k(λ) ρ_base(λ_k)
+//! ```
+//!
+//! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
+//! computed at λ per call (η(λ) from a 5 nm table of the material's index,
+//! F in closed form); the rest of ρ is smooth in λ. `sample` and `pdf` at λ
+//! are those of the model nearest λ.
+
+use super::integrated::models_at;
+use super::{ChannelBake, ColourTerms, Lobes, Options, Sample, Tables, TwoScale, finite_or_zero};
+use crate::fresnel::{Complex, fresnel};
+use crate::math;
+use crate::optical::SpectralMaterial;
+use core::borrow::{Borrow, BorrowMut};
+
+/// Number of wavelengths of [`Spectral`].
+pub const SPECTRAL_COUNT: usize = 11;
+
+/// The wavelengths of [`Spectral`]'s models, µm: [0.36, 0.83], 0.04 apart
+/// where the eye is most sensitive, wider towards the red end.
+pub const SPECTRAL_WAVELENGTHS: [f32; SPECTRAL_COUNT] = [
+    0.36, 0.40, 0.44, 0.48, 0.52, 0.56, 0.60, 0.64, 0.69, 0.76, 0.83,
+];
+
+/// Nodes of the 5 nm table of η.
+const ETA_NODES: usize = 95;
+/// First node and spacing of the table of η, µm.
+const ETA_FIRST: f32 = 0.36;
+const ETA_STEP: f32 = 0.005;
+
+/// The hats' cell of `lambda` on `nodes` (held at the ends): `(k, f)` with
+/// `hat_k = 1 − f`, `hat_{k+1} = f`.
+#[inline]
+fn cell(nodes: &[f32], lambda: f32) -> (usize, f32) {
+    let mut k = 0;
+    while k + 2 < nodes.len() && lambda > nodes[k + 1] {
+        k += 1;
+    }
+    let (a, b) = (nodes[k], nodes[k + 1]);
+    let f = (lambda - a) / (b - a);
+    // NaN → 0.
+    (k, if f > 0.0 { f.min(1.0) } else { 0.0 })
+}
+
+/// The two-scale BRDF at any wavelength of [0.36, 0.83] µm (module
+/// documentation); wavelengths outside are clamped to it. The bakes are held
+/// as `B` as [`TwoScale`]'s: boxed (`Spectral::boxed`, feature `std`) or in
+/// caller-provided storage ([`Spectral::new_in`]); 11 × 45 KB.
+#[derive(Clone)]
+pub struct Spectral<'a, B = ChannelBake> {
+    nodes: [TwoScale<'a, B>; SPECTRAL_COUNT],
+    /// η every 5 nm from 0.36 µm.
+    eta: [Complex; ETA_NODES],
+    white: bool,
+}
+
+#[cfg(feature = "std")]
+impl<'a> Spectral<'a, std::boxed::Box<ChannelBake>> {
+    /// [`Spectral::new_in`] with the bakes on the heap.
+    pub fn boxed(tables: &Tables<'a>, material: &SpectralMaterial<'_>, options: Options) -> Self {
+        let bakes = core::array::from_fn(|_| ChannelBake::boxed());
+        Self::new_in(bakes, tables, material, options)
+    }
+}
+
+impl<'a, B: BorrowMut<ChannelBake>> Spectral<'a, B> {
+    /// The model of `material` baked into `bakes` in place (see
+    /// [`TwoScale::new_in`]; sanitised as [`TwoScale::new`]).
+    pub fn new_in(
+        bakes: [B; SPECTRAL_COUNT],
+        tables: &Tables<'a>,
+        material: &SpectralMaterial<'_>,
+        options: Options,
+    ) -> Self {
+        Spectral {
+            nodes: models_at(bakes, tables, material, options, &SPECTRAL_WAVELENGTHS),
+            eta: core::array::from_fn(|j| material.eta.at(ETA_FIRST + ETA_STEP * j as f32)),
+            white: options.colour == ColourTerms::White,
+        }
+    }
+}
+
+impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
+    /// The one-wavelength models, at [`SPECTRAL_WAVELENGTHS`].
+    pub fn nodes(&self) -> &[TwoScale<'_, B>; SPECTRAL_COUNT] {
+        &self.nodes
+    }
+
+    /// λ clamped to [0.36, 0.83] µm (NaN → 0.36).
+    #[inline]
+    fn clamped(lambda: f32) -> f32 {
+        let (lo, hi) = (
+            SPECTRAL_WAVELENGTHS[0],
+            SPECTRAL_WAVELENGTHS[SPECTRAL_COUNT - 1],
+        );
+        if lambda > lo { lambda.min(hi) } else { lo }
+    }
+
+    /// η at `lambda` (clamped), linear between the 5 nm nodes.
+    fn eta_at(&self, lambda: f32) -> Complex {
+        let t = (lambda - ETA_FIRST) / ETA_STEP;
+        let j = (math::floor(f64::from(t.max(0.0))) as usize).min(ETA_NODES - 2);
+        let f = (t - j as f32).max(0.0).min(1.0);
+        let (a, b) = (self.eta[j], self.eta[j + 1]);
+        Complex::new(a.re + f * (b.re - a.re), a.im + f * (b.im - a.im))
+    }
+
+    /// ρ(i, o) at `lambda` µm (module documentation). 0 below the horizon.
+    pub fn eval(&self, i: [f32; 3], o: [f32; 3], lambda: f32) -> f32 {
+        self.eval4(i, o, [lambda; 4])[0]
+    }
+
+    /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
+    /// the pair's geometry, D and G once, each model needed once.
+    pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
+        let Some(pair) = self.nodes[0].pair(i, o) else {
+            return [0.0; 4];
+        };
+        let cos_d = pair.geometry.cos_d as f32;
+        // Each model's lobes and F(θd), computed when first needed.
+        let mut done: [Option<(Lobes, f64)>; SPECTRAL_COUNT] = [None; SPECTRAL_COUNT];
+        let mut at = |k: usize| -> (Lobes, f64) {
+            *done[k].get_or_insert_with(|| {
+                let node = &self.nodes[k];
+                (node.lobes(&pair), node.fresnel_at(pair.cells[2]))
+            })
+        };
+        lambdas.map(|lambda| {
+            let lambda = Self::clamped(lambda);
+            let (k, f) = cell(&SPECTRAL_WAVELENGTHS, lambda);
+            let (a, fa) = at(k);
+            let (b, fb) = at(k + 1);
+            let f = f64::from(f);
+            let surface = |l: &Lobes| f64::from(l.specular) + f64::from(l.diffraction);
+            let value = if self.white || !(fa > 0.0 && fb > 0.0) {
+                (1.0 - f) * f64::from(a.total()) + f * f64::from(b.total())
+            } else {
+                let fl = f64::from(fresnel(self.eta_at(lambda), cos_d));
+                fl * ((1.0 - f) * surface(&a) / fa + f * surface(&b) / fb)
+                    + (1.0 - f) * f64::from(a.base)
+                    + f * f64::from(b.base)
+            };
+            finite_or_zero(value.max(0.0))
+        })
+    }
+
+    /// The model whose sampler serves `lambda`: the nearest of
+    /// [`SPECTRAL_WAVELENGTHS`].
+    fn nearest(&self, lambda: f32) -> &TwoScale<'_, B> {
+        let (k, f) = cell(&SPECTRAL_WAVELENGTHS, Self::clamped(lambda));
+        &self.nodes[if f < 0.5 { k } else { k + 1 }]
+    }
+
+    /// The density of [`Spectral::sample`] at `lambda`.
+    pub fn pdf(&self, i: [f32; 3], o: [f32; 3], lambda: f32) -> f32 {
+        self.nearest(lambda).pdf(i, o)
+    }
+
+    /// Samples an outgoing direction for the (hero) wavelength `lambda`
+    /// with the sampler of the nearest model; the value is
+    /// [`Spectral::eval`] at `lambda`.
+    pub fn sample(&self, i: [f32; 3], u: [f32; 3], lambda: f32) -> Option<Sample> {
+        let s = self.nearest(lambda).sample(i, u)?;
+        Some(Sample {
+            value: self.eval(i, s.o, lambda),
+            ..s
+        })
+    }
+}
