@@ -16,7 +16,7 @@
 mod merl;
 
 use std::collections::BTreeMap;
-use std::sync::LazyLock;
+use std::sync::{LazyLock, OnceLock};
 
 use numpy::ndarray::{Array1, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
@@ -28,7 +28,9 @@ use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options,
     SigmaRelMode, Surface,
 };
+use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
+use twoscale::optical::{Ior, SpectralMaterial};
 use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Bxdf, Complex, Convolution, Rgb, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
@@ -261,6 +263,11 @@ struct Material {
     model: Box<Rgb<'static, Box<ChannelBake>>>,
     material: twoscale::brdf::Material,
     options: Options,
+    /// The index over the spectrum: a preset's measured one, or the one
+    /// index of a material that gives the same (n, k) for every channel.
+    spectral: Option<SpectralMaterial<'static>>,
+    /// `spectral`'s model at any wavelength, built by the first `eval_spectral`.
+    spectral_model: OnceLock<Box<Spectral<'static, Box<ChannelBake>>>>,
 }
 
 impl Material {
@@ -268,10 +275,30 @@ impl Material {
     /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
     /// is enough (`tests/test_small_stack.py`).
     fn build(material: twoscale::brdf::Material, options: Options) -> Self {
+        let [first, ..] = material.eta_rgb;
+        let spectral =
+            material
+                .eta_rgb
+                .iter()
+                .all(|&eta| eta == first)
+                .then_some(SpectralMaterial {
+                    layer: material.layer,
+                    eta: Ior::Constant(first),
+                });
+        Material::with_spectrum(material, options, spectral)
+    }
+
+    fn with_spectrum(
+        material: twoscale::brdf::Material,
+        options: Options,
+        spectral: Option<SpectralMaterial<'static>>,
+    ) -> Self {
         Material {
             model: Box::new(Rgb::boxed(&TABLES.brdf_tables(), &material, options)),
             material,
             options,
+            spectral,
+            spectral_model: OnceLock::new(),
         }
     }
 }
@@ -355,10 +382,14 @@ impl Material {
         colour: Option<&str>,
         halo_weight: Option<&str>,
     ) -> PyResult<Self> {
-        let material = twoscale::materials::preset(name)
+        let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
         let options = options(masking, sigma_rel, colour, halo_weight)?;
-        Ok(Material::build(material, options))
+        Ok(Material::with_spectrum(
+            spectral.paper_rgb(),
+            options,
+            Some(spectral),
+        ))
     }
 
     /// presets(): the names of the shipped presets, for `Material.preset`.
@@ -387,6 +418,60 @@ impl Material {
         let ([wi, wo], model) = (&v.rows, &*self.model);
         let values = py.detach(|| rows(v.len(), |k| Bxdf::eval(model, wi[k], wo[k])));
         Ok(shaped_vectors(py, &v.shape, values))
+    }
+
+    /// eval_spectral(wi, wo, lam): ρ(wi, wo) in sr⁻¹ at the wavelength `lam`
+    /// (µm, in [0.36, 0.83]), float32 of the broadcast leading shape of `wi`,
+    /// `wo` (`(..., 3)`) and `lam` (`(...)`), from one construction that
+    /// serves every wavelength (`twoscale::brdf::Spectral`, docs/model.md
+    /// §2.10; built by the first call). For presets (their measured index)
+    /// and materials whose `eta` is one (n, k) for every channel; other
+    /// materials, and `lam` outside the range, raise `ValueError`.
+    fn eval_spectral<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let Some(spectral) = &self.spectral else {
+            return Err(value_error(
+                "eval_spectral needs an index over the spectrum: a preset, or one (n, k) for every channel",
+            ));
+        };
+        // lam as a (..., 3) array, to broadcast with the directions.
+        let np = PyModule::import(py, "numpy")?;
+        let lam = np.call_method1("asarray", (lam, "float64")).map_err(|_| {
+            value_error(format!(
+                "lam must be an array of numbers (µm), got {}",
+                describe(lam)
+            ))
+        })?;
+        let lam3 = np.call_method1(
+            "repeat",
+            (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
+        )?;
+        let v = vectors([("wi", wi), ("wo", wo), ("lam", &lam3)])?;
+        let [wi, wo, lam] = &v.rows;
+        let (lo, hi) = (
+            SPECTRAL_WAVELENGTHS[0],
+            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+        );
+        if let Some(k) = lam.iter().position(|l| !(l[0] >= lo && l[0] <= hi)) {
+            return Err(value_error(format!(
+                "lam must be in [{lo}, {hi}] µm, got {} at row {k}",
+                lam[k][0]
+            )));
+        }
+        let model = self.spectral_model.get_or_init(|| {
+            Box::new(Spectral::boxed(
+                &TABLES.brdf_tables(),
+                spectral,
+                self.options,
+            ))
+        });
+        let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k], lam[k][0])));
+        Ok(shaped(py, &v.shape, values))
     }
 
     /// pdf(wi, wo): the solid-angle density (sr⁻¹) of `sample(wi, ·)` at

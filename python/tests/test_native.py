@@ -305,3 +305,41 @@ def test_explicit_material_equals_preset():
     assert m.options["sigma_rel"] == "symmetrised"
     wi, wo = hemisphere(100), hemisphere(100)
     np.testing.assert_array_equal(m.eval(wi, wo), ref.eval(wi, wo))
+
+
+def test_eval_spectral_matches_the_rgb_channels_at_their_wavelengths():
+    """At the paper's wavelengths the spectral model of a preset is its RGB
+    model's channel (the spectral model interpolates between models 0.04 µm
+    apart, docs/model.md §2.10: within 0.5%)."""
+    gold = twoscale.Material.preset("gold-rough")
+    n = 2000
+    wi = hemisphere(n)
+    wo, pdf, _ = gold.sample(wi, RNG.random((n, 3)))
+    ok = pdf > 0
+    wi, wo = wi[ok], wo[ok]
+    rgb = gold.eval(wi, wo)
+    for ch, lam in enumerate(twoscale.RGB_WAVELENGTHS):
+        spectral = gold.eval_spectral(wi, wo, lam)
+        assert spectral.shape == (len(wi),)
+        big = rgb[:, ch] > 1e-3 * rgb[:, ch].max()
+        np.testing.assert_allclose(spectral[big], rgb[big, ch], rtol=5e-3)
+
+
+def test_eval_spectral_broadcasts_and_refuses():
+    gold = twoscale.Material.preset("gold-hp17-geometry")
+    wi = np.array([0.5, 0.0, 0.866])
+    wo = np.array([-0.45, 0.05, 0.89])
+    lam = np.linspace(0.36, 0.83, 7)
+    out = gold.eval_spectral(wi, wo, lam)
+    assert out.shape == (7,)
+    for k, l in enumerate(lam):
+        assert out[k] == gold.eval_spectral(wi, wo, l)
+    assert gold.eval_spectral(wi, wo, 0.5).shape == ()
+    with pytest.raises(ValueError, match=r"lam must be in \[0.36, 0.83\]"):
+        gold.eval_spectral(wi, wo, [0.5, 0.9])
+    # One index for every channel: a constant index over the spectrum.
+    grey = twoscale.Material(beta=0.2, p=1.0, eta=[(1.5, 3.0)] * 3)
+    assert grey.eval_spectral(wi, wo, 0.6) > 0
+    per_channel = twoscale.Material(beta=0.2, p=1.0, eta=[(0.2, 3.5), (0.5, 2.2), (1.4, 1.9)])
+    with pytest.raises(ValueError, match="index over the spectrum"):
+        per_channel.eval_spectral(wi, wo, 0.6)
