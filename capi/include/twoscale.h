@@ -457,6 +457,26 @@ int ts_eval_rgb(const ts_material *m,
                 float out[3]);
 
 /**
+ * ρ(wi, wo) (sr⁻¹) at four wavelengths `lambda` (µm, each in
+ * [0.36, 0.83]) into `out`, as spectral renderers carry them: the model that
+ * serves every wavelength from one construction (docs/model.md §2.10),
+ * built by the first call on the material (milliseconds; thread-safe). For
+ * presets (their measured index) and materials whose `eta` is one (n, k)
+ * for every channel; other materials give `TS_ERR_INVALID`, as does a
+ * wavelength outside the range or a non-finite direction.
+ *
+ * # Safety
+ *
+ * `m` is NULL or a live material; `wi`, `wo` are NULL or hold 3 floats,
+ * `lambda` and `out` NULL or 4.
+ */
+int ts_eval_spectral(const ts_material *m,
+                     const float wi[3],
+                     const float wo[3],
+                     const float lambda[4],
+                     float out[4]);
+
+/**
  * The sampling density of `wo` given `wi` (solid angle), the density of
  * `ts_sample_rgb`, into `*pdf`.
  *

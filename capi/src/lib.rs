@@ -23,9 +23,11 @@ use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
     RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
 };
+use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
+use twoscale::optical::{Ior, SpectralMaterial};
 use twoscale::table_set::TABLES;
 use twoscale::validate::{self, Domain, Invalid};
 use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
@@ -85,6 +87,13 @@ pub struct ts_material {
     /// Borrows `_tables` (declared after it, so dropped before it); its
     /// bakes are allocated zeroed on the heap and filled in place.
     rgb: Rgb<'static, Box<ChannelBake>>,
+    /// The index over the spectrum (a preset's measured one, or the one
+    /// index of a description that gives the same for every channel).
+    spectral: Option<SpectralMaterial<'static>>,
+    /// `spectral`'s model at any wavelength, built by the first
+    /// `ts_eval_spectral`; borrows `_tables` as `rgb` does.
+    spectral_model: OnceLock<Spectral<'static, Box<ChannelBake>>>,
+    options: Options,
     _tables: Arc<OwnedTableSet>,
 }
 
@@ -549,6 +558,24 @@ fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
 
 /// Builds the material handle of `material` from the set behind `t`.
 fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
+    let first = material.eta_rgb[0];
+    let spectral = material
+        .eta_rgb
+        .iter()
+        .all(|&eta| eta == first)
+        .then_some(SpectralMaterial {
+            layer: material.layer,
+            eta: Ior::Constant(first),
+        });
+    new_material_with(t, material, options, spectral)
+}
+
+fn new_material_with(
+    t: &ts_tables,
+    material: &Material,
+    options: Options,
+    spectral: Option<SpectralMaterial<'static>>,
+) -> Box<ts_material> {
     let rgb = Rgb::boxed(&t.inner.set().brdf_tables(), material, options);
     // SAFETY: `rgb` borrows only the `TableSet` inside the `Arc` allocation
     // (which never moves) and, through it, the table storage it owns. The
@@ -559,6 +586,9 @@ fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_
     };
     Box::new(ts_material {
         rgb,
+        spectral,
+        spectral_model: OnceLock::new(),
+        options,
         _tables: Arc::clone(&t.inner),
     })
 }
@@ -825,12 +855,17 @@ pub unsafe extern "C" fn ts_material_preset(
     handle(|| {
         non_null(t, "the tables")?;
         let name = utf8(name, "name")?;
-        let material = twoscale::materials::preset(name).ok_or_else(|| {
+        let spectral = twoscale::materials::spectral(name).ok_or_else(|| {
             Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name })
         })?;
         // SAFETY: non-null, a live handle by the caller's contract.
         let t = unsafe { &*t };
-        Ok(new_material(t, &material, Options::default()))
+        Ok(new_material_with(
+            t,
+            &spectral.paper_rgb(),
+            Options::default(),
+            Some(spectral),
+        ))
     })
 }
 
@@ -912,6 +947,77 @@ pub unsafe extern "C" fn ts_eval_rgb(
 ) -> c_int {
     // SAFETY: forwarded caller contract; one direction pair is a batch of 1.
     unsafe { ts_eval_rgb_batch(m, 1, wi, wo, out) }
+}
+
+/// ρ(wi, wo) (sr⁻¹) at four wavelengths `lambda` (µm, each in
+/// [0.36, 0.83]) into `out`, as spectral renderers carry them: the model that
+/// serves every wavelength from one construction (docs/model.md §2.10),
+/// built by the first call on the material (milliseconds; thread-safe). For
+/// presets (their measured index) and materials whose `eta` is one (n, k)
+/// for every channel; other materials give `TS_ERR_INVALID`, as does a
+/// wavelength outside the range or a non-finite direction.
+///
+/// # Safety
+///
+/// `m` is NULL or a live material; `wi`, `wo` are NULL or hold 3 floats,
+/// `lambda` and `out` NULL or 4.
+/// cbindgen:ptrs-as-arrays=[[wi;3], [wo;3], [lambda;4], [out;4]]
+// The annotation's brackets are cbindgen syntax, not links.
+#[allow(rustdoc::broken_intra_doc_links)]
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_eval_spectral(
+    m: *const ts_material,
+    wi: *const f32,
+    wo: *const f32,
+    lambda: *const f32,
+    out: *mut f32,
+) -> c_int {
+    status(|| {
+        // SAFETY: the caller's contract.
+        let m = unsafe { material(m) }?;
+        floats(wi, "wi")?;
+        floats(wo, "wo")?;
+        floats(lambda, "lambda")?;
+        floats(out, "out")?;
+        // SAFETY: checked pointers; the caller gives 3, 3 and 4 floats.
+        let (i, o) = unsafe { (read3(wi, 0, "wi")?, read3(wo, 0, "wo")?) };
+        // SAFETY: as above.
+        let lambdas: [f32; 4] = unsafe { [0, 1, 2, 3].map(|k| lambda.add(k).read()) };
+        let (lo, hi) = (
+            SPECTRAL_WAVELENGTHS[0],
+            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+        );
+        if let Some(k) = lambdas.iter().position(|l| !(*l >= lo && *l <= hi)) {
+            return Err(Fail::new(
+                TS_ERR_INVALID,
+                format!("lambda[{k}] = {} is not in [{lo}, {hi}] µm", lambdas[k]),
+            ));
+        }
+        let Some(spectral) = &m.spectral else {
+            return Err(Fail::new(
+                TS_ERR_INVALID,
+                "ts_eval_spectral needs an index over the spectrum: a preset, or one (n, k) for every channel",
+            ));
+        };
+        let model = m.spectral_model.get_or_init(|| {
+            let model = Spectral::boxed(&m._tables.set().brdf_tables(), spectral, m.options);
+            // SAFETY: as in `new_material_with`: the model borrows only the
+            // `TableSet` inside the `Arc` the handle keeps (`_tables`,
+            // declared after `spectral_model`, so dropped after it).
+            unsafe {
+                std::mem::transmute::<
+                    Spectral<'_, Box<ChannelBake>>,
+                    Spectral<'static, Box<ChannelBake>>,
+                >(model)
+            }
+        });
+        let values = model.eval4(i, o, lambdas);
+        for (k, v) in values.iter().enumerate() {
+            // SAFETY: `out` holds 4 floats by the caller's contract.
+            unsafe { out.add(k).write(*v) };
+        }
+        Ok(())
+    })
 }
 
 /// The sampling density of `wo` given `wi` (solid angle), the density of

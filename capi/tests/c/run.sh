@@ -21,7 +21,7 @@ fi
 cargo build -p twoscale-capi -p generator --release --locked
 lib=target/release
 cflags=(-std=c11 -Wall -Wextra -Werror -pedantic -O2 -g -I capi/include)
-for t in misuse query_rows small_stack material_file; do
+for t in misuse query_rows small_stack material_file spectral; do
   cc "${cflags[@]}" "capi/tests/c/$t.c" -L "$lib" -ltwoscale_capi -Wl,-rpath,"$PWD/$lib" \
     -lm -lpthread -o "$out/$t"
 done
@@ -38,6 +38,7 @@ memcheck=(valgrind --error-exitcode=1 --leak-check=full
 "${memcheck[@]}" "$out/query_rows" compare "$out/answered.csv" "$materials" "$pairs"
 "${memcheck[@]}" "$out/small_stack"
 "${memcheck[@]}" "$out/material_file" check "$out"
+"${memcheck[@]}" "$out/spectral"
 
 # docs/c-api.md verbatim: its one ```c block saved as example.c at the root
 # and the ```sh block of "Build and link" run there (it builds and runs
