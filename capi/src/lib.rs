@@ -27,7 +27,7 @@ use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
-use twoscale::optical::{Ior, SpectralMaterial};
+use twoscale::optical::SpectralMaterial;
 use twoscale::table_set::TABLES;
 use twoscale::validate::{self, Domain, Invalid};
 use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
@@ -558,15 +558,7 @@ fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
 
 /// Builds the material handle of `material` from the set behind `t`.
 fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
-    let first = material.eta_rgb[0];
-    let spectral = material
-        .eta_rgb
-        .iter()
-        .all(|&eta| eta == first)
-        .then_some(SpectralMaterial {
-            layer: material.layer,
-            eta: Ior::Constant(first),
-        });
+    let spectral = SpectralMaterial::with_one_index(material);
     new_material_with(t, material, options, spectral)
 }
 

@@ -30,7 +30,7 @@ use twoscale::brdf::{
 };
 use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
-use twoscale::optical::{Ior, SpectralMaterial};
+use twoscale::optical::SpectralMaterial;
 use twoscale::validate::{self, Invalid, Named};
 use twoscale::{Bxdf, Complex, Convolution, Rgb, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
@@ -275,16 +275,7 @@ impl Material {
     /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
     /// is enough (`tests/test_small_stack.py`).
     fn build(material: twoscale::brdf::Material, options: Options) -> Self {
-        let [first, ..] = material.eta_rgb;
-        let spectral =
-            material
-                .eta_rgb
-                .iter()
-                .all(|&eta| eta == first)
-                .then_some(SpectralMaterial {
-                    layer: material.layer,
-                    eta: Ior::Constant(first),
-                });
+        let spectral = SpectralMaterial::with_one_index(&material);
         Material::with_spectrum(material, options, spectral)
     }
 

@@ -145,6 +145,21 @@ impl SpectralMaterial<'_> {
         }
     }
 
+    /// `material` over the spectrum when it has one index for every channel
+    /// (a constant [`Ior`]); `None` when its channels' indices differ (they
+    /// are no spectrum).
+    pub fn with_one_index(material: &Material) -> Option<SpectralMaterial<'static>> {
+        let first = material.eta_rgb[0];
+        material
+            .eta_rgb
+            .iter()
+            .all(|&eta| eta == first)
+            .then_some(SpectralMaterial {
+                layer: material.layer,
+                eta: Ior::Constant(first),
+            })
+    }
+
     /// Checks the layer ([`Layer::validate`]) and the index (every row, or
     /// the constant, as [`validate::eta`]).
     pub fn validate(&self) -> Result<(), Invalid> {
@@ -278,6 +293,16 @@ mod tests {
         let eta = t.at(mid);
         assert!((eta.re - 0.5 * (a[1] + b[1])).abs() < 1e-5);
         assert!((eta.im - 0.5 * (a[2] + b[2])).abs() < 1e-5);
+    }
+
+    #[test]
+    fn one_index_for_every_channel_is_a_spectrum() {
+        let mut m = crate::materials::preset("gold-rough").unwrap();
+        assert_eq!(SpectralMaterial::with_one_index(&m), None);
+        m.eta_rgb = [Complex::new(1.5, 2.0); 3];
+        let s = SpectralMaterial::with_one_index(&m).unwrap();
+        assert_eq!(s.eta, Ior::Constant(Complex::new(1.5, 2.0)));
+        assert_eq!(s.paper_rgb(), m);
     }
 
     #[test]
