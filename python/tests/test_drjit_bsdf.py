@@ -1,8 +1,71 @@
-"""The Dr.Jit port of the model (twoscale.drjit_bsdf) against the runtime."""
+"""The Dr.Jit port of the model (``twoscale.drjit_bsdf``) against the runtime,
+in ``llvm_ad_rgb`` with Mitsuba's default symbolic loops and calls."""
+
+import os
 
 import numpy as np
+import pytest
 
-import twoscale
+LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if os.path.exists(LLVM):
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", LLVM)
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+
+import twoscale  # noqa: E402
+
+mi.set_variant("llvm_ad_rgb")
+import twoscale.drjit_bsdf as tb  # noqa: E402
+
+tb.register()
+
+#: Pairs per preset (issue 25 item 4 asks for 10⁵ in CI; 10⁴ keeps this file
+#: under ~30 s).
+PAIRS = 10_000
+#: Relative agreement asked by issue 25 item 4, where ρ exceeds 1e-6 of the peak.
+TOLERANCE = 2e-4
+
+
+@pytest.fixture(autouse=True)
+def symbolic_mode():
+    """Mitsuba's default (symbolic loops and calls on), whatever another test
+    file set in this process (``twoscale.mitsuba.register`` switches them off)."""
+    saved = [dr.flag(f) for f in (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls)]
+    dr.set_flag(dr.JitFlag.SymbolicLoops, True)
+    dr.set_flag(dr.JitFlag.SymbolicCalls, True)
+    yield
+    dr.set_flag(dr.JitFlag.SymbolicLoops, saved[0])
+    dr.set_flag(dr.JitFlag.SymbolicCalls, saved[1])
+
+
+def pairs(seed, n=PAIRS):
+    """Random pairs (light, camera) in the upper hemisphere: half uniform,
+    half within ~3° of the mirror direction (the peaks), some grazing."""
+    rng = np.random.default_rng(seed)
+
+    def unit(v):
+        return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
+
+    def upper(v):
+        v[:, 2] = np.abs(v[:, 2])
+        return unit(v)
+
+    light, camera = upper(rng.normal(size=(n, 3))), upper(rng.normal(size=(n, 3)))
+    k = n // 2
+    mirror = light[:k] * np.array([-1.0, -1.0, 1.0], dtype=np.float32)
+    camera[:k] = upper(mirror + 0.05 * rng.normal(size=(k, 3)))
+    return light, camera
+
+
+def relative_error(got, ref):
+    """Largest |got − ref|/ref over the values above 1e-6 of each channel's
+    peak; and whether `got` is 0 (to 1e-30 absolute) elsewhere below it."""
+    peak = ref.max(axis=0)
+    big = ref > 1e-6 * peak
+    rel = np.where(big, np.abs(got - ref) / np.where(big, ref, 1.0), 0.0)
+    small_ok = np.all(np.abs(got - ref)[~big] <= (1e-6 * np.broadcast_to(peak, ref.shape))[~big])
+    return rel.max(), small_ok
 
 
 def test_bakes_are_the_runtime_bakes():
@@ -12,7 +75,7 @@ def test_bakes_are_the_runtime_bakes():
     bakes = m.bakes()
     assert len(bakes) == 3
     assert [round(b["lambda"], 3) for b in bakes] == [0.645, 0.526, 0.444]
-    for b in bakes:
+    for b, (n, k) in zip(bakes, m.eta):
         assert b["direction_rows"].shape == (257, 8)
         assert b["direction_rows"].dtype == np.float32
         assert b["masking_g1"].shape == (1025,)
@@ -20,8 +83,72 @@ def test_bakes_are_the_runtime_bakes():
         assert b["conv_baked"] == 1.0
         # Nodes even in √cos θ: node 0 is grazing (F = 1), the last normal incidence.
         assert abs(b["direction_rows"][0, 6] - 1.0) < 1e-6
-        # G1 is 1 at normal incidence and 0 at the horizon node.
-        assert abs(b["masking_g1"][0] - 1.0) < 1e-6 and b["masking_g1"][-1] == 0.0
-    for b, (n, k) in zip(bakes, m.eta):
         f = float(twoscale.reference.fresnel(n, k, 1.0))
         assert abs(b["direction_rows"][-1, 6] - f) < 2e-5
+        # G1 is 1 at normal incidence and 0 at the horizon node.
+        assert abs(b["masking_g1"][0] - 1.0) < 1e-6 and b["masking_g1"][-1] == 0.0
+
+
+MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
+    ("gold-hp17-geometry", {"masking": "height-correlated"}),
+    ("gold-hp17-geometry", {"sigma_rel": "symmetrised"}),
+    ("gold-hp17-geometry", {"halo_weight": "incident"}),
+    ("white-plastic", {"colour": "white"}),
+]
+
+
+@pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
+def test_eval_equals_the_runtime(name, options):
+    """`Model.eval` equals `Material.eval` within 2e-4 relative where ρ exceeds
+    1e-6 of the channel's peak, on 10⁴ pairs, evaluated inside a symbolic
+    loop (symbolic mode on: nothing in eval may be evaluated eagerly)."""
+    for key, value in options.items():
+        assert value in twoscale.OPTIONS[key], (key, twoscale.OPTIONS[key])
+    material = twoscale.Material.preset(name, **options)
+    model = tb.Model(material)
+    light, camera = pairs(hash((name, tuple(options.items()))) % 2**32)
+    ref = material.eval(light, camera)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+
+    def body(k, acc):
+        return k + 1, acc + model.eval(wi, wo)
+
+    _, acc = dr.while_loop((mi.UInt32(0), mi.Color3f(0.0)), lambda k, acc: k < 2, body)
+    got = np.array(acc).T / 2.0
+    worst, small_ok = relative_error(got, ref)
+    assert worst < TOLERANCE, f"{name} {options}: worst relative error {worst:.2e}"
+    assert small_ok
+
+
+def test_plugin_eval_through_a_symbolic_call():
+    """The plugin's `eval` through a `BSDFPtr` (a symbolic call) is
+    ρ(wi=wo, wo=si.wi) cos θ(wo), the convention of `twoscale.mitsuba`;
+    below the horizon it is 0; `pdf` and `sample` are consistent (the
+    cosine-weighted stand-in, documented as such)."""
+    assert dr.flag(dr.JitFlag.SymbolicCalls)
+    name = "gold-rough"
+    bsdf = mi.load_dict({"type": tb.NAME, "material": name})
+    light, camera = pairs(5, 2000)
+    light[:100, 2] *= -1.0  # below the horizon
+    n = len(light)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(camera.T)
+    ptr = dr.gather(mi.BSDFPtr, mi.BSDFPtr(bsdf), dr.zeros(mi.UInt32, n))
+    ctx = mi.BSDFContext()
+    value, pdf = ptr.eval_pdf(ctx, si, mi.Vector3f(light.T), mi.Bool(True))
+    ref = twoscale.Material.preset(name).eval(light, camera) * np.maximum(light[:, 2:3], 0.0)
+    got = np.array(value).T
+    worst, small_ok = relative_error(got[100:], ref[100:])
+    assert worst < TOLERANCE and small_ok
+    assert np.all(got[:100] == 0.0)
+    assert np.allclose(np.array(pdf)[100:], light[100:, 2] / np.pi, rtol=1e-5)
+    assert np.all(np.array(pdf)[:100] == 0.0)
+    # sample: its weight is eval / pdf at the sampled direction.
+    rng = np.random.default_rng(9)
+    u = rng.random((3, n)).astype(np.float32)
+    bs, weight = ptr.sample(ctx, si, mi.Float(u[0]), mi.Point2f(u[1:]), mi.Bool(True))
+    v2 = ptr.eval(ctx, si, bs.wo, mi.Bool(True))
+    p2 = np.array(bs.pdf)
+    ok = p2 > 0
+    assert ok.mean() > 0.99
+    assert np.allclose(np.array(weight).T[ok], (np.array(v2).T / p2[:, None])[ok], rtol=1e-5)

@@ -1,0 +1,377 @@
+"""A Mitsuba 3 BSDF ``twoscale_drjit`` written in Dr.Jit (issue 25, first steps).
+
+The per-material bakes come from the Rust runtime (:meth:`twoscale.Material.bakes`,
+the only place where the tables are interpreted); they are uploaded once per
+material as Dr.Jit arrays, and ``eval`` mirrors ``TwoScale::lobes`` of
+runtime/src/brdf.rs with Dr.Jit operations only (gathers and arithmetic: no
+NumPy, no host callback), so it runs with Mitsuba's symbolic loops and calls
+on (the default) and no Dr.Jit flag is switched. The lookups are the runtime's
+own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
+``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
+the bakes' node axes and cubic weights are not a texture's.
+
+**Status.** ``eval`` (three RGB channels) is the runtime's. ``pdf`` and
+``sample`` are *not yet* the runtime's: the visible-slope sampler's tables are
+not exported yet, so ``sample`` draws a cosine-weighted direction and ``pdf``
+is that density, ``cos θ / π``. The pair is consistent (an unbiased estimator,
+with more variance than the runtime's sampler on glossy lobes), but it is not
+the importance sampler of ``twoscale.mitsuba``. Particle tracing is not
+supported (as in ``twoscale.mitsuba``).
+
+**Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
+ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
+incident one.
+
+Register with :func:`register` after ``mi.set_variant(...)``; the plugin takes
+the parameters of ``twoscale.mitsuba`` (``material``, ``filename`` or explicit
+ones).
+"""
+
+import math
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+
+import twoscale
+from twoscale.mitsuba import _material
+
+#: Plugin name.
+NAME = "twoscale_drjit"
+
+# The constants of `math::log2_axis` (runtime/src/math.rs), in f32.
+_LOG2_E = np.float32(math.log2(math.e))
+_AXIS_D0 = float(_LOG2_E)
+_AXIS_C2 = float(np.float32(3.0) - np.float32(2.5) * _LOG2_E)
+_AXIS_C3 = float(np.float32(1.5) * _LOG2_E - np.float32(2.0))
+
+
+def _log2_axis(x):
+    """`math::log2_axis`: `e + m (d0 + m (c2 + m c3))` for `x = 2^e (1 + m)`."""
+    bits = dr.reinterpret_array(mi.UInt32, x)
+    exponent = mi.Float(mi.Int32((bits >> 23) & 0xFF) - 127)
+    m = dr.reinterpret_array(mi.Float, (bits & 0x007FFFFF) | 0x3F800000) - 1.0
+    return exponent + m * (_AXIS_D0 + m * (_AXIS_C2 + m * _AXIS_C3))
+
+
+def _cell_at(t, n):
+    """`bake::cell_at`: the cell `i ∈ [0, n − 2]` and fraction of position `t ≥ 0`."""
+    t = dr.minimum(dr.maximum(t, 0.0), float(n - 1))
+    i = dr.clip(mi.Int32(dr.floor(t)), 0, n - 2)
+    return mi.UInt32(i), t - mi.Float(i)
+
+
+def _lerp_gather(table, width, column, i, frac):
+    """Linear interpolation of column `column` of a row-major table of `width`."""
+    a = dr.gather(mi.Float, table, i * width + column)
+    b = dr.gather(mi.Float, table, (i + 1) * width + column)
+    return dr.fma(frac, b - a, a)
+
+
+def _catmull_rom_weights(t):
+    """`conv::catmull_rom_weights`."""
+    t2 = t * t
+    t3 = t2 * t
+    return (
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    )
+
+
+def _finite_or_zero(x):
+    return dr.select(dr.isfinite(x), x, 0.0)
+
+
+class _Channel:
+    """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
+
+    def __init__(self, bakes):
+        self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
+        self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        self.t = {k: mi.Float(np.ascontiguousarray(v, dtype=np.float32).ravel())
+                  for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        s = self.s
+        self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
+        if self.diffraction and s["conv_baked"] == 0.0:
+            raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
+
+    # -- the 1-D bakes -------------------------------------------------
+    def direction_cell(self, cos):
+        n = self.shapes["direction_rows"][0]
+        return _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+
+    def direction(self, cell, columns):
+        i, frac = cell
+        return [_lerp_gather(self.t["direction_rows"], 8, k, i, frac) for k in columns]
+
+    def g1(self, r, z):
+        """`MaskingBake::g1`."""
+        n = self.shapes["masking_g1"][0]
+        a_num = self.s["masking_beta"] * r
+        y = a_num / (a_num + z)
+        i, frac = _cell_at(y * float(n - 1), n)
+        value = _lerp_gather(self.t["masking_g1"], 1, 0, i, frac)
+        return dr.select(z > 0.0, value, 0.0)
+
+    # -- C over (u, θh) ------------------------------------------------
+    def conv(self, sin_h, cos_h, u):
+        """`ConvBake::at`."""
+        s = self.s
+        n_u, n_s = self.shapes["conv_ln_c"]
+        nodes_u, nodes_s = n_u - 2, n_s - 2
+        u = dr.minimum(dr.maximum(u, 0.0), s["conv_big_b"])
+        sec_h = 1.0 / dr.maximum(cos_h, s["conv_cos_h_min"])
+        tan_h = dr.minimum(dr.maximum(sin_h, 0.0), 1.0) * sec_h
+        x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * s["conv_u_linear"]) * s["conv_u_scale"]
+        v = u + 0.5
+        nv = s["conv_ndf_quarter_width"] * v
+        inv_w = dr.sqrt(16.0 + v * v / (1.0 / 64.0 + nv * nv))
+        x_h = sec_h + tan_h * inv_w
+        span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
+        x_s = _log2_axis(x_h) * (float(nodes_s - 1) / span)
+        ju, tu = _cell_at(x_u, nodes_u)
+        ks, ts = _cell_at(x_s, nodes_s)
+        wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
+        ln_c = mi.Float(0.0)
+        for a in range(4):
+            row = (ju + a) * n_s + ks
+            inner = mi.Float(0.0)
+            for b in range(4):
+                inner += ws[b] * dr.gather(mi.Float, self.t["conv_ln_c"], row + b)
+            ln_c += wu[a] * inner
+        value = dr.exp(ln_c)
+        return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+
+    # -- the model -----------------------------------------------------
+    def q_bar(self, fi, fo, along, across):
+        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`)."""
+        s = self.s
+        s_sq = along * along + across * across
+        ok = s_sq > 0.0
+        along = dr.select(ok, along, 1.0)
+        across = dr.select(ok, across, 0.0)
+        inv_s_sq = dr.select(ok, 1.0 / s_sq, 1.0)
+        # ui uo along − η² (wi wo) s², complex.
+        uu_re = fi[1] * fo[1] - fi[2] * fo[2]
+        uu_im = fi[1] * fo[2] + fi[2] * fo[1]
+        ww_re = fi[3] * fo[3] - fi[4] * fo[4]
+        ww_im = fi[3] * fo[4] + fi[4] * fo[3]
+        e_re, e_im = s["q_eta_sq_re"], s["q_eta_sq_im"]
+        pp_re = uu_re * along - (e_re * ww_re - e_im * ww_im) * s_sq
+        pp_im = uu_im * along - (e_re * ww_im + e_im * ww_re) * s_sq
+        norm_ui = fi[1] * fi[1] + fi[2] * fi[2]
+        norm_uo = fo[1] * fo[1] + fo[2] * fo[2]
+        q = (fi[0] * fo[0] * (along * along)
+             + (fi[0] * norm_uo + norm_ui * fo[0]) * (across * across)
+             + pp_re * pp_re + pp_im * pp_im)
+        return 0.5 * s["q_e_norm_sqr"] * q * inv_s_sq
+
+    def base_value(self, f_i, f_o, cos_i, cos_o):
+        """`TwoScale::base_value`: ρ_base + k_d/π."""
+        s = self.s
+        lambertian = s["lambertian"] / math.pi
+        if s["white"] != 0.0 or s["base"] == 0.0:
+            return mi.Float64(lambertian)
+        t = (1.0 - f_i) * (1.0 - f_o)
+        n = max(abs(s["eta_re"]), 1e-3)
+        f_dr = s["f_dr_int"]
+        if s["base"] == 1.0:
+            rho_d = s["albedo"]
+            return t * (rho_d / (math.pi * n * n * (1.0 - rho_d * f_dr))) + lambertian
+        alpha = s["albedo"]
+
+        def refracted(cos):
+            return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) / (n * n), 0.0))
+
+        single = alpha * t / (4.0 * math.pi) / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
+        a_f = (1.0 - f_dr) / (1.0 + f_dr)
+        root = math.sqrt(3.0 * (1.0 - alpha))
+        multi = alpha / (2.0 * math.pi) * math.exp(-root) * (1.0 + math.exp(-4.0 / 3.0 * a_f * root))
+        return single + t * multi + lambertian
+
+    def lobes(self, g, geo):
+        """`TwoScale::lobes`: (specular, diffraction, base) at a pair."""
+        s = self.s
+        wi, wo = geo["wi"], geo["wo"]
+        cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
+        cell_i = self.direction_cell(mi.Float(cos_i))
+        cell_o = self.direction_cell(mi.Float(cos_o))
+        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(7))]
+        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(7))]
+        # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
+        x = s["x_scale"] * cos_d * cos_d
+        if s["sigma_s"] > 0.0:
+            r_i, r_o = at_i[5], at_o[5]
+            ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
+            sigma_rel_sq = s["sigma_s_sq"] * ratio_sq
+        else:
+            sigma_rel_sq = mi.Float64(0.0)
+
+        def exp_and_one_minus_over(x, srs):
+            t = x * srs
+            e = dr.exp(-t)
+            small = t < 1e-8
+            return (dr.select(small, 1.0 - t, e),
+                    dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
+
+        a_spec, one_minus_a_over = exp_and_one_minus_over(x, sigma_rel_sq)
+        fresnel_d = (mi.Float64(1.0) if s["white"] else
+                     mi.Float64(self.direction(self.direction_cell(mi.Float(cos_d)), [6])[0]))
+        rho_ct = fresnel_d * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+        specular = a_spec * rho_ct
+
+        if self.diffraction:
+            if s["white"]:
+                q = mi.Float64(1.0)
+            elif s["has_q"]:
+                q = dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
+            else:
+                q = mi.Float64(0.0)
+            if s["halo_incident"]:
+                one_minus_a_over = exp_and_one_minus_over(s["x_scale"] * cos_i * cos_i,
+                                                          sigma_rel_sq)[1]
+            halo = s["halo_scale"] * one_minus_a_over
+            c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
+                                mi.Float(s["big_b"] * cos_d))
+            c_value = mi.Float64(dr.maximum(c_value, 0.0))
+            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0)
+        else:
+            diffraction = mi.Float64(0.0)
+        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o)
+        return _finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base)
+
+
+class Model:
+    """The RGB model of a :class:`twoscale.Material` in Dr.Jit: its three
+    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
+
+    def __init__(self, material: twoscale.Material):
+        self.material = material
+        self.channels = [_Channel(b) for b in material.bakes()]
+        first = self.channels[0].s
+        self.beta, self.p = first["beta"], first["p"]
+        self.epd_norm, self.epd_inv_beta_sq = first["epd_norm"], first["epd_inv_beta_sq"]
+        self.height_correlated = first["height_correlated"] != 0.0
+
+    def d(self, h):
+        """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
+        cos_sq = h.z * h.z
+        inv_cos4 = 1.0 / (cos_sq * cos_sq)
+        tan_sq = (h.x * h.x + h.y * h.y) / cos_sq
+        y = dr.power(tan_sq * self.epd_inv_beta_sq, self.p)
+        value = self.epd_norm * inv_cos4 * dr.exp(-y)
+        return dr.select((h.z > 0.0) & (y < 104.0) & dr.isfinite(value), value, 0.0)
+
+    def geometry(self, wi, wo):
+        """The pair's geometry and D(h) (as `TwoScale::geometry`: directions
+        and h in f64, D of h rounded to f32), and whether both directions
+        are above the horizon."""
+        wi, wo = mi.Vector3f(wi), mi.Vector3f(wo)
+        valid = dr.all(dr.isfinite(wi)) & dr.all(dr.isfinite(wo))
+        wi, wo = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
+        valid &= (wi.z > 0.0) & (wo.z > 0.0)
+        h = dr.normalize(wi + wo)
+        return valid, {
+            "wi": wi,
+            "wo": wo,
+            "cos_d": dr.clip(dr.dot(wi, h), 0.0, 1.0),
+            "cos_h": dr.clip(h.z, 0.0, 1.0),
+            "sin_h": dr.minimum(dr.sqrt(h.x * h.x + h.y * h.y), 1.0),
+            "d": self.d(mi.Vector3f(h)),
+            "along": -(wi.x * wo.x + wi.y * wo.y),
+            "across": -(wi.x * wo.y - wi.y * wo.x),
+        }
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
+        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
+        below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        ch = self.channels[0]
+
+        def tangential(w):
+            return dr.sqrt(mi.Float(w.x * w.x + w.y * w.y))
+
+        g1_i = mi.Float64(ch.g1(tangential(wi), mi.Float(wi.z)))
+        g1_o = mi.Float64(ch.g1(tangential(wo), mi.Float(wo.z)))
+        if self.height_correlated:
+            g = 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0)
+        else:
+            g = g1_i * g1_o
+        values = []
+        for channel in self.channels:
+            spec, diff, base = channel.lobes(g, geo)
+            values.append(mi.Float(_finite_or_zero(
+                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base)))))
+        return dr.select(valid, mi.Color3f(*values), 0.0)
+
+    def pdf(self, wi, wo):
+        """The density of :meth:`sample` (not yet ``Material.pdf``): ``cos θo / π``."""
+        wo = mi.Vector3f(wo)
+        valid = (mi.Vector3f(wi).z > 0.0) & (wo.z > 0.0)
+        return dr.select(valid, dr.normalize(wo).z / math.pi, 0.0)
+
+
+def _bsdf_class():
+    """The BSDF class for the current variant (``mi.BSDF`` is per variant)."""
+
+    class TwoScaleDrJitBSDF(mi.BSDF):
+        """The two-scale BRDF in Dr.Jit (front side only, glossy reflection)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            self.model = Model(_material(props))
+            self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            self.m_components = [self.m_flags]
+
+        @staticmethod
+        def _active(ctx, active):
+            return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
+
+        def _eval(self, si, wo):
+            """ρ(wi=wo, wo=si.wi) · cos θ(wo)."""
+            return self.model.eval(wo, si.wi) * dr.maximum(wo.z, 0.0)
+
+        def eval(self, ctx, si, wo, active=True):
+            return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            active = self._active(ctx, active)
+            return (dr.select(active, self._eval(si, wo), 0.0),
+                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            wo = mi.warp.square_to_cosine_hemisphere(sample2)
+            bs = mi.BSDFSample3f()
+            bs.wo = wo
+            bs.pdf = self.model.pdf(si.wi, wo)
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+            bs.sampled_component = mi.UInt32(0)
+            active = self._active(ctx, active) & (bs.pdf > 0.0)
+            weight = self._eval(si, wo) / dr.select(active, bs.pdf, 1.0)
+            return bs, dr.select(active, weight, 0.0)
+
+        def traverse(self, callback):
+            # No parameter is differentiable yet (issue 25 item 3).
+            pass
+
+        def to_string(self):
+            return f"TwoScaleDrJitBSDF[{self.model.material!r}]"
+
+    return TwoScaleDrJitBSDF
+
+
+def register() -> None:
+    """register(): registers the ``twoscale_drjit`` BSDF with the current Mitsuba
+    variant. No Dr.Jit flag is changed."""
+    if not mi.variant():
+        raise RuntimeError("call mi.set_variant(...) before twoscale.drjit_bsdf.register()")
+    cls = _bsdf_class()
+    mi.register_bsdf(NAME, lambda props: cls(props))
