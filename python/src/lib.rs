@@ -478,7 +478,7 @@ impl Material {
     /// bakes(): the model's per-channel constants and bakes as the runtime
     /// built them, for ports of `eval` and `pdf` (`twoscale.drjit_bsdf`):
     /// a list of three dicts (red, green, blue) mapping names to float
-    /// scalars and float32 arrays (the names and layouts of
+    /// scalars and float32 or float64 arrays (the names and layouts of
     /// `TwoScale::visit_bakes` and `runtime/src/bake.rs`; not a stable
     /// interface).
     fn bakes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
@@ -607,6 +607,12 @@ impl DictVisitor<'_> {
 
 impl BakeVisitor for DictVisitor<'_> {
     fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]) {
+        let array = shaped(self.dict.py(), shape, data.to_vec());
+        let result = self.dict.set_item(name, array);
+        self.keep(result);
+    }
+
+    fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]) {
         let array = shaped(self.dict.py(), shape, data.to_vec());
         let result = self.dict.set_item(name, array);
         self.keep(result);

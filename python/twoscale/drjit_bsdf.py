@@ -10,13 +10,15 @@ own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
 ``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
 the bakes' node axes and cubic weights are not a texture's.
 
-**Status.** ``eval`` (three RGB channels) is the runtime's. ``pdf`` and
-``sample`` are *not yet* the runtime's: the visible-slope sampler's tables are
-not exported yet, so ``sample`` draws a cosine-weighted direction and ``pdf``
-is that density, ``cos θ / π``. The pair is consistent (an unbiased estimator,
-with more variance than the runtime's sampler on glossy lobes), but it is not
-the importance sampler of ``twoscale.mitsuba``. Particle tracing is not
-supported (as in ``twoscale.mitsuba``).
+**Status.** :meth:`Model.eval` (three RGB channels) and :meth:`Model.pdf` (the
+density of the runtime's sampler: the visible-slope tables, the diffraction
+law, the cosine lobe, the baked lobe weights) are the runtime's. The
+runtime's *sampler* is not ported yet, so the plugin's ``sample`` draws a
+cosine-weighted direction and the plugin's ``pdf`` is that density,
+``cos θ / π`` (:meth:`Model.cosine_pdf`): a consistent pair (unbiased, with
+more variance than the runtime's sampler on glossy lobes), not the importance
+sampler of ``twoscale.mitsuba``. Particle tracing is not supported (as in
+``twoscale.mitsuba``).
 
 **Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
 ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
@@ -80,6 +82,16 @@ def _catmull_rom_weights(t):
     )
 
 
+def _acos_approx(x):
+    """`math::acos_approx` (Abramowitz & Stegun 4.4.46), f64."""
+    a = dr.minimum(dr.abs(x), 1.0)
+    p = 1.5707963050 + a * (-0.2145988016 + a * (0.0889789874 + a * (
+        -0.0501743046 + a * (0.0308918810 + a * (-0.0170881256 + a * (
+            0.0066700901 - 0.0012624911 * a))))))
+    r = dr.sqrt(1.0 - a) * p
+    return dr.select(x < 0.0, math.pi - r, r)
+
+
 def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
@@ -90,9 +102,11 @@ class _Channel:
     def __init__(self, bakes):
         self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
         self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
-        self.t = {k: mi.Float(np.ascontiguousarray(v, dtype=np.float32).ravel())
+        self.t = {k: (mi.Float64 if v.dtype == np.float64 else mi.Float)(
+                      np.ascontiguousarray(v).ravel())
                   for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
+        self.r_max = float(bakes["visible_rows"][-1])
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
@@ -143,6 +157,109 @@ class _Channel:
             ln_c += wu[a] * inner
         value = dr.exp(ln_c)
         return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+
+    # -- the sampler's densities ---------------------------------------
+    def lobe_weights(self, cos_i):
+        """`DirectionBake::lobe_weights`: `[specular, diffraction, base]`, sum 1 (f64)."""
+        i, frac = self.direction_cell(mi.Float(cos_i))
+        w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
+             for k in range(3)]
+        total = w[0] + w[1] + w[2]
+        ok = total > 0.0
+        return [dr.select(ok, w[0] / total, 1.0), dr.select(ok, w[1] / total, 0.0),
+                dr.select(ok, w[2] / total, 0.0)]
+
+    def diffraction_pdf(self, wi, wo):
+        """`TwoScale::diffraction_pdf` (HP17 51-55), f64."""
+        s = self.s
+        if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
+            return mi.Float64(0.0)
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        dx, dy = wo.x + wi.x, wo.y + wi.y
+        r = dr.sqrt(dx * dx + dy * dy)
+        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
+        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
+        b, c = s["big_b"], s["c"]
+        density = ((c - 1.0) * b * b * dr.power(1.0 + b * b * r * r, -0.5 * (c + 1.0)) * inv_m
+                   / (2.0 * phi_max))
+        ok = (inv_m > 0.0) & (r <= 1.0 + sin_i) & (phi_max > 0.0)
+        return dr.select(ok, density * wo.z, 0.0)
+
+    def visible_pdf(self, wi, wo):
+        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
+        s, t = self.s, self.t
+        beta = s["visible_beta"]
+        rows_n, cols_n = self.shapes["visible_dens"]
+        x_nodes = self.shapes["visible_mass"][0]
+        sum_ = wi + wo
+        # The stretched incidence.
+        tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
+        bt = beta * tangential
+        length = dr.sqrt(bt * bt + wi.z * wi.z)
+        has_t = tangential > 0.0
+        t0 = dr.select(has_t, wi.x / tangential, 1.0)
+        t1 = dr.select(has_t, wi.y / tangential, 0.0)
+        c, sn = wi.z / length, bt / length
+        inv_bz = 1.0 / (beta * sum_.z)
+        sx, sy = -sum_.x * inv_bz, -sum_.y * inv_bz
+        x = sx * t0 + sy * t1
+        y = -sx * t1 + sy * t0
+        r_max = self.r_max
+        valid = (sum_.z > 0.0) & (c - sn * x > 0.0) & (dr.abs(x) <= r_max) & (dr.abs(y) <= r_max)
+
+        def node(name, k):
+            return dr.gather(mi.Float64, t[name], k)
+
+        def locate(a, names, n, scale):
+            position = _log2_axis(1.0 + mi.Float(a) * s["visible_inv_sigma"]) * scale
+            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+            lower = (k > 0) & (a < node(names, k))
+            upper = (k + 2 < n) & (a >= node(names, k + 1))
+            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+            a0, a1 = node(names, k), node(names, k + 1)
+            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
+
+        # The extent: N_tab.
+        def phi_node(j):
+            return c * node("visible_mass", j) - sn * node("visible_moment", j)
+
+        mu = c / sn
+        i_mu, _ = locate(dr.select(sn * r_max > c, mu, 0.0), "visible_rows", rows_n,
+                         s["visible_row_scale"])
+        x0 = node("visible_rows", i_mu)
+        p0 = node("visible_p2", i_mu)
+        h = node("visible_rows", i_mu + 1) - x0
+        slope = (node("visible_p2", i_mu + 1) - p0) / h
+        tau = mu - x0
+        a = c - sn * x0
+        partial = tau * (a * p0 + tau * (0.5 * (a * slope - sn * p0) - tau * (sn * slope / 3.0)))
+        norm = dr.select(sn * r_max > c, phi_node(rows_n - 1 + i_mu) + partial,
+                         phi_node(mi.UInt32(x_nodes - 1)))
+        # The tabulated density at (x̃, ỹ).
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, s["visible_row_scale"])
+
+        def blend(a0, a1):
+            return a0 + lam * (a1 - a0)
+
+        p2 = blend(node("visible_p2", i), node("visible_p2", i + 1))
+        ay = dr.abs(y)
+        kk, tt = locate(ay, "visible_cols", cols_n, s["visible_col_scale"])
+
+        def dens(row, col):
+            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
+
+        g0 = blend(dens(i, kk), dens(i + 1, kk))
+        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
+        total = blend(node("visible_cum", i * cols_n + cols_n - 1),
+                      node("visible_cum", (i + 1) * cols_n + cols_n - 1))
+        g = (g0 + tt * (g1 - g0)) / total
+        slope_sq = beta * beta * (sx * sx + sy * sy)
+        sec4 = (1.0 + slope_sq) * (1.0 + slope_sq)
+        value = p2 * g * sec4 / (8.0 * norm * beta * beta * length)
+        return dr.select(valid, value, 0.0)
 
     # -- the model -----------------------------------------------------
     def q_bar(self, fi, fo, along, across):
@@ -309,7 +426,24 @@ class Model:
         return dr.select(valid, mi.Color3f(*values), 0.0)
 
     def pdf(self, wi, wo):
-        """The density of :meth:`sample` (not yet ``Material.pdf``): ``cos θo / π``."""
+        """`Material.pdf(wi, wo)` (``Rgb::pdf``): the mean over the channels of
+        `Σ_k w_k(wi) pdf_k(wi, wo)`, as an ``mi.Float``; 0 below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        specular = self.channels[0].visible_pdf(wi, wo)
+        base = wo.z / math.pi
+        total = mi.Float64(0.0)
+        for channel in self.channels:
+            w = channel.lobe_weights(wi.z)
+            value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
+            if channel.diffraction:
+                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
+            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            total += mi.Float64(_finite_or_zero(mi.Float(value)))
+        return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)
+
+    def cosine_pdf(self, wi, wo):
+        """The density of the plugin's stand-in sampler, ``cos θo / π``."""
         wo = mi.Vector3f(wo)
         valid = (mi.Vector3f(wi).z > 0.0) & (wo.z > 0.0)
         return dr.select(valid, dr.normalize(wo).z / math.pi, 0.0)
@@ -339,18 +473,18 @@ def _bsdf_class():
             return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
+            return dr.select(self._active(ctx, active), self.model.cosine_pdf(si.wi, wo), 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             active = self._active(ctx, active)
             return (dr.select(active, self._eval(si, wo), 0.0),
-                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
+                    dr.select(active, self.model.cosine_pdf(si.wi, wo), 0.0))
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             wo = mi.warp.square_to_cosine_hemisphere(sample2)
             bs = mi.BSDFSample3f()
             bs.wo = wo
-            bs.pdf = self.model.pdf(si.wi, wo)
+            bs.pdf = self.model.cosine_pdf(si.wi, wo)
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)

@@ -104,6 +104,8 @@ const ROUNDER: f32 = 12_582_912.0;
 pub trait BakeVisitor {
     /// An array of `shape` (row-major).
     fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]);
+    /// An f64 array of `shape` (row-major).
+    fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]);
     /// A scalar.
     fn scalar(&mut self, name: &'static str, value: f64);
 }

@@ -646,8 +646,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// Hands the model's constants and bakes to `v` (names in the
     /// visitor's calls; layouts as [`crate::bake`] documents), for ports of
-    /// `eval` and `pdf` (the Python package's `Material.bakes()`). The
-    /// visible-slope sampler's tables are not exported yet.
+    /// `eval` and `pdf` (the Python package's `Material.bakes()`).
     #[doc(hidden)]
     pub fn visit_bakes(&self, v: &mut dyn BakeVisitor) {
         let s = &self.surface;
@@ -707,6 +706,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         bake.masking.visit(v);
         bake.radial_norm.visit(v);
         bake.conv.visit(v);
+        bake.visible.visit(v);
     }
 
     /// The sanitised surface parameters in use.
