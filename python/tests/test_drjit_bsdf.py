@@ -2,6 +2,7 @@
 in ``llvm_ad_rgb`` with Mitsuba's default symbolic loops and calls."""
 
 import os
+import zlib
 
 import numpy as np
 import pytest
@@ -37,6 +38,11 @@ def symbolic_mode():
     yield
     dr.set_flag(dr.JitFlag.SymbolicLoops, saved[0])
     dr.set_flag(dr.JitFlag.SymbolicCalls, saved[1])
+
+
+def seed(*parts):
+    """A seed fixed by the test's parameters (`hash` of a string is not)."""
+    return zlib.crc32(repr(parts).encode())
 
 
 def pairs(seed, n=PAIRS):
@@ -106,7 +112,7 @@ def test_eval_equals_the_runtime(name, options):
         assert value in twoscale.OPTIONS[key], (key, twoscale.OPTIONS[key])
     material = twoscale.Material.preset(name, **options)
     model = tb.Model(material)
-    light, camera = pairs(hash((name, tuple(options.items()))) % 2**32)
+    light, camera = pairs(seed(name, "eval", options))
     ref = material.eval(light, camera)
     wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
 
@@ -129,7 +135,7 @@ def test_pdf_equals_the_runtime(name, options):
     symbolic loop."""
     material = twoscale.Material.preset(name, **options)
     model = tb.Model(material)
-    light, camera = pairs(hash((name, "pdf", tuple(options.items()))) % 2**32)
+    light, camera = pairs(seed(name, "pdf", options))
     ref = material.pdf(light, camera)[:, None]
     wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
 
@@ -143,13 +149,35 @@ def test_pdf_equals_the_runtime(name, options):
     assert small_ok
 
 
-def test_plugin_eval_through_a_symbolic_call():
-    """The plugin's `eval` through a `BSDFPtr` (a symbolic call) is
-    ρ(wi=wo, wo=si.wi) cos θ(wo), the convention of `twoscale.mitsuba`;
-    below the horizon it is 0; `pdf` and `sample` are consistent (the
-    cosine-weighted stand-in, documented as such)."""
+@pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
+def test_sample_equals_the_runtime(name, options):
+    """`Model.sample_direction` returns `Material.sample`'s direction for the
+    same uniforms and fails on the same rows, on 10⁴ incidences. Not bit for
+    bit: the runtime takes the diffraction sampler's ln(1 − M u) and its
+    inverse in f32 (`ln_1pf`, `exp_m1f`), the port in f64. Measured on 2·10⁵
+    uniform incidences per preset: 0.02–6% of the directions differ, 0.09%
+    at most by more than 1e-6, none by more than 2.0e-5."""
+    material = twoscale.Material.preset(name, **options)
+    model = tb.Model(material)
+    rng = np.random.default_rng(seed(name, "sample", options))
+    light, _ = pairs(int(rng.integers(2**31)))
+    u = rng.random((len(light), 3)).astype(np.float32)
+    ref_o, ref_pdf, _ = material.sample(light, u)
+    o, ok = model.sample_direction(mi.Vector3f(light.T), mi.Vector3f(u.T))
+    o, ok = np.array(o).T, np.array(ok).astype(bool)
+    assert np.array_equal(ok, ref_pdf > 0)
+    assert np.abs(o - ref_o)[ok].max() <= 1e-4
+    assert np.mean(np.abs(o - ref_o).max(axis=1)[ok] > 1e-6) < 3e-3
+
+
+def test_plugin_through_a_symbolic_call():
+    """The plugin through a `BSDFPtr` (a symbolic call): `eval` is
+    ρ(wi=wo, wo=si.wi) cos θ(wo), the convention of `twoscale.mitsuba`, 0
+    below the horizon; `pdf` is `Material.pdf(si.wi, wo)`; `sample` draws
+    `Material.sample(si.wi, u)`'s direction with weight eval / pdf."""
     assert dr.flag(dr.JitFlag.SymbolicCalls)
     name = "gold-rough"
+    material = twoscale.Material.preset(name)
     bsdf = mi.load_dict({"type": tb.NAME, "material": name})
     light, camera = pairs(5, 2000)
     light[:100, 2] *= -1.0  # below the horizon
@@ -159,19 +187,59 @@ def test_plugin_eval_through_a_symbolic_call():
     ptr = dr.gather(mi.BSDFPtr, mi.BSDFPtr(bsdf), dr.zeros(mi.UInt32, n))
     ctx = mi.BSDFContext()
     value, pdf = ptr.eval_pdf(ctx, si, mi.Vector3f(light.T), mi.Bool(True))
-    ref = twoscale.Material.preset(name).eval(light, camera) * np.maximum(light[:, 2:3], 0.0)
+    ref = material.eval(light, camera) * np.maximum(light[:, 2:3], 0.0)
     got = np.array(value).T
     worst, small_ok = relative_error(got[100:], ref[100:])
     assert worst < TOLERANCE and small_ok
     assert np.all(got[:100] == 0.0)
-    assert np.allclose(np.array(pdf)[100:], light[100:, 2] / np.pi, rtol=1e-5)
+    ref_pdf = material.pdf(camera, light)
+    worst, small_ok = relative_error(np.array(pdf)[100:, None], ref_pdf[100:, None])
+    assert worst < TOLERANCE and small_ok
     assert np.all(np.array(pdf)[:100] == 0.0)
-    # sample: its weight is eval / pdf at the sampled direction.
     rng = np.random.default_rng(9)
     u = rng.random((3, n)).astype(np.float32)
     bs, weight = ptr.sample(ctx, si, mi.Float(u[0]), mi.Point2f(u[1:]), mi.Bool(True))
-    v2 = ptr.eval(ctx, si, bs.wo, mi.Bool(True))
+    ref_o, ref_p, ref_w = material.sample(camera, u.T)
     p2 = np.array(bs.pdf)
     ok = p2 > 0
-    assert ok.mean() > 0.99
-    assert np.allclose(np.array(weight).T[ok], (np.array(v2).T / p2[:, None])[ok], rtol=1e-5)
+    assert np.array_equal(ok, ref_p > 0)
+    assert np.abs(np.array(bs.wo).T - ref_o)[ok].max() <= 1e-5
+    v2 = np.array(ptr.eval(ctx, si, bs.wo, mi.Bool(True))).T
+    assert np.allclose(np.array(weight).T[ok], v2[ok] / p2[ok, None], rtol=1e-5)
+
+
+GOLD = "0.163 3.56, 0.584 2.15, 1.403 1.925"
+
+
+def xml(**props):
+    """Plugin properties as the XML the χ² adapter expects."""
+    out = []
+    for key, value in props.items():
+        kind = "float" if isinstance(value, float) else "string"
+        out.append(f'<{kind} name="{key}" value="{value}"/>')
+    return "".join(out)
+
+
+@pytest.mark.parametrize(
+    "label,props,theta",
+    [
+        ("gold-hp17-geometry", dict(material="gold-hp17-geometry"), 40.0),
+        ("white-plastic", dict(material="white-plastic"), 30.0),
+        ("strong halo", dict(beta=0.1, p=1.0, sigma_s=0.1, b=3.0, c=1.6, eta=GOLD), 45.0),
+        ("grazing", dict(material="gold-rough"), 85.0),
+    ],
+)
+def test_chi2(label, props, theta):
+    """Mitsuba's χ² test of the plugin's `sample` against its `pdf`, with
+    symbolic mode on (ires=16, as test_mitsuba: the default under-resolves
+    lobes of β ≈ 0.06)."""
+    t = np.radians(theta)
+    wi = [float(np.sin(t)), 0.0, float(np.cos(t))]
+    sample, pdf = mi.chi2.BSDFAdapter(tb.NAME, xml(**props), wi=wi)
+    test = mi.chi2.ChiSquareTest(
+        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
+        sample_dim=3, ires=16,
+    )
+    passed = test.run(quiet=True)
+    print(f"chi2 {label}: p = {test.p_value:.4f}")
+    assert passed, test.messages

@@ -10,15 +10,16 @@ own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
 ``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
 the bakes' node axes and cubic weights are not a texture's.
 
-**Status.** :meth:`Model.eval` (three RGB channels) and :meth:`Model.pdf` (the
-density of the runtime's sampler: the visible-slope tables, the diffraction
-law, the cosine lobe, the baked lobe weights) are the runtime's. The
-runtime's *sampler* is not ported yet, so the plugin's ``sample`` draws a
-cosine-weighted direction and the plugin's ``pdf`` is that density,
-``cos θ / π`` (:meth:`Model.cosine_pdf`): a consistent pair (unbiased, with
-more variance than the runtime's sampler on glossy lobes), not the importance
-sampler of ``twoscale.mitsuba``. Particle tracing is not supported (as in
-``twoscale.mitsuba``).
+**What is ported.** :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
+:meth:`Model.pdf` (``Rgb::pdf``: the visible-slope tables, the diffraction
+law, the cosine lobe, the baked lobe weights, averaged over the channels) and
+:meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
+lobe picks, the visible-slope sampler with its Newton solve as a symbolic
+loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
+light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
+its density and weight ``eval / pdf``. Not yet: gradients (``traverse``
+exposes nothing), spectral variants. Particle tracing is not supported (as
+in ``twoscale.mitsuba``).
 
 **Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
 ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
@@ -261,6 +262,173 @@ class _Channel:
         value = p2 * g * sec4 / (8.0 * norm * beta * beta * length)
         return dr.select(valid, value, 0.0)
 
+    def visible_sample(self, wi, u0, u1):
+        """`VisibleSlopeBake::sample`: a visible EPD normal for the unit `wi`
+        (f64) from two uniforms, and whether the tables gave mass."""
+        s, t = self.s, self.t
+        beta = s["visible_beta"]
+        rows_n, cols_n = self.shapes["visible_dens"]
+        x_nodes = self.shapes["visible_mass"][0]
+        r_max = self.r_max
+
+        def node(name, k):
+            return dr.gather(mi.Float64, t[name], k)
+
+        tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
+        bt = beta * tangential
+        length = dr.sqrt(bt * bt + wi.z * wi.z)
+        has_t = tangential > 0.0
+        t0 = dr.select(has_t, wi.x / tangential, 1.0)
+        t1 = dr.select(has_t, wi.y / tangential, 0.0)
+        c, sn = wi.z / length, bt / length
+
+        def x_node(j):
+            below = j + 1 >= rows_n
+            k = dr.select(below, j + 1 - rows_n, rows_n - 1 - j)
+            v = node("visible_rows", k)
+            return dr.select(below, v, -v)
+
+        def p_node(j):
+            below = j + 1 >= rows_n
+            return node("visible_p2", dr.select(below, j + 1 - rows_n, rows_n - 1 - j))
+
+        def phi_node(j):
+            return c * node("visible_mass", j) - sn * node("visible_moment", j)
+
+        def cell_integral(x0, p0, k, tau):
+            a = c - sn * x0
+            return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
+
+        def locate(a, name, n, scale):
+            position = _log2_axis(1.0 + mi.Float(a) * s["visible_inv_sigma"]) * scale
+            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+            lower = (k > 0) & (a < node(name, k))
+            upper = (k + 2 < n) & (a >= node(name, k + 1))
+            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+            a0, a1 = node(name, k), node(name, k + 1)
+            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
+
+        # The extent (`VisibleSlopeBake::extent`).
+        reaches = sn * r_max > c
+        mu = c / sn
+        i_mu, _ = locate(dr.select(reaches, mu, 0.0), "visible_rows", rows_n,
+                         s["visible_row_scale"])
+        j_mu = rows_n - 1 + i_mu
+        x0m, p0m = node("visible_rows", i_mu), node("visible_p2", i_mu)
+        km = (node("visible_p2", i_mu + 1) - p0m) / (node("visible_rows", i_mu + 1) - x0m)
+        last = mi.UInt32(x_nodes - 2)
+        j_end = dr.select(reaches, j_mu, last)
+        tau_end = dr.select(reaches, mu - x0m, x_node(last + 1) - x_node(last))
+        norm = dr.select(reaches, phi_node(j_mu) + cell_integral(x0m, p0m, km, mu - x0m),
+                         phi_node(last + 1))
+        ok = norm > 0.0
+        target = u0 * norm
+
+        def last_at_most(n, below, steps):
+            base, size = mi.UInt32(0), mi.UInt32(n)
+            for _ in range(steps):
+                half = size // 2
+                base = dr.select(below(base + half), base + half, base)
+                size -= half
+            return base
+
+        j = last_at_most(j_end + 1, lambda j: phi_node(j) <= target, 8)
+        x0, p0 = x_node(j), p_node(j)
+        h = x_node(j + 1) - x0
+        k = (p_node(j + 1) - p0) / h
+        tau_max = dr.select(j == j_end, tau_end, h)
+        rest = target - phi_node(j)
+        tau = self._solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral)
+        x = x0 + tau
+        # The conditional at |x̃|.
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, s["visible_row_scale"])
+
+        def blend(a0, a1):
+            return a0 + lam * (a1 - a0)
+
+        def cum(row, col):
+            return node("visible_cum", row * cols_n + col)
+
+        def dens(row, col):
+            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
+
+        signed = 2.0 * u1 - 1.0
+        q = dr.abs(signed) * blend(cum(i, cols_n - 1), cum(i + 1, cols_n - 1))
+        kk = last_at_most(cols_n - 1, lambda kc: blend(cum(i, kc), cum(i + 1, kc)) <= q, 7)
+        w = node("visible_cols", kk + 1) - node("visible_cols", kk)
+        g0 = blend(dens(i, kk), dens(i + 1, kk))
+        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
+        r = dr.maximum(q - blend(cum(i, kk), cum(i + 1, kk)), 0.0)
+        b = g0 * w
+        disc = dr.maximum(b * b + 2.0 * (g1 - g0) * w * r, 0.0)
+        denom = b + dr.sqrt(disc)
+        tau_y = dr.select(denom > 0.0, dr.clip(2.0 * r / denom, 0.0, 1.0), 0.0)
+        y = dr.copysign(node("visible_cols", kk) + tau_y * w, signed)
+        sx = beta * (x * t0 - y * t1)
+        sy = beta * (x * t1 + y * t0)
+        inv = 1.0 / dr.sqrt(1.0 + sx * sx + sy * sy)
+        return mi.Vector3d(-sx * inv, -sy * inv, inv), ok
+
+    @staticmethod
+    def _solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral):
+        """`visible::solve_cell`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until it converges, at most 40 steps)."""
+        a = c - sn * x0
+
+        def density(t):
+            return (a - sn * t) * (p0 + k * t)
+
+        f0 = density(0.0 * a)
+        b = a * k - sn * p0
+        disc = f0 * f0 + 2.0 * b * rest
+        denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
+        t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
+        lo, hi = dr.zeros(mi.Float64, dr.width(t)), mi.Float64(tau_max)
+        tol = 1e-13 * (dr.abs(x0) + tau_max)
+
+        def body(step, done, t, lo, hi):
+            f = cell_integral(x0, p0, k, t) - rest
+            lo = dr.select(f < 0.0, t, lo)
+            hi = dr.select(f < 0.0, hi, t)
+            d = density(t)
+            nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
+            nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+            done = dr.abs(nxt - t) <= tol
+            return step + 1, done, nxt, lo, hi
+
+        _, _, t, _, _ = dr.while_loop(
+            (mi.UInt32(0), mi.Bool(False), t, lo, hi),
+            lambda step, done, t, lo, hi: (step < 40) & ~done,
+            body,
+        )
+        return t
+
+    def diffraction_sample(self, wi, u0, u1):
+        """The diffraction lobe's direction (`TwoScale::sample_lobe`, HP17
+        51-55) and whether it exists (f64)."""
+        s = self.s
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        b, c = s["big_b"], s["c"]
+        m = 1.0 / inv_m
+        # ln_1pf and exp_m1f of the runtime, in f64.
+        t = -2.0 / (c - 1.0) * dr.log(1.0 - m * u0)
+        r = dr.minimum(dr.sqrt(dr.maximum(dr.exp(t) - 1.0, 0.0)) / b, 1.0 + sin_i)
+        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
+        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
+        psi = (2.0 * u1 - 1.0) * phi_max
+        has = sin_i > 0.0
+        cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
+        sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
+        cp, sp = dr.cos(psi), dr.sin(psi)
+        ox = r * (cos_phi_i * cp - sin_phi_i * sp) - wi.x
+        oy = r * (sin_phi_i * cp + cos_phi_i * sp) - wi.y
+        z2 = 1.0 - ox * ox - oy * oy
+        ok = (inv_m > 0.0) & (z2 > 0.0) & (s["sigma_s"] > 0.0) & (b > 0.0)
+        return mi.Vector3d(ox, oy, dr.sqrt(dr.maximum(z2, 0.0))), ok
+
     # -- the model -----------------------------------------------------
     def q_bar(self, fi, fo, along, across):
         """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`)."""
@@ -371,6 +539,7 @@ class Model:
         self.beta, self.p = first["beta"], first["p"]
         self.epd_norm, self.epd_inv_beta_sq = first["epd_norm"], first["epd_inv_beta_sq"]
         self.height_correlated = first["height_correlated"] != 0.0
+        self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
 
     def d(self, h):
         """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
@@ -442,11 +611,55 @@ class Model:
             total += mi.Float64(_finite_or_zero(mi.Float(value)))
         return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)
 
-    def cosine_pdf(self, wi, wo):
-        """The density of the plugin's stand-in sampler, ``cos θo / π``."""
-        wo = mi.Vector3f(wo)
-        valid = (mi.Vector3f(wi).z > 0.0) & (wo.z > 0.0)
-        return dr.select(valid, dr.normalize(wo).z / math.pi, 0.0)
+    def sample_direction(self, wi, u):
+        """``Rgb::sample``'s direction for incidence `wi` and three uniforms
+        `u` (an ``mi.Vector3f``): a channel picked with `u[0]`, its lobe with
+        the rescaled `u[0]`, the lobe's direction from `u[1], u[2]`. Returns
+        the direction (``mi.Vector3f``) and whether one was drawn."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        wi_f = mi.Vector3f(wi)
+        valid = dr.all(dr.isfinite(wi_f))
+        wi = dr.normalize(mi.Vector3d(wi_f))
+        valid &= wi.z > 0.0
+        pick = 3.0 * mi.Float64(dr.clip(u.x, 0.0, below_one))
+        k = dr.minimum(mi.UInt32(pick), 2)
+        rest = mi.Float(pick - mi.Float64(k))
+        lobe_pick = mi.Float64(dr.clip(rest, 0.0, below_one))
+        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
+        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        # The picked channel's lobe weights.
+        weights = [ch.lobe_weights(wi.z) for ch in self.channels]
+        w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
+             for n in range(3)]
+        # `pick_lobe`.
+        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+        for n in range(3):
+            positive = w[n] > 0.0
+            cumulative += dr.select(positive, w[n], 0.0)
+            last = dr.select(positive, n, last)
+            chosen = dr.select((chosen < 0) & positive & (lobe_pick < cumulative), n, chosen)
+        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
+        # Specular: reflect wi about a visible normal (the bake is the channels').
+        m, ok_spec = self.channels[0].visible_sample(wi, u1, u2)
+        o = 2.0 * dr.dot(wi, m) * m - wi
+        ok = ok_spec
+        # Diffraction: the picked channel's law.
+        for n, channel in enumerate(self.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & (k == n)
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+        # Base: cosine-weighted.
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe == 2, ob, o)
+        ok = dr.select(lobe == 2, True, ok)
+        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
+        # `upper_unit(to_f32(o))`, back to f32.
+        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
+        return o, ok
 
 
 def _bsdf_class():
@@ -473,22 +686,25 @@ def _bsdf_class():
             return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            return dr.select(self._active(ctx, active), self.model.cosine_pdf(si.wi, wo), 0.0)
+            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             active = self._active(ctx, active)
             return (dr.select(active, self._eval(si, wo), 0.0),
-                    dr.select(active, self.model.cosine_pdf(si.wi, wo), 0.0))
+                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            wo = mi.warp.square_to_cosine_hemisphere(sample2)
+            # The light direction from the runtime's sampler given the camera
+            # direction (as twoscale.mitsuba), its density and eval / pdf.
+            u = mi.Vector3f(sample1, sample2.x, sample2.y)
+            wo, ok = self.model.sample_direction(si.wi, u)
             bs = mi.BSDFSample3f()
             bs.wo = wo
-            bs.pdf = self.model.cosine_pdf(si.wi, wo)
+            bs.pdf = dr.select(ok, self.model.pdf(si.wi, wo), 0.0)
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)
-            active = self._active(ctx, active) & (bs.pdf > 0.0)
+            active = self._active(ctx, active) & ok & (bs.pdf > 0.0)
             weight = self._eval(si, wo) / dr.select(active, bs.pdf, 1.0)
             return bs, dr.select(active, weight, 0.0)
 
