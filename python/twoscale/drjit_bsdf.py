@@ -93,6 +93,20 @@ def _acos_approx(x):
     return dr.select(x < 0.0, math.pi - r, r)
 
 
+class _Opaque:
+    """A material's constants as opaque Dr.Jit scalars of one type (made on
+    first use): kernel inputs rather than literals, so that materials of the
+    same structure share compiled kernels."""
+
+    def __init__(self, values, dtype):
+        self.values, self.dtype, self.cache = values, dtype, {}
+
+    def __getitem__(self, name):
+        if name not in self.cache:
+            self.cache[name] = dr.opaque(self.dtype, self.values[name])
+        return self.cache[name]
+
+
 def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
@@ -108,6 +122,20 @@ class _Channel:
                   for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
+        s["visible_r_max"] = self.r_max
+        # Constants of the base layer (`TwoScale::base_value`).
+        n = max(abs(s["eta_re"]), 1e-3)
+        f_dr, alpha = s["f_dr_int"], s["albedo"]
+        s["base_lambertian"] = s["lambertian"] / math.pi
+        s["base_inv_n_sq"] = 1.0 / (n * n)
+        if s["base"] == 1.0:
+            s["base_plastic"] = alpha / (math.pi * n * n * (1.0 - alpha * f_dr))
+        a_f = (1.0 - f_dr) / (1.0 + f_dr)
+        root = math.sqrt(max(3.0 * (1.0 - alpha), 0.0))
+        s["base_single"] = alpha / (4.0 * math.pi)
+        s["base_multi"] = (alpha / (2.0 * math.pi) * math.exp(-root)
+                           * (1.0 + math.exp(-4.0 / 3.0 * a_f * root)))
+        self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
@@ -124,7 +152,7 @@ class _Channel:
     def g1(self, r, z):
         """`MaskingBake::g1`."""
         n = self.shapes["masking_g1"][0]
-        a_num = self.s["masking_beta"] * r
+        a_num = self.f["masking_beta"] * r
         y = a_num / (a_num + z)
         i, frac = _cell_at(y * float(n - 1), n)
         value = _lerp_gather(self.t["masking_g1"], 1, 0, i, frac)
@@ -133,15 +161,15 @@ class _Channel:
     # -- C over (u, θh) ------------------------------------------------
     def conv(self, sin_h, cos_h, u):
         """`ConvBake::at`."""
-        s = self.s
+        s, f = self.s, self.f
         n_u, n_s = self.shapes["conv_ln_c"]
         nodes_u, nodes_s = n_u - 2, n_s - 2
-        u = dr.minimum(dr.maximum(u, 0.0), s["conv_big_b"])
+        u = dr.minimum(dr.maximum(u, 0.0), f["conv_big_b"])
         sec_h = 1.0 / dr.maximum(cos_h, s["conv_cos_h_min"])
         tan_h = dr.minimum(dr.maximum(sin_h, 0.0), 1.0) * sec_h
-        x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * s["conv_u_linear"]) * s["conv_u_scale"]
+        x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * f["conv_u_linear"]) * f["conv_u_scale"]
         v = u + 0.5
-        nv = s["conv_ndf_quarter_width"] * v
+        nv = f["conv_ndf_quarter_width"] * v
         inv_w = dr.sqrt(16.0 + v * v / (1.0 / 64.0 + nv * nv))
         x_h = sec_h + tan_h * inv_w
         span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
@@ -183,7 +211,7 @@ class _Channel:
         r = dr.sqrt(dx * dx + dy * dy)
         x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
         phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
-        b, c = s["big_b"], s["c"]
+        b, c = self.d["big_b"], self.d["c"]
         density = ((c - 1.0) * b * b * dr.power(1.0 + b * b * r * r, -0.5 * (c + 1.0)) * inv_m
                    / (2.0 * phi_max))
         ok = (inv_m > 0.0) & (r <= 1.0 + sin_i) & (phi_max > 0.0)
@@ -192,7 +220,7 @@ class _Channel:
     def visible_pdf(self, wi, wo):
         """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
         s, t = self.s, self.t
-        beta = s["visible_beta"]
+        beta = self.d["visible_beta"]
         rows_n, cols_n = self.shapes["visible_dens"]
         x_nodes = self.shapes["visible_mass"][0]
         sum_ = wi + wo
@@ -208,14 +236,14 @@ class _Channel:
         sx, sy = -sum_.x * inv_bz, -sum_.y * inv_bz
         x = sx * t0 + sy * t1
         y = -sx * t1 + sy * t0
-        r_max = self.r_max
+        r_max = self.d["visible_r_max"]
         valid = (sum_.z > 0.0) & (c - sn * x > 0.0) & (dr.abs(x) <= r_max) & (dr.abs(y) <= r_max)
 
         def node(name, k):
             return dr.gather(mi.Float64, t[name], k)
 
         def locate(a, names, n, scale):
-            position = _log2_axis(1.0 + mi.Float(a) * s["visible_inv_sigma"]) * scale
+            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
             k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
             lower = (k > 0) & (a < node(names, k))
             upper = (k + 2 < n) & (a >= node(names, k + 1))
@@ -229,7 +257,7 @@ class _Channel:
 
         mu = c / sn
         i_mu, _ = locate(dr.select(sn * r_max > c, mu, 0.0), "visible_rows", rows_n,
-                         s["visible_row_scale"])
+                         self.f["visible_row_scale"])
         x0 = node("visible_rows", i_mu)
         p0 = node("visible_p2", i_mu)
         h = node("visible_rows", i_mu + 1) - x0
@@ -240,14 +268,14 @@ class _Channel:
         norm = dr.select(sn * r_max > c, phi_node(rows_n - 1 + i_mu) + partial,
                          phi_node(mi.UInt32(x_nodes - 1)))
         # The tabulated density at (x̃, ỹ).
-        i, lam = locate(dr.abs(x), "visible_rows", rows_n, s["visible_row_scale"])
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
 
         def blend(a0, a1):
             return a0 + lam * (a1 - a0)
 
         p2 = blend(node("visible_p2", i), node("visible_p2", i + 1))
         ay = dr.abs(y)
-        kk, tt = locate(ay, "visible_cols", cols_n, s["visible_col_scale"])
+        kk, tt = locate(ay, "visible_cols", cols_n, self.f["visible_col_scale"])
 
         def dens(row, col):
             return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
@@ -266,10 +294,10 @@ class _Channel:
         """`VisibleSlopeBake::sample`: a visible EPD normal for the unit `wi`
         (f64) from two uniforms, and whether the tables gave mass."""
         s, t = self.s, self.t
-        beta = s["visible_beta"]
+        beta = self.d["visible_beta"]
         rows_n, cols_n = self.shapes["visible_dens"]
         x_nodes = self.shapes["visible_mass"][0]
-        r_max = self.r_max
+        r_max = self.d["visible_r_max"]
 
         def node(name, k):
             return dr.gather(mi.Float64, t[name], k)
@@ -300,7 +328,7 @@ class _Channel:
             return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
 
         def locate(a, name, n, scale):
-            position = _log2_axis(1.0 + mi.Float(a) * s["visible_inv_sigma"]) * scale
+            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
             k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
             lower = (k > 0) & (a < node(name, k))
             upper = (k + 2 < n) & (a >= node(name, k + 1))
@@ -312,7 +340,7 @@ class _Channel:
         reaches = sn * r_max > c
         mu = c / sn
         i_mu, _ = locate(dr.select(reaches, mu, 0.0), "visible_rows", rows_n,
-                         s["visible_row_scale"])
+                         self.f["visible_row_scale"])
         j_mu = rows_n - 1 + i_mu
         x0m, p0m = node("visible_rows", i_mu), node("visible_p2", i_mu)
         km = (node("visible_p2", i_mu + 1) - p0m) / (node("visible_rows", i_mu + 1) - x0m)
@@ -341,7 +369,7 @@ class _Channel:
         tau = self._solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral)
         x = x0 + tau
         # The conditional at |x̃|.
-        i, lam = locate(dr.abs(x), "visible_rows", rows_n, s["visible_row_scale"])
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
 
         def blend(a0, a1):
             return a0 + lam * (a1 - a0)
@@ -411,7 +439,7 @@ class _Channel:
         n = self.shapes["radial_inv_m"][0]
         i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
         inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
-        b, c = s["big_b"], s["c"]
+        b, c = self.d["big_b"], self.d["c"]
         m = 1.0 / inv_m
         # ln_1pf and exp_m1f of the runtime, in f64.
         t = -2.0 / (c - 1.0) * dr.log(1.0 - m * u0)
@@ -443,7 +471,7 @@ class _Channel:
         uu_im = fi[1] * fo[2] + fi[2] * fo[1]
         ww_re = fi[3] * fo[3] - fi[4] * fo[4]
         ww_im = fi[3] * fo[4] + fi[4] * fo[3]
-        e_re, e_im = s["q_eta_sq_re"], s["q_eta_sq_im"]
+        e_re, e_im = self.d["q_eta_sq_re"], self.d["q_eta_sq_im"]
         pp_re = uu_re * along - (e_re * ww_re - e_im * ww_im) * s_sq
         pp_im = uu_im * along - (e_re * ww_im + e_im * ww_re) * s_sq
         norm_ui = fi[1] * fi[1] + fi[2] * fi[2]
@@ -451,30 +479,23 @@ class _Channel:
         q = (fi[0] * fo[0] * (along * along)
              + (fi[0] * norm_uo + norm_ui * fo[0]) * (across * across)
              + pp_re * pp_re + pp_im * pp_im)
-        return 0.5 * s["q_e_norm_sqr"] * q * inv_s_sq
+        return 0.5 * self.d["q_e_norm_sqr"] * q * inv_s_sq
 
     def base_value(self, f_i, f_o, cos_i, cos_o):
-        """`TwoScale::base_value`: ρ_base + k_d/π."""
-        s = self.s
-        lambertian = s["lambertian"] / math.pi
+        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47)."""
+        s, d = self.s, self.d
+        lambertian = d["base_lambertian"]
         if s["white"] != 0.0 or s["base"] == 0.0:
             return mi.Float64(lambertian)
         t = (1.0 - f_i) * (1.0 - f_o)
-        n = max(abs(s["eta_re"]), 1e-3)
-        f_dr = s["f_dr_int"]
         if s["base"] == 1.0:
-            rho_d = s["albedo"]
-            return t * (rho_d / (math.pi * n * n * (1.0 - rho_d * f_dr))) + lambertian
-        alpha = s["albedo"]
+            return t * d["base_plastic"] + lambertian
 
         def refracted(cos):
-            return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) / (n * n), 0.0))
+            return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) * d["base_inv_n_sq"], 0.0))
 
-        single = alpha * t / (4.0 * math.pi) / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
-        a_f = (1.0 - f_dr) / (1.0 + f_dr)
-        root = math.sqrt(3.0 * (1.0 - alpha))
-        multi = alpha / (2.0 * math.pi) * math.exp(-root) * (1.0 + math.exp(-4.0 / 3.0 * a_f * root))
-        return single + t * multi + lambertian
+        single = t * d["base_single"] / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
+        return single + t * d["base_multi"] + lambertian
 
     def lobes(self, g, geo):
         """`TwoScale::lobes`: (specular, diffraction, base) at a pair."""
@@ -486,11 +507,11 @@ class _Channel:
         at_i = [mi.Float64(v) for v in self.direction(cell_i, range(7))]
         at_o = [mi.Float64(v) for v in self.direction(cell_o, range(7))]
         # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
-        x = s["x_scale"] * cos_d * cos_d
+        x = self.d["x_scale"] * cos_d * cos_d
         if s["sigma_s"] > 0.0:
             r_i, r_o = at_i[5], at_o[5]
             ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
-            sigma_rel_sq = s["sigma_s_sq"] * ratio_sq
+            sigma_rel_sq = self.d["sigma_s_sq"] * ratio_sq
         else:
             sigma_rel_sq = mi.Float64(0.0)
 
@@ -515,11 +536,11 @@ class _Channel:
             else:
                 q = mi.Float64(0.0)
             if s["halo_incident"]:
-                one_minus_a_over = exp_and_one_minus_over(s["x_scale"] * cos_i * cos_i,
+                one_minus_a_over = exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
                                                           sigma_rel_sq)[1]
-            halo = s["halo_scale"] * one_minus_a_over
+            halo = self.d["halo_scale"] * one_minus_a_over
             c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
-                                mi.Float(s["big_b"] * cos_d))
+                                mi.Float(self.d["big_b"] * cos_d))
             c_value = mi.Float64(dr.maximum(c_value, 0.0))
             diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0)
         else:
@@ -536,8 +557,9 @@ class Model:
         self.material = material
         self.channels = [_Channel(b) for b in material.bakes()]
         first = self.channels[0].s
-        self.beta, self.p = first["beta"], first["p"]
-        self.epd_norm, self.epd_inv_beta_sq = first["epd_norm"], first["epd_inv_beta_sq"]
+        self.p = dr.opaque(mi.Float, first["p"])
+        self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
+        self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
         self.height_correlated = first["height_correlated"] != 0.0
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
 
