@@ -15,6 +15,7 @@ import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
+from furnace import direction, furnace_albedo, furnace_render  # noqa: E402
 
 mi.set_variant("llvm_ad_rgb")
 import twoscale.drjit_bsdf as tb  # noqa: E402
@@ -233,9 +234,7 @@ def test_chi2(label, props, theta):
     """Mitsuba's χ² test of the plugin's `sample` against its `pdf`, with
     symbolic mode on (ires=16, as test_mitsuba: the default under-resolves
     lobes of β ≈ 0.06)."""
-    t = np.radians(theta)
-    wi = [float(np.sin(t)), 0.0, float(np.cos(t))]
-    sample, pdf = mi.chi2.BSDFAdapter(tb.NAME, xml(**props), wi=wi)
+    sample, pdf = mi.chi2.BSDFAdapter(tb.NAME, xml(**props), wi=direction(theta))
     test = mi.chi2.ChiSquareTest(
         domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
         sample_dim=3, ires=16,
@@ -243,3 +242,17 @@ def test_chi2(label, props, theta):
     passed = test.run(quiet=True)
     print(f"chi2 {label}: p = {test.p_value:.4f}")
     assert passed, test.messages
+
+
+@pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
+def test_white_furnace(name, theta):
+    """A render with the plugin (symbolic mode on) estimates the albedo of
+    the white-colour material, ∫ ρ cos θi dωi by quadrature over the
+    runtime's eval (as test_mitsuba.py's furnace of the NumPy plugin)."""
+    material = twoscale.Material.preset(name, colour="white")
+    expected = furnace_albedo(material, theta)
+    pixels = furnace_render({"type": tb.NAME, "material": name, "colour": "white"}, theta, seed=0)
+    mean = pixels.mean(axis=0)
+    standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
+    print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
+    assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
