@@ -15,7 +15,7 @@ import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
-from furnace import direction, furnace_albedo, furnace_render  # noqa: E402
+from render_checks import beckmann_limit, direction, furnace_albedo, furnace_render  # noqa: E402,E501
 
 mi.set_variant("llvm_ad_rgb")
 import twoscale.drjit_bsdf as tb  # noqa: E402
@@ -256,3 +256,15 @@ def test_white_furnace(name, theta):
     standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
     print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
     assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
+
+
+@pytest.mark.parametrize("alpha", [0.1, 0.3])
+def test_beckmann_limit(alpha):
+    """At p = 1, σs = 0 the plugin renders as Mitsuba's roughconductor
+    (Beckmann, same α, η, k), in symbolic mode: the renders differ by their
+    noise (the bounds of test_mitsuba.py's check of the NumPy plugin)."""
+    diff, noise, bias = beckmann_limit(alpha, plugin=tb.NAME)
+    print(f"Beckmann limit α={alpha}: mean|Δ| = {diff:.5f}, noise = {noise:.5f}, "
+          f"ratio = {diff / noise:.3f}, mean bias = {bias:+.4%}")
+    assert diff / noise < 1.1
+    assert abs(bias) < 0.01

@@ -16,7 +16,7 @@ import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
-from furnace import direction, furnace_albedo, furnace_render  # noqa: E402
+from render_checks import beckmann_limit, direction, furnace_albedo, furnace_render  # noqa: E402,E501
 
 mi.set_variant("llvm_ad_rgb")
 tm.register()
@@ -97,47 +97,6 @@ def test_eval_pdf_sample_consistent_and_directions():
     swapped = material.eval(cam[ok], wo[ok]) * wo[ok, 2:3]
     # the swap differs by far more than the tolerance above
     assert (np.abs(swapped - expected) / expected).max() > 1e-2
-
-
-def sphere_scene(bsdf):
-    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
-    return mi.load_dict({
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": 2},
-        "sensor": {
-            "type": "perspective", "fov": 30, "to_world": look,
-            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
-            "sampler": {"type": "independent", "sample_count": 64},
-        },
-        "sphere": {"type": "sphere", "bsdf": bsdf},
-        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
-        "sun": {"type": "directional", "direction": [-1, -1, -2],
-                "irradiance": {"type": "rgb", "value": 5.0}},
-    })
-
-
-def beckmann_limit(alpha):
-    """Mean |difference| between twoscale (p = 1, σs = 0) and roughconductor
-    (beckmann, same α, η, k) renders, over the noise level expected for two
-    independent renders, from two seeds of each."""
-    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
-    twoscale_bsdf = {"type": "twoscale", "beta": alpha, "p": 1.0, "sigma_s": 0.0,
-                     "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))}
-    rough = {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha,
-             "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}}
-    img = {}
-    for name, bsdf in (("twoscale", twoscale_bsdf), ("rough", rough)):
-        scene = sphere_scene(bsdf)
-        for seed in (0, 1):
-            img[name, seed] = np.asarray(mi.render(scene, seed=seed, spp=64))
-    mad = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731
-    noise_rough = mad(img["rough", 0], img["rough", 1])
-    noise_twoscale = mad(img["twoscale", 0], img["twoscale", 1])
-    diff = (mad(img["twoscale", 0], img["rough", 1]) + mad(img["twoscale", 1], img["rough", 0])) / 2
-    # independent renders A, B: E|A − B| ∝ sqrt(σA² + σB²)
-    noise = np.sqrt((noise_rough**2 + noise_twoscale**2) / 2)
-    bias = (img["twoscale", 0] + img["twoscale", 1]).mean() / (img["rough", 0] + img["rough", 1]).mean() - 1
-    return diff, noise, bias
 
 
 @pytest.mark.parametrize("alpha", [0.1, 0.3])
