@@ -22,11 +22,11 @@ use numpy::ndarray::{Array1, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 use twoscale::brdf::{
-    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Options,
-    SigmaRelMode, Surface,
+    BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
+    Options, SigmaRelMode, Surface,
 };
 use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
@@ -551,6 +551,30 @@ impl Material {
         Ok(shaped(py, &full, values.map_err(value_error)?))
     }
 
+    /// bakes(): the model's per-channel constants and bakes as the runtime
+    /// built them, for ports of `eval` and `pdf` (`twoscale.drjit_bsdf`):
+    /// a list of three dicts (red, green, blue) mapping names to float
+    /// scalars and float32 or float64 arrays (the names and layouts of
+    /// `TwoScale::visit_bakes` and `runtime/src/bake.rs`; not a stable
+    /// interface).
+    fn bakes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.model
+            .channels
+            .iter()
+            .map(|channel| {
+                let mut visitor = DictVisitor {
+                    dict: PyDict::new(py),
+                    error: None,
+                };
+                channel.visit_bakes(&mut visitor);
+                match visitor.error {
+                    Some(e) => Err(e),
+                    None => Ok(visitor.dict),
+                }
+            })
+            .collect()
+    }
+
     /// β, the EPD's roughness (slope scale), dimensionless.
     #[getter]
     fn beta(&self) -> f32 {
@@ -641,6 +665,39 @@ fn columns<const K: usize>(
         same_rows((names[0], n), (name, view.len()))?;
     }
     Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// Collects `TwoScale::visit_bakes` into a dict (the first error is kept).
+struct DictVisitor<'py> {
+    dict: Bound<'py, PyDict>,
+    error: Option<PyErr>,
+}
+
+impl DictVisitor<'_> {
+    fn keep(&mut self, result: PyResult<()>) {
+        if let (Err(e), None) = (result, &self.error) {
+            self.error = Some(e);
+        }
+    }
+}
+
+impl BakeVisitor for DictVisitor<'_> {
+    fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]) {
+        let array = shaped(self.dict.py(), shape, data.to_vec());
+        let result = self.dict.set_item(name, array);
+        self.keep(result);
+    }
+
+    fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]) {
+        let array = shaped(self.dict.py(), shape, data.to_vec());
+        let result = self.dict.set_item(name, array);
+        self.keep(result);
+    }
+
+    fn scalar(&mut self, name: &'static str, value: f64) {
+        let result = self.dict.set_item(name, value);
+        self.keep(result);
+    }
 }
 
 /// Evaluates `f` on every row without the GIL; the first failing row's error

@@ -95,6 +95,21 @@ fn cell_at(t: f32, n: usize) -> (usize, f32) {
 /// `1.5·2²³`: adding it to `x ∈ (−2²², 2²²)` rounds `x` to an integer.
 const ROUNDER: f32 = 12_582_912.0;
 
+/// Receives a model's bakes and constants by name, for ports of `eval` and
+/// `pdf` to array languages (the Python package's Dr.Jit plugin reads them
+/// through `Material.bakes()`): arrays are row-major f32 with their shape,
+/// scalars f64. The names and layouts are the bakes' own and may change
+/// with them; not a stable interface.
+#[doc(hidden)]
+pub trait BakeVisitor {
+    /// An array of `shape` (row-major).
+    fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]);
+    /// An f64 array of `shape` (row-major).
+    fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]);
+    /// A scalar.
+    fn scalar(&mut self, name: &'static str, value: f64);
+}
+
 /// One direction's quantities at one wavelength (module documentation).
 #[derive(Clone, Debug, FromZeros)]
 pub(crate) struct DirectionBake {
@@ -250,6 +265,17 @@ impl DirectionBake {
         DirectionValues { v }
     }
 
+    /// Hands the node rows and lobe weights to `v` (`direction_rows`
+    /// `[257, 8]`, `direction_weights` `[257, 4]`; nodes even in `√cos θ`).
+    pub fn visit(&self, v: &mut dyn BakeVisitor) {
+        v.array("direction_rows", &[MU_NODES, ROW], self.rows.as_flattened());
+        v.array(
+            "direction_weights",
+            &[MU_NODES, 4],
+            self.weights.as_flattened(),
+        );
+    }
+
     /// The sampler's lobe weights `[specular, diffraction, base]` (sum 1) at
     /// `cos θ` (clamped to [0, 1]).
     #[inline]
@@ -310,6 +336,11 @@ impl RadialNormBake {
         self.inv_m = [0.0f32; RADIAL_NODES];
     }
 
+    /// Hands `1/M` to `v` (`radial_inv_m`, nodes even in `sin θi`).
+    pub fn visit(&self, v: &mut dyn BakeVisitor) {
+        v.array("radial_inv_m", &[RADIAL_NODES], &self.inv_m);
+    }
+
     /// `1/M` at `sin θi` (clamped to [0, 1]).
     #[inline]
     pub fn inv_m(&self, sin_i: f64) -> f64 {
@@ -346,6 +377,13 @@ impl MaskingBake {
         let mut bake = Self::new_zeroed();
         bake.init(beta, shape);
         bake
+    }
+
+    /// Hands β and G1 to `v` (`masking_beta`; `masking_g1`, nodes even in
+    /// `y = a/(1 + a)`).
+    pub fn visit(&self, v: &mut dyn BakeVisitor) {
+        v.scalar("masking_beta", f64::from(self.beta));
+        v.array("masking_g1", &[MASKING_NODES], &self.g1);
     }
 
     /// G1 of a direction with `z = cos θ` and tangential length `r = sin θ`
@@ -478,6 +516,19 @@ impl ConvBake {
         let v = u + 0.5;
         let nv = self.ndf_quarter_width * v;
         math::sqrtf(16.0 + v * v / (1.0 / 64.0 + nv * nv))
+    }
+
+    /// Hands the axes' constants and the padded `ln C` grid to `v`
+    /// (`conv_ln_c` `[35, 132]`, ghost nodes included; `conv_*` scalars,
+    /// and the axes' constants `conv_u0`, `conv_cos_h_min`).
+    pub fn visit(&self, v: &mut dyn BakeVisitor) {
+        v.scalar("conv_big_b", f64::from(self.big_b));
+        v.scalar("conv_u_scale", f64::from(self.u_scale));
+        v.scalar("conv_u_linear", f64::from(self.u_linear));
+        v.scalar("conv_ndf_quarter_width", f64::from(self.ndf_quarter_width));
+        v.scalar("conv_u0", f64::from(U0));
+        v.scalar("conv_cos_h_min", COS_H_MIN);
+        v.array("conv_ln_c", &[PADDED_U, PADDED_S], &self.ln_c);
     }
 
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).

@@ -47,6 +47,7 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
+pub use crate::bake::BakeVisitor;
 use crate::bake::{
     ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, RadialNormBake,
 };
@@ -643,6 +644,71 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         let diffraction = self.surface.sigma_s > 0.0 && self.surface.b > 0.0;
         let base = self.base != BaseLayer::Conductor && !self.white();
         (diffraction, base || self.lambertian > 0.0)
+    }
+
+    /// Hands the model's constants and bakes to `v` (names in the
+    /// visitor's calls; layouts as [`crate::bake`] documents), for ports of
+    /// `eval` and `pdf` (the Python package's `Material.bakes()`).
+    #[doc(hidden)]
+    pub fn visit_bakes(&self, v: &mut dyn BakeVisitor) {
+        let s = &self.surface;
+        for (name, value) in [
+            ("beta", s.beta),
+            ("p", s.p),
+            ("sigma_s", s.sigma_s),
+            ("b", s.b),
+            ("c", s.c),
+        ] {
+            v.scalar(name, f64::from(value));
+        }
+        let (norm, inv_beta_sq) = self.ndf.d_constants();
+        v.scalar("epd_norm", f64::from(norm));
+        v.scalar("epd_inv_beta_sq", f64::from(inv_beta_sq));
+        let (e_norm_sqr, eta_sq) = self.q.map_or((0.0, [0.0; 2]), |q| q.combine_constants());
+        v.scalar("has_q", if self.q.is_some() { 1.0 } else { 0.0 });
+        v.scalar("q_e_norm_sqr", e_norm_sqr);
+        v.scalar("q_eta_sq_re", eta_sq[0]);
+        v.scalar("q_eta_sq_im", eta_sq[1]);
+        let (base, albedo) = match self.base {
+            BaseLayer::Conductor => (0.0, 0.0),
+            BaseLayer::Plastic { albedo } => (1.0, f64::from(albedo)),
+            BaseLayer::Subsurface { albedo } => (2.0, f64::from(albedo)),
+        };
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        for (name, value) in [
+            ("lambda", self.lambda),
+            ("big_b", self.big_b),
+            ("x_scale", self.x_scale),
+            ("sigma_s_sq", self.sigma_s_sq),
+            ("halo_scale", self.halo_scale),
+            ("f_dr_int", self.f_dr_int),
+            ("eta_re", self.eta_re),
+            ("lambertian", self.lambertian),
+            ("base", base),
+            ("albedo", albedo),
+            ("white", flag(self.white())),
+            (
+                "height_correlated",
+                flag(self.options.masking == Masking::HeightCorrelated),
+            ),
+            (
+                "symmetrised",
+                flag(self.options.sigma_rel == SigmaRelMode::Symmetrised),
+            ),
+            (
+                "halo_incident",
+                flag(self.options.halo_weight == HaloWeight::Incident),
+            ),
+            ("conv_baked", flag(self.bake().conv_baked)),
+        ] {
+            v.scalar(name, value);
+        }
+        let bake = self.bake();
+        bake.direction.visit(v);
+        bake.masking.visit(v);
+        bake.radial_norm.visit(v);
+        bake.conv.visit(v);
+        bake.visible.visit(v);
     }
 
     /// The sanitised surface parameters in use.

@@ -66,6 +66,11 @@ impl<'a> Epd<'a> {
         self.p
     }
 
+    /// `(norm, 1/β²)` of [`Epd::d`]: `D = norm · e^−(tan²θ/β²)^p / cos⁴θ`.
+    pub(crate) fn d_constants(&self) -> (f32, f32) {
+        (self.norm, self.inv_beta_sq)
+    }
+
     /// The NDF D(θm) (HP17 34-35) of a microfacet normal `m` (unit vector, local
     /// frame). Zero at and below the horizon; `∫ D cos θm dω = 1`.
     ///

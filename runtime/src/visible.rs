@@ -181,6 +181,23 @@ impl VisibleSlopeBake {
         }
     }
 
+    /// Hands the tables to `v` (`visible_*`: β, the axis constants, the
+    /// row and column nodes, `P2_tab`, its mass and moment at the `x̃`
+    /// nodes, the conditional's densities and integrals per row).
+    pub fn visit(&self, v: &mut dyn crate::bake::BakeVisitor) {
+        v.scalar("visible_beta", self.beta);
+        v.scalar("visible_inv_sigma", f64::from(self.inv_sigma));
+        v.scalar("visible_row_scale", f64::from(self.row_scale));
+        v.scalar("visible_col_scale", f64::from(self.col_scale));
+        v.array_f64("visible_rows", &[ROWS], &self.rows);
+        v.array_f64("visible_cols", &[COLS], &self.cols);
+        v.array_f64("visible_p2", &[ROWS], &self.p2);
+        v.array_f64("visible_mass", &[X_NODES], &self.mass);
+        v.array_f64("visible_moment", &[X_NODES], &self.moment);
+        v.array("visible_dens", &[ROWS, COLS], self.dens.as_flattened());
+        v.array_f64("visible_cum", &[ROWS, COLS], self.cum.as_flattened());
+    }
+
     /// The `x̃` node `j` (`j = ROWS − 1` is 0).
     #[inline]
     fn x_node(&self, j: usize) -> f64 {

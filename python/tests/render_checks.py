@@ -1,0 +1,89 @@
+"""Render checks shared by the Mitsuba plugins' tests (test_mitsuba.py,
+test_drjit_bsdf.py): the white furnace (a material's albedo by quadrature
+over the runtime's eval, and a render that estimates it in every pixel) and
+the Beckmann limit against Mitsuba's roughconductor."""
+
+import mitsuba as mi
+import numpy as np
+
+
+def direction(theta_deg):
+    t = np.radians(theta_deg)
+    return [float(np.sin(t)), 0.0, float(np.cos(t))]
+
+
+def furnace_albedo(material, theta_deg, k=1500):
+    """∫ ρ(i, o) cos θi dωi for the viewer at θo, by the midpoint rule in
+    (cos θi, φi) over the runtime's eval."""
+    o = np.array([direction(theta_deg)])
+    z = (np.arange(k) + 0.5) / k
+    phi = (np.arange(2 * k) + 0.5) / (2 * k) * 2 * np.pi
+    total = np.zeros(3)
+    for zi in np.array_split(z, 10):
+        zz, pp = np.meshgrid(zi, phi, indexing="ij")
+        r = np.sqrt(1 - zz**2)
+        wi = np.stack([r * np.cos(pp), r * np.sin(pp), zz], axis=-1).reshape(-1, 3)
+        value = material.eval(wi, np.broadcast_to(o, wi.shape))
+        total += (value * wi[:, 2:3]).sum(axis=0)
+    return total * (1 / k) * (np.pi / k)
+
+
+def furnace_render(bsdf, theta_deg, seed):
+    """A flat patch seen by an orthographic camera at θo under a constant
+    emitter of radiance 1: every pixel estimates the albedo."""
+    t = np.radians(theta_deg)
+    look = mi.ScalarTransform4f().look_at(origin=[5 * np.sin(t), 0, 5 * np.cos(t)],
+                                          target=[0, 0, 0], up=[0, 1, 0])
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 2},
+        "sensor": {
+            "type": "orthographic", "to_world": look @ mi.ScalarTransform4f().scale([0.5, 0.5, 1]),
+            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": 64},
+        },
+        "patch": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale(5), "bsdf": bsdf},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 1.0}},
+    })
+    return np.asarray(mi.render(scene, seed=seed, spp=64)).reshape(-1, 3)
+
+
+def sphere_scene(bsdf):
+    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 2},
+        "sensor": {
+            "type": "perspective", "fov": 30, "to_world": look,
+            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": 64},
+        },
+        "sphere": {"type": "sphere", "bsdf": bsdf},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
+        "sun": {"type": "directional", "direction": [-1, -1, -2],
+                "irradiance": {"type": "rgb", "value": 5.0}},
+    })
+
+
+def beckmann_limit(alpha, plugin="twoscale"):
+    """Mean |difference| between the plugin `plugin` (p = 1, σs = 0) and
+    roughconductor (beckmann, same α, η, k) renders, over the noise level
+    expected for two independent renders, from two seeds of each."""
+    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
+    twoscale_bsdf = {"type": plugin, "beta": alpha, "p": 1.0, "sigma_s": 0.0,
+                     "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))}
+    rough = {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha,
+             "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}}
+    img = {}
+    for name, bsdf in (("twoscale", twoscale_bsdf), ("rough", rough)):
+        scene = sphere_scene(bsdf)
+        for seed in (0, 1):
+            img[name, seed] = np.asarray(mi.render(scene, seed=seed, spp=64))
+    mad = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731
+    noise_rough = mad(img["rough", 0], img["rough", 1])
+    noise_twoscale = mad(img["twoscale", 0], img["twoscale", 1])
+    diff = (mad(img["twoscale", 0], img["rough", 1]) + mad(img["twoscale", 1], img["rough", 0])) / 2
+    # independent renders A, B: E|A − B| ∝ sqrt(σA² + σB²)
+    noise = np.sqrt((noise_rough**2 + noise_twoscale**2) / 2)
+    bias = (img["twoscale", 0] + img["twoscale", 1]).mean() / (img["rough", 0] + img["rough", 1]).mean() - 1
+    return diff, noise, bias

@@ -1,0 +1,270 @@
+"""The Dr.Jit port of the model (``twoscale.drjit_bsdf``) against the runtime,
+in ``llvm_ad_rgb`` with Mitsuba's default symbolic loops and calls."""
+
+import os
+import zlib
+
+import numpy as np
+import pytest
+
+LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if os.path.exists(LLVM):
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", LLVM)
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+
+import twoscale  # noqa: E402
+from render_checks import beckmann_limit, direction, furnace_albedo, furnace_render  # noqa: E402,E501
+
+mi.set_variant("llvm_ad_rgb")
+import twoscale.drjit_bsdf as tb  # noqa: E402
+
+tb.register()
+
+#: Pairs per preset (issue 25 item 4 asks for 10⁵ in CI; 10⁴ keeps this file
+#: under ~30 s).
+PAIRS = 10_000
+#: Relative agreement asked by issue 25 item 4, where ρ exceeds 1e-6 of the peak.
+TOLERANCE = 2e-4
+
+
+@pytest.fixture(autouse=True)
+def symbolic_mode():
+    """Mitsuba's default (symbolic loops and calls on), whatever another test
+    file set in this process (``twoscale.mitsuba.register`` switches them off)."""
+    saved = [dr.flag(f) for f in (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls)]
+    dr.set_flag(dr.JitFlag.SymbolicLoops, True)
+    dr.set_flag(dr.JitFlag.SymbolicCalls, True)
+    yield
+    dr.set_flag(dr.JitFlag.SymbolicLoops, saved[0])
+    dr.set_flag(dr.JitFlag.SymbolicCalls, saved[1])
+
+
+def seed(*parts):
+    """A seed fixed by the test's parameters (`hash` of a string is not)."""
+    return zlib.crc32(repr(parts).encode())
+
+
+def pairs(seed, n=PAIRS):
+    """Random pairs (light, camera) in the upper hemisphere: half uniform,
+    half within ~3° of the mirror direction (the peaks), some grazing."""
+    rng = np.random.default_rng(seed)
+
+    def unit(v):
+        return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
+
+    def upper(v):
+        v[:, 2] = np.abs(v[:, 2])
+        return unit(v)
+
+    light, camera = upper(rng.normal(size=(n, 3))), upper(rng.normal(size=(n, 3)))
+    k = n // 2
+    mirror = light[:k] * np.array([-1.0, -1.0, 1.0], dtype=np.float32)
+    camera[:k] = upper(mirror + 0.05 * rng.normal(size=(k, 3)))
+    return light, camera
+
+
+def relative_error(got, ref):
+    """Largest |got − ref|/ref over the values above 1e-6 of each channel's
+    peak; and whether `got` is 0 (to 1e-30 absolute) elsewhere below it."""
+    peak = ref.max(axis=0)
+    big = ref > 1e-6 * peak
+    rel = np.where(big, np.abs(got - ref) / np.where(big, ref, 1.0), 0.0)
+    small_ok = np.all(np.abs(got - ref)[~big] <= (1e-6 * np.broadcast_to(peak, ref.shape))[~big])
+    return rel.max(), small_ok
+
+
+def test_bakes_are_the_runtime_bakes():
+    """Material.bakes(): three channels of named scalars and float32 arrays,
+    at the channels' wavelengths, with the layouts the port reads."""
+    m = twoscale.Material.preset("gold-hp17-geometry")
+    bakes = m.bakes()
+    assert len(bakes) == 3
+    assert [round(b["lambda"], 3) for b in bakes] == [0.645, 0.526, 0.444]
+    for b, (n, k) in zip(bakes, m.eta):
+        assert b["direction_rows"].shape == (257, 8)
+        assert b["direction_rows"].dtype == np.float32
+        assert b["masking_g1"].shape == (1025,)
+        assert b["conv_ln_c"].shape == (35, 132)
+        assert b["conv_baked"] == 1.0
+        # Nodes even in √cos θ: node 0 is grazing (F = 1), the last normal incidence.
+        assert abs(b["direction_rows"][0, 6] - 1.0) < 1e-6
+        f = float(twoscale.reference.fresnel(n, k, 1.0))
+        assert abs(b["direction_rows"][-1, 6] - f) < 2e-5
+        # G1 is 1 at normal incidence and 0 at the horizon node.
+        assert abs(b["masking_g1"][0] - 1.0) < 1e-6 and b["masking_g1"][-1] == 0.0
+
+
+MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
+    ("gold-hp17-geometry", {"masking": "height-correlated"}),
+    ("gold-hp17-geometry", {"sigma_rel": "symmetrised"}),
+    ("gold-hp17-geometry", {"halo_weight": "incident"}),
+    ("white-plastic", {"colour": "white"}),
+]
+
+
+@pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
+def test_eval_equals_the_runtime(name, options):
+    """`Model.eval` equals `Material.eval` within 2e-4 relative where ρ exceeds
+    1e-6 of the channel's peak, on 10⁴ pairs, evaluated inside a symbolic
+    loop (symbolic mode on: nothing in eval may be evaluated eagerly)."""
+    for key, value in options.items():
+        assert value in twoscale.OPTIONS[key], (key, twoscale.OPTIONS[key])
+    material = twoscale.Material.preset(name, **options)
+    model = tb.Model(material)
+    light, camera = pairs(seed(name, "eval", options))
+    ref = material.eval(light, camera)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+
+    def body(k, acc):
+        return k + 1, acc + model.eval(wi, wo)
+
+    _, acc = dr.while_loop((mi.UInt32(0), mi.Color3f(0.0)), lambda k, acc: k < 2, body)
+    got = np.array(acc).T / 2.0
+    worst, small_ok = relative_error(got, ref)
+    assert worst < TOLERANCE, f"{name} {options}: worst relative error {worst:.2e}"
+    assert small_ok
+
+
+@pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
+def test_pdf_equals_the_runtime(name, options):
+    """`Model.pdf` (the runtime's sampler density: the visible-slope tables,
+    the diffraction sampler's law, the cosine lobe and the bake's lobe
+    weights, averaged over the channels) equals `Material.pdf` within 2e-4
+    relative where it exceeds 1e-6 of its peak, on 10⁴ pairs, inside a
+    symbolic loop."""
+    material = twoscale.Material.preset(name, **options)
+    model = tb.Model(material)
+    light, camera = pairs(seed(name, "pdf", options))
+    ref = material.pdf(light, camera)[:, None]
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+
+    def body(k, acc):
+        return k + 1, acc + model.pdf(wi, wo)
+
+    _, acc = dr.while_loop((mi.UInt32(0), mi.Float(0.0)), lambda k, acc: k < 2, body)
+    got = np.array(acc)[:, None] / 2.0
+    worst, small_ok = relative_error(got, ref)
+    assert worst < TOLERANCE, f"{name} {options}: worst relative error {worst:.2e}"
+    assert small_ok
+
+
+@pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
+def test_sample_equals_the_runtime(name, options):
+    """`Model.sample_direction` returns `Material.sample`'s direction for the
+    same uniforms and fails on the same rows, on 10⁴ incidences. Not bit for
+    bit: the runtime takes the diffraction sampler's ln(1 − M u) and its
+    inverse in f32 (`ln_1pf`, `exp_m1f`), the port in f64. Measured on 2·10⁵
+    uniform incidences per preset: 0.02–6% of the directions differ, 0.09%
+    at most by more than 1e-6, none by more than 2.0e-5."""
+    material = twoscale.Material.preset(name, **options)
+    model = tb.Model(material)
+    rng = np.random.default_rng(seed(name, "sample", options))
+    light, _ = pairs(int(rng.integers(2**31)))
+    u = rng.random((len(light), 3)).astype(np.float32)
+    ref_o, ref_pdf, _ = material.sample(light, u)
+    o, ok = model.sample_direction(mi.Vector3f(light.T), mi.Vector3f(u.T))
+    o, ok = np.array(o).T, np.array(ok).astype(bool)
+    assert np.array_equal(ok, ref_pdf > 0)
+    assert np.abs(o - ref_o)[ok].max() <= 1e-4
+    assert np.mean(np.abs(o - ref_o).max(axis=1)[ok] > 1e-6) < 3e-3
+
+
+def test_plugin_through_a_symbolic_call():
+    """The plugin through a `BSDFPtr` (a symbolic call): `eval` is
+    ρ(wi=wo, wo=si.wi) cos θ(wo), the convention of `twoscale.mitsuba`, 0
+    below the horizon; `pdf` is `Material.pdf(si.wi, wo)`; `sample` draws
+    `Material.sample(si.wi, u)`'s direction with weight eval / pdf."""
+    assert dr.flag(dr.JitFlag.SymbolicCalls)
+    name = "gold-rough"
+    material = twoscale.Material.preset(name)
+    bsdf = mi.load_dict({"type": tb.NAME, "material": name})
+    light, camera = pairs(5, 2000)
+    light[:100, 2] *= -1.0  # below the horizon
+    n = len(light)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(camera.T)
+    ptr = dr.gather(mi.BSDFPtr, mi.BSDFPtr(bsdf), dr.zeros(mi.UInt32, n))
+    ctx = mi.BSDFContext()
+    value, pdf = ptr.eval_pdf(ctx, si, mi.Vector3f(light.T), mi.Bool(True))
+    ref = material.eval(light, camera) * np.maximum(light[:, 2:3], 0.0)
+    got = np.array(value).T
+    worst, small_ok = relative_error(got[100:], ref[100:])
+    assert worst < TOLERANCE and small_ok
+    assert np.all(got[:100] == 0.0)
+    ref_pdf = material.pdf(camera, light)
+    worst, small_ok = relative_error(np.array(pdf)[100:, None], ref_pdf[100:, None])
+    assert worst < TOLERANCE and small_ok
+    assert np.all(np.array(pdf)[:100] == 0.0)
+    rng = np.random.default_rng(9)
+    u = rng.random((3, n)).astype(np.float32)
+    bs, weight = ptr.sample(ctx, si, mi.Float(u[0]), mi.Point2f(u[1:]), mi.Bool(True))
+    ref_o, ref_p, ref_w = material.sample(camera, u.T)
+    p2 = np.array(bs.pdf)
+    ok = p2 > 0
+    assert np.array_equal(ok, ref_p > 0)
+    assert np.abs(np.array(bs.wo).T - ref_o)[ok].max() <= 1e-5
+    v2 = np.array(ptr.eval(ctx, si, bs.wo, mi.Bool(True))).T
+    assert np.allclose(np.array(weight).T[ok], v2[ok] / p2[ok, None], rtol=1e-5)
+
+
+GOLD = "0.163 3.56, 0.584 2.15, 1.403 1.925"
+
+
+def xml(**props):
+    """Plugin properties as the XML the χ² adapter expects."""
+    out = []
+    for key, value in props.items():
+        kind = "float" if isinstance(value, float) else "string"
+        out.append(f'<{kind} name="{key}" value="{value}"/>')
+    return "".join(out)
+
+
+@pytest.mark.parametrize(
+    "label,props,theta",
+    [
+        ("gold-hp17-geometry", dict(material="gold-hp17-geometry"), 40.0),
+        ("white-plastic", dict(material="white-plastic"), 30.0),
+        ("strong halo", dict(beta=0.1, p=1.0, sigma_s=0.1, b=3.0, c=1.6, eta=GOLD), 45.0),
+        ("grazing", dict(material="gold-rough"), 85.0),
+    ],
+)
+def test_chi2(label, props, theta):
+    """Mitsuba's χ² test of the plugin's `sample` against its `pdf`, with
+    symbolic mode on (ires=16, as test_mitsuba: the default under-resolves
+    lobes of β ≈ 0.06)."""
+    sample, pdf = mi.chi2.BSDFAdapter(tb.NAME, xml(**props), wi=direction(theta))
+    test = mi.chi2.ChiSquareTest(
+        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
+        sample_dim=3, ires=16,
+    )
+    passed = test.run(quiet=True)
+    print(f"chi2 {label}: p = {test.p_value:.4f}")
+    assert passed, test.messages
+
+
+@pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
+def test_white_furnace(name, theta):
+    """A render with the plugin (symbolic mode on) estimates the albedo of
+    the white-colour material, ∫ ρ cos θi dωi by quadrature over the
+    runtime's eval (as test_mitsuba.py's furnace of the NumPy plugin)."""
+    material = twoscale.Material.preset(name, colour="white")
+    expected = furnace_albedo(material, theta)
+    pixels = furnace_render({"type": tb.NAME, "material": name, "colour": "white"}, theta, seed=0)
+    mean = pixels.mean(axis=0)
+    standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
+    print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
+    assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
+
+
+@pytest.mark.parametrize("alpha", [0.1, 0.3])
+def test_beckmann_limit(alpha):
+    """At p = 1, σs = 0 the plugin renders as Mitsuba's roughconductor
+    (Beckmann, same α, η, k), in symbolic mode: the renders differ by their
+    noise (the bounds of test_mitsuba.py's check of the NumPy plugin)."""
+    diff, noise, bias = beckmann_limit(alpha, plugin=tb.NAME)
+    print(f"Beckmann limit α={alpha}: mean|Δ| = {diff:.5f}, noise = {noise:.5f}, "
+          f"ratio = {diff / noise:.3f}, mean bias = {bias:+.4%}")
+    assert diff / noise < 1.1
+    assert abs(bias) < 0.01

@@ -1,0 +1,749 @@
+"""A Mitsuba 3 BSDF ``twoscale_drjit`` written in Dr.Jit (issue 25, first steps).
+
+The per-material bakes come from the Rust runtime (:meth:`twoscale.Material.bakes`,
+the only place where the tables are interpreted); they are uploaded once per
+material as Dr.Jit arrays, and ``eval`` mirrors ``TwoScale::lobes`` of
+runtime/src/brdf.rs with Dr.Jit operations only (gathers and arithmetic: no
+NumPy, no host callback), so it runs with Mitsuba's symbolic loops and calls
+on (the default) and no Dr.Jit flag is switched. The lookups are the runtime's
+own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
+``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
+the bakes' node axes and cubic weights are not a texture's.
+
+**What is ported.** :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
+:meth:`Model.pdf` (``Rgb::pdf``: the visible-slope tables, the diffraction
+law, the cosine lobe, the baked lobe weights, averaged over the channels) and
+:meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
+lobe picks, the visible-slope sampler with its Newton solve as a symbolic
+loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
+light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
+its density and weight ``eval / pdf``. Not yet: gradients (``traverse``
+exposes nothing), spectral variants. Particle tracing is not supported (as
+in ``twoscale.mitsuba``).
+
+**Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
+ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
+incident one.
+
+Register with :func:`register` after ``mi.set_variant(...)``; the plugin takes
+the parameters of ``twoscale.mitsuba`` (``material``, ``filename`` or explicit
+ones).
+"""
+
+import math
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+
+import twoscale
+from twoscale.mitsuba import _material
+
+#: Plugin name.
+NAME = "twoscale_drjit"
+
+# The constants of `math::log2_axis` (runtime/src/math.rs), in f32.
+_LOG2_E = np.float32(math.log2(math.e))
+_AXIS_D0 = float(_LOG2_E)
+_AXIS_C2 = float(np.float32(3.0) - np.float32(2.5) * _LOG2_E)
+_AXIS_C3 = float(np.float32(1.5) * _LOG2_E - np.float32(2.0))
+
+
+def _log2_axis(x):
+    """`math::log2_axis`: `e + m (d0 + m (c2 + m c3))` for `x = 2^e (1 + m)`."""
+    bits = dr.reinterpret_array(mi.UInt32, x)
+    exponent = mi.Float(mi.Int32((bits >> 23) & 0xFF) - 127)
+    m = dr.reinterpret_array(mi.Float, (bits & 0x007FFFFF) | 0x3F800000) - 1.0
+    return exponent + m * (_AXIS_D0 + m * (_AXIS_C2 + m * _AXIS_C3))
+
+
+def _cell_at(t, n):
+    """`bake::cell_at`: the cell `i ∈ [0, n − 2]` and fraction of position `t ≥ 0`."""
+    t = dr.minimum(dr.maximum(t, 0.0), float(n - 1))
+    i = dr.clip(mi.Int32(dr.floor(t)), 0, n - 2)
+    return mi.UInt32(i), t - mi.Float(i)
+
+
+def _lerp_gather(table, width, column, i, frac):
+    """Linear interpolation of column `column` of a row-major table of `width`."""
+    a = dr.gather(mi.Float, table, i * width + column)
+    b = dr.gather(mi.Float, table, (i + 1) * width + column)
+    return dr.fma(frac, b - a, a)
+
+
+def _catmull_rom_weights(t):
+    """`conv::catmull_rom_weights`."""
+    t2 = t * t
+    t3 = t2 * t
+    return (
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    )
+
+
+def _acos_approx(x):
+    """`math::acos_approx` (Abramowitz & Stegun 4.4.46), f64."""
+    a = dr.minimum(dr.abs(x), 1.0)
+    p = 1.5707963050 + a * (-0.2145988016 + a * (0.0889789874 + a * (
+        -0.0501743046 + a * (0.0308918810 + a * (-0.0170881256 + a * (
+            0.0066700901 - 0.0012624911 * a))))))
+    r = dr.sqrt(1.0 - a) * p
+    return dr.select(x < 0.0, math.pi - r, r)
+
+
+class _Opaque:
+    """A material's constants as opaque Dr.Jit scalars of one type (made on
+    first use): kernel inputs rather than literals, so that materials of the
+    same structure share compiled kernels."""
+
+    def __init__(self, values, dtype):
+        self.values, self.dtype, self.cache = values, dtype, {}
+
+    def __getitem__(self, name):
+        if name not in self.cache:
+            self.cache[name] = dr.opaque(self.dtype, self.values[name])
+        return self.cache[name]
+
+
+def _finite_or_zero(x):
+    return dr.select(dr.isfinite(x), x, 0.0)
+
+
+class _Channel:
+    """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
+
+    def __init__(self, bakes):
+        self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
+        self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        self.t = {k: (mi.Float64 if v.dtype == np.float64 else mi.Float)(
+                      np.ascontiguousarray(v).ravel())
+                  for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        s = self.s
+        self.r_max = float(bakes["visible_rows"][-1])
+        s["visible_r_max"] = self.r_max
+        # Constants of the base layer (`TwoScale::base_value`).
+        n = max(abs(s["eta_re"]), 1e-3)
+        f_dr, alpha = s["f_dr_int"], s["albedo"]
+        s["base_lambertian"] = s["lambertian"] / math.pi
+        s["base_inv_n_sq"] = 1.0 / (n * n)
+        if s["base"] == 1.0:
+            s["base_plastic"] = alpha / (math.pi * n * n * (1.0 - alpha * f_dr))
+        a_f = (1.0 - f_dr) / (1.0 + f_dr)
+        root = math.sqrt(max(3.0 * (1.0 - alpha), 0.0))
+        s["base_single"] = alpha / (4.0 * math.pi)
+        s["base_multi"] = (alpha / (2.0 * math.pi) * math.exp(-root)
+                           * (1.0 + math.exp(-4.0 / 3.0 * a_f * root)))
+        self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
+        self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
+        if self.diffraction and s["conv_baked"] == 0.0:
+            raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
+
+    # -- the 1-D bakes -------------------------------------------------
+    def direction_cell(self, cos):
+        n = self.shapes["direction_rows"][0]
+        return _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+
+    def direction(self, cell, columns):
+        i, frac = cell
+        return [_lerp_gather(self.t["direction_rows"], 8, k, i, frac) for k in columns]
+
+    def g1(self, r, z):
+        """`MaskingBake::g1`."""
+        n = self.shapes["masking_g1"][0]
+        a_num = self.f["masking_beta"] * r
+        y = a_num / (a_num + z)
+        i, frac = _cell_at(y * float(n - 1), n)
+        value = _lerp_gather(self.t["masking_g1"], 1, 0, i, frac)
+        return dr.select(z > 0.0, value, 0.0)
+
+    # -- C over (u, θh) ------------------------------------------------
+    def conv(self, sin_h, cos_h, u):
+        """`ConvBake::at`."""
+        s, f = self.s, self.f
+        n_u, n_s = self.shapes["conv_ln_c"]
+        nodes_u, nodes_s = n_u - 2, n_s - 2
+        u = dr.minimum(dr.maximum(u, 0.0), f["conv_big_b"])
+        sec_h = 1.0 / dr.maximum(cos_h, s["conv_cos_h_min"])
+        tan_h = dr.minimum(dr.maximum(sin_h, 0.0), 1.0) * sec_h
+        x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * f["conv_u_linear"]) * f["conv_u_scale"]
+        v = u + 0.5
+        nv = f["conv_ndf_quarter_width"] * v
+        inv_w = dr.sqrt(16.0 + v * v / (1.0 / 64.0 + nv * nv))
+        x_h = sec_h + tan_h * inv_w
+        span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
+        x_s = _log2_axis(x_h) * (float(nodes_s - 1) / span)
+        ju, tu = _cell_at(x_u, nodes_u)
+        ks, ts = _cell_at(x_s, nodes_s)
+        wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
+        ln_c = mi.Float(0.0)
+        for a in range(4):
+            row = (ju + a) * n_s + ks
+            inner = mi.Float(0.0)
+            for b in range(4):
+                inner += ws[b] * dr.gather(mi.Float, self.t["conv_ln_c"], row + b)
+            ln_c += wu[a] * inner
+        value = dr.exp(ln_c)
+        return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+
+    # -- the sampler's densities ---------------------------------------
+    def lobe_weights(self, cos_i):
+        """`DirectionBake::lobe_weights`: `[specular, diffraction, base]`, sum 1 (f64)."""
+        i, frac = self.direction_cell(mi.Float(cos_i))
+        w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
+             for k in range(3)]
+        total = w[0] + w[1] + w[2]
+        ok = total > 0.0
+        return [dr.select(ok, w[0] / total, 1.0), dr.select(ok, w[1] / total, 0.0),
+                dr.select(ok, w[2] / total, 0.0)]
+
+    def diffraction_pdf(self, wi, wo):
+        """`TwoScale::diffraction_pdf` (HP17 51-55), f64."""
+        s = self.s
+        if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
+            return mi.Float64(0.0)
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        dx, dy = wo.x + wi.x, wo.y + wi.y
+        r = dr.sqrt(dx * dx + dy * dy)
+        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
+        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
+        b, c = self.d["big_b"], self.d["c"]
+        density = ((c - 1.0) * b * b * dr.power(1.0 + b * b * r * r, -0.5 * (c + 1.0)) * inv_m
+                   / (2.0 * phi_max))
+        ok = (inv_m > 0.0) & (r <= 1.0 + sin_i) & (phi_max > 0.0)
+        return dr.select(ok, density * wo.z, 0.0)
+
+    def visible_pdf(self, wi, wo):
+        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
+        s, t = self.s, self.t
+        beta = self.d["visible_beta"]
+        rows_n, cols_n = self.shapes["visible_dens"]
+        x_nodes = self.shapes["visible_mass"][0]
+        sum_ = wi + wo
+        # The stretched incidence.
+        tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
+        bt = beta * tangential
+        length = dr.sqrt(bt * bt + wi.z * wi.z)
+        has_t = tangential > 0.0
+        t0 = dr.select(has_t, wi.x / tangential, 1.0)
+        t1 = dr.select(has_t, wi.y / tangential, 0.0)
+        c, sn = wi.z / length, bt / length
+        inv_bz = 1.0 / (beta * sum_.z)
+        sx, sy = -sum_.x * inv_bz, -sum_.y * inv_bz
+        x = sx * t0 + sy * t1
+        y = -sx * t1 + sy * t0
+        r_max = self.d["visible_r_max"]
+        valid = (sum_.z > 0.0) & (c - sn * x > 0.0) & (dr.abs(x) <= r_max) & (dr.abs(y) <= r_max)
+
+        def node(name, k):
+            return dr.gather(mi.Float64, t[name], k)
+
+        def locate(a, names, n, scale):
+            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
+            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+            lower = (k > 0) & (a < node(names, k))
+            upper = (k + 2 < n) & (a >= node(names, k + 1))
+            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+            a0, a1 = node(names, k), node(names, k + 1)
+            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
+
+        # The extent: N_tab.
+        def phi_node(j):
+            return c * node("visible_mass", j) - sn * node("visible_moment", j)
+
+        mu = c / sn
+        i_mu, _ = locate(dr.select(sn * r_max > c, mu, 0.0), "visible_rows", rows_n,
+                         self.f["visible_row_scale"])
+        x0 = node("visible_rows", i_mu)
+        p0 = node("visible_p2", i_mu)
+        h = node("visible_rows", i_mu + 1) - x0
+        slope = (node("visible_p2", i_mu + 1) - p0) / h
+        tau = mu - x0
+        a = c - sn * x0
+        partial = tau * (a * p0 + tau * (0.5 * (a * slope - sn * p0) - tau * (sn * slope / 3.0)))
+        norm = dr.select(sn * r_max > c, phi_node(rows_n - 1 + i_mu) + partial,
+                         phi_node(mi.UInt32(x_nodes - 1)))
+        # The tabulated density at (x̃, ỹ).
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
+
+        def blend(a0, a1):
+            return a0 + lam * (a1 - a0)
+
+        p2 = blend(node("visible_p2", i), node("visible_p2", i + 1))
+        ay = dr.abs(y)
+        kk, tt = locate(ay, "visible_cols", cols_n, self.f["visible_col_scale"])
+
+        def dens(row, col):
+            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
+
+        g0 = blend(dens(i, kk), dens(i + 1, kk))
+        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
+        total = blend(node("visible_cum", i * cols_n + cols_n - 1),
+                      node("visible_cum", (i + 1) * cols_n + cols_n - 1))
+        g = (g0 + tt * (g1 - g0)) / total
+        slope_sq = beta * beta * (sx * sx + sy * sy)
+        sec4 = (1.0 + slope_sq) * (1.0 + slope_sq)
+        value = p2 * g * sec4 / (8.0 * norm * beta * beta * length)
+        return dr.select(valid, value, 0.0)
+
+    def visible_sample(self, wi, u0, u1):
+        """`VisibleSlopeBake::sample`: a visible EPD normal for the unit `wi`
+        (f64) from two uniforms, and whether the tables gave mass."""
+        s, t = self.s, self.t
+        beta = self.d["visible_beta"]
+        rows_n, cols_n = self.shapes["visible_dens"]
+        x_nodes = self.shapes["visible_mass"][0]
+        r_max = self.d["visible_r_max"]
+
+        def node(name, k):
+            return dr.gather(mi.Float64, t[name], k)
+
+        tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
+        bt = beta * tangential
+        length = dr.sqrt(bt * bt + wi.z * wi.z)
+        has_t = tangential > 0.0
+        t0 = dr.select(has_t, wi.x / tangential, 1.0)
+        t1 = dr.select(has_t, wi.y / tangential, 0.0)
+        c, sn = wi.z / length, bt / length
+
+        def x_node(j):
+            below = j + 1 >= rows_n
+            k = dr.select(below, j + 1 - rows_n, rows_n - 1 - j)
+            v = node("visible_rows", k)
+            return dr.select(below, v, -v)
+
+        def p_node(j):
+            below = j + 1 >= rows_n
+            return node("visible_p2", dr.select(below, j + 1 - rows_n, rows_n - 1 - j))
+
+        def phi_node(j):
+            return c * node("visible_mass", j) - sn * node("visible_moment", j)
+
+        def cell_integral(x0, p0, k, tau):
+            a = c - sn * x0
+            return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
+
+        def locate(a, name, n, scale):
+            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
+            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+            lower = (k > 0) & (a < node(name, k))
+            upper = (k + 2 < n) & (a >= node(name, k + 1))
+            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+            a0, a1 = node(name, k), node(name, k + 1)
+            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
+
+        # The extent (`VisibleSlopeBake::extent`).
+        reaches = sn * r_max > c
+        mu = c / sn
+        i_mu, _ = locate(dr.select(reaches, mu, 0.0), "visible_rows", rows_n,
+                         self.f["visible_row_scale"])
+        j_mu = rows_n - 1 + i_mu
+        x0m, p0m = node("visible_rows", i_mu), node("visible_p2", i_mu)
+        km = (node("visible_p2", i_mu + 1) - p0m) / (node("visible_rows", i_mu + 1) - x0m)
+        last = mi.UInt32(x_nodes - 2)
+        j_end = dr.select(reaches, j_mu, last)
+        tau_end = dr.select(reaches, mu - x0m, x_node(last + 1) - x_node(last))
+        norm = dr.select(reaches, phi_node(j_mu) + cell_integral(x0m, p0m, km, mu - x0m),
+                         phi_node(last + 1))
+        ok = norm > 0.0
+        target = u0 * norm
+
+        def last_at_most(n, below, steps):
+            base, size = mi.UInt32(0), mi.UInt32(n)
+            for _ in range(steps):
+                half = size // 2
+                base = dr.select(below(base + half), base + half, base)
+                size -= half
+            return base
+
+        j = last_at_most(j_end + 1, lambda j: phi_node(j) <= target, 8)
+        x0, p0 = x_node(j), p_node(j)
+        h = x_node(j + 1) - x0
+        k = (p_node(j + 1) - p0) / h
+        tau_max = dr.select(j == j_end, tau_end, h)
+        rest = target - phi_node(j)
+        tau = self._solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral)
+        x = x0 + tau
+        # The conditional at |x̃|.
+        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
+
+        def blend(a0, a1):
+            return a0 + lam * (a1 - a0)
+
+        def cum(row, col):
+            return node("visible_cum", row * cols_n + col)
+
+        def dens(row, col):
+            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
+
+        signed = 2.0 * u1 - 1.0
+        q = dr.abs(signed) * blend(cum(i, cols_n - 1), cum(i + 1, cols_n - 1))
+        kk = last_at_most(cols_n - 1, lambda kc: blend(cum(i, kc), cum(i + 1, kc)) <= q, 7)
+        w = node("visible_cols", kk + 1) - node("visible_cols", kk)
+        g0 = blend(dens(i, kk), dens(i + 1, kk))
+        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
+        r = dr.maximum(q - blend(cum(i, kk), cum(i + 1, kk)), 0.0)
+        b = g0 * w
+        disc = dr.maximum(b * b + 2.0 * (g1 - g0) * w * r, 0.0)
+        denom = b + dr.sqrt(disc)
+        tau_y = dr.select(denom > 0.0, dr.clip(2.0 * r / denom, 0.0, 1.0), 0.0)
+        y = dr.copysign(node("visible_cols", kk) + tau_y * w, signed)
+        sx = beta * (x * t0 - y * t1)
+        sy = beta * (x * t1 + y * t0)
+        inv = 1.0 / dr.sqrt(1.0 + sx * sx + sy * sy)
+        return mi.Vector3d(-sx * inv, -sy * inv, inv), ok
+
+    @staticmethod
+    def _solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral):
+        """`visible::solve_cell`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until it converges, at most 40 steps)."""
+        a = c - sn * x0
+
+        def density(t):
+            return (a - sn * t) * (p0 + k * t)
+
+        f0 = density(0.0 * a)
+        b = a * k - sn * p0
+        disc = f0 * f0 + 2.0 * b * rest
+        denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
+        t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
+        lo, hi = dr.zeros(mi.Float64, dr.width(t)), mi.Float64(tau_max)
+        tol = 1e-13 * (dr.abs(x0) + tau_max)
+
+        def body(step, done, t, lo, hi):
+            f = cell_integral(x0, p0, k, t) - rest
+            lo = dr.select(f < 0.0, t, lo)
+            hi = dr.select(f < 0.0, hi, t)
+            d = density(t)
+            nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
+            nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+            done = dr.abs(nxt - t) <= tol
+            return step + 1, done, nxt, lo, hi
+
+        _, _, t, _, _ = dr.while_loop(
+            (mi.UInt32(0), mi.Bool(False), t, lo, hi),
+            lambda step, done, t, lo, hi: (step < 40) & ~done,
+            body,
+        )
+        return t
+
+    def diffraction_sample(self, wi, u0, u1):
+        """The diffraction lobe's direction (`TwoScale::sample_lobe`, HP17
+        51-55) and whether it exists (f64)."""
+        s = self.s
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        b, c = self.d["big_b"], self.d["c"]
+        m = 1.0 / inv_m
+        # ln_1pf and exp_m1f of the runtime, in f64.
+        t = -2.0 / (c - 1.0) * dr.log(1.0 - m * u0)
+        r = dr.minimum(dr.sqrt(dr.maximum(dr.exp(t) - 1.0, 0.0)) / b, 1.0 + sin_i)
+        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
+        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
+        psi = (2.0 * u1 - 1.0) * phi_max
+        has = sin_i > 0.0
+        cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
+        sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
+        cp, sp = dr.cos(psi), dr.sin(psi)
+        ox = r * (cos_phi_i * cp - sin_phi_i * sp) - wi.x
+        oy = r * (sin_phi_i * cp + cos_phi_i * sp) - wi.y
+        z2 = 1.0 - ox * ox - oy * oy
+        ok = (inv_m > 0.0) & (z2 > 0.0) & (s["sigma_s"] > 0.0) & (b > 0.0)
+        return mi.Vector3d(ox, oy, dr.sqrt(dr.maximum(z2, 0.0))), ok
+
+    # -- the model -----------------------------------------------------
+    def q_bar(self, fi, fo, along, across):
+        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`)."""
+        s = self.s
+        s_sq = along * along + across * across
+        ok = s_sq > 0.0
+        along = dr.select(ok, along, 1.0)
+        across = dr.select(ok, across, 0.0)
+        inv_s_sq = dr.select(ok, 1.0 / s_sq, 1.0)
+        # ui uo along − η² (wi wo) s², complex.
+        uu_re = fi[1] * fo[1] - fi[2] * fo[2]
+        uu_im = fi[1] * fo[2] + fi[2] * fo[1]
+        ww_re = fi[3] * fo[3] - fi[4] * fo[4]
+        ww_im = fi[3] * fo[4] + fi[4] * fo[3]
+        e_re, e_im = self.d["q_eta_sq_re"], self.d["q_eta_sq_im"]
+        pp_re = uu_re * along - (e_re * ww_re - e_im * ww_im) * s_sq
+        pp_im = uu_im * along - (e_re * ww_im + e_im * ww_re) * s_sq
+        norm_ui = fi[1] * fi[1] + fi[2] * fi[2]
+        norm_uo = fo[1] * fo[1] + fo[2] * fo[2]
+        q = (fi[0] * fo[0] * (along * along)
+             + (fi[0] * norm_uo + norm_ui * fo[0]) * (across * across)
+             + pp_re * pp_re + pp_im * pp_im)
+        return 0.5 * self.d["q_e_norm_sqr"] * q * inv_s_sq
+
+    def base_value(self, f_i, f_o, cos_i, cos_o):
+        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47)."""
+        s, d = self.s, self.d
+        lambertian = d["base_lambertian"]
+        if s["white"] != 0.0 or s["base"] == 0.0:
+            return mi.Float64(lambertian)
+        t = (1.0 - f_i) * (1.0 - f_o)
+        if s["base"] == 1.0:
+            return t * d["base_plastic"] + lambertian
+
+        def refracted(cos):
+            return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) * d["base_inv_n_sq"], 0.0))
+
+        single = t * d["base_single"] / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
+        return single + t * d["base_multi"] + lambertian
+
+    def lobes(self, g, geo):
+        """`TwoScale::lobes`: (specular, diffraction, base) at a pair."""
+        s = self.s
+        wi, wo = geo["wi"], geo["wo"]
+        cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
+        cell_i = self.direction_cell(mi.Float(cos_i))
+        cell_o = self.direction_cell(mi.Float(cos_o))
+        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(7))]
+        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(7))]
+        # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
+        x = self.d["x_scale"] * cos_d * cos_d
+        if s["sigma_s"] > 0.0:
+            r_i, r_o = at_i[5], at_o[5]
+            ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
+            sigma_rel_sq = self.d["sigma_s_sq"] * ratio_sq
+        else:
+            sigma_rel_sq = mi.Float64(0.0)
+
+        def exp_and_one_minus_over(x, srs):
+            t = x * srs
+            e = dr.exp(-t)
+            small = t < 1e-8
+            return (dr.select(small, 1.0 - t, e),
+                    dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
+
+        a_spec, one_minus_a_over = exp_and_one_minus_over(x, sigma_rel_sq)
+        fresnel_d = (mi.Float64(1.0) if s["white"] else
+                     mi.Float64(self.direction(self.direction_cell(mi.Float(cos_d)), [6])[0]))
+        rho_ct = fresnel_d * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+        specular = a_spec * rho_ct
+
+        if self.diffraction:
+            if s["white"]:
+                q = mi.Float64(1.0)
+            elif s["has_q"]:
+                q = dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
+            else:
+                q = mi.Float64(0.0)
+            if s["halo_incident"]:
+                one_minus_a_over = exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
+                                                          sigma_rel_sq)[1]
+            halo = self.d["halo_scale"] * one_minus_a_over
+            c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
+                                mi.Float(self.d["big_b"] * cos_d))
+            c_value = mi.Float64(dr.maximum(c_value, 0.0))
+            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0)
+        else:
+            diffraction = mi.Float64(0.0)
+        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o)
+        return _finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base)
+
+
+class Model:
+    """The RGB model of a :class:`twoscale.Material` in Dr.Jit: its three
+    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
+
+    def __init__(self, material: twoscale.Material):
+        self.material = material
+        self.channels = [_Channel(b) for b in material.bakes()]
+        first = self.channels[0].s
+        self.p = dr.opaque(mi.Float, first["p"])
+        self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
+        self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
+        self.height_correlated = first["height_correlated"] != 0.0
+        self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
+
+    def d(self, h):
+        """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
+        cos_sq = h.z * h.z
+        inv_cos4 = 1.0 / (cos_sq * cos_sq)
+        tan_sq = (h.x * h.x + h.y * h.y) / cos_sq
+        y = dr.power(tan_sq * self.epd_inv_beta_sq, self.p)
+        value = self.epd_norm * inv_cos4 * dr.exp(-y)
+        return dr.select((h.z > 0.0) & (y < 104.0) & dr.isfinite(value), value, 0.0)
+
+    def geometry(self, wi, wo):
+        """The pair's geometry and D(h) (as `TwoScale::geometry`: directions
+        and h in f64, D of h rounded to f32), and whether both directions
+        are above the horizon."""
+        wi, wo = mi.Vector3f(wi), mi.Vector3f(wo)
+        valid = dr.all(dr.isfinite(wi)) & dr.all(dr.isfinite(wo))
+        wi, wo = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
+        valid &= (wi.z > 0.0) & (wo.z > 0.0)
+        h = dr.normalize(wi + wo)
+        return valid, {
+            "wi": wi,
+            "wo": wo,
+            "cos_d": dr.clip(dr.dot(wi, h), 0.0, 1.0),
+            "cos_h": dr.clip(h.z, 0.0, 1.0),
+            "sin_h": dr.minimum(dr.sqrt(h.x * h.x + h.y * h.y), 1.0),
+            "d": self.d(mi.Vector3f(h)),
+            "along": -(wi.x * wo.x + wi.y * wo.y),
+            "across": -(wi.x * wo.y - wi.y * wo.x),
+        }
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
+        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
+        below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        ch = self.channels[0]
+
+        def tangential(w):
+            return dr.sqrt(mi.Float(w.x * w.x + w.y * w.y))
+
+        g1_i = mi.Float64(ch.g1(tangential(wi), mi.Float(wi.z)))
+        g1_o = mi.Float64(ch.g1(tangential(wo), mi.Float(wo.z)))
+        if self.height_correlated:
+            g = 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0)
+        else:
+            g = g1_i * g1_o
+        values = []
+        for channel in self.channels:
+            spec, diff, base = channel.lobes(g, geo)
+            values.append(mi.Float(_finite_or_zero(
+                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base)))))
+        return dr.select(valid, mi.Color3f(*values), 0.0)
+
+    def pdf(self, wi, wo):
+        """`Material.pdf(wi, wo)` (``Rgb::pdf``): the mean over the channels of
+        `Σ_k w_k(wi) pdf_k(wi, wo)`, as an ``mi.Float``; 0 below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        specular = self.channels[0].visible_pdf(wi, wo)
+        base = wo.z / math.pi
+        total = mi.Float64(0.0)
+        for channel in self.channels:
+            w = channel.lobe_weights(wi.z)
+            value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
+            if channel.diffraction:
+                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
+            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            total += mi.Float64(_finite_or_zero(mi.Float(value)))
+        return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)
+
+    def sample_direction(self, wi, u):
+        """``Rgb::sample``'s direction for incidence `wi` and three uniforms
+        `u` (an ``mi.Vector3f``): a channel picked with `u[0]`, its lobe with
+        the rescaled `u[0]`, the lobe's direction from `u[1], u[2]`. Returns
+        the direction (``mi.Vector3f``) and whether one was drawn."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        wi_f = mi.Vector3f(wi)
+        valid = dr.all(dr.isfinite(wi_f))
+        wi = dr.normalize(mi.Vector3d(wi_f))
+        valid &= wi.z > 0.0
+        pick = 3.0 * mi.Float64(dr.clip(u.x, 0.0, below_one))
+        k = dr.minimum(mi.UInt32(pick), 2)
+        rest = mi.Float(pick - mi.Float64(k))
+        lobe_pick = mi.Float64(dr.clip(rest, 0.0, below_one))
+        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
+        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        # The picked channel's lobe weights.
+        weights = [ch.lobe_weights(wi.z) for ch in self.channels]
+        w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
+             for n in range(3)]
+        # `pick_lobe`.
+        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+        for n in range(3):
+            positive = w[n] > 0.0
+            cumulative += dr.select(positive, w[n], 0.0)
+            last = dr.select(positive, n, last)
+            chosen = dr.select((chosen < 0) & positive & (lobe_pick < cumulative), n, chosen)
+        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
+        # Specular: reflect wi about a visible normal (the bake is the channels').
+        m, ok_spec = self.channels[0].visible_sample(wi, u1, u2)
+        o = 2.0 * dr.dot(wi, m) * m - wi
+        ok = ok_spec
+        # Diffraction: the picked channel's law.
+        for n, channel in enumerate(self.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & (k == n)
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+        # Base: cosine-weighted.
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe == 2, ob, o)
+        ok = dr.select(lobe == 2, True, ok)
+        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
+        # `upper_unit(to_f32(o))`, back to f32.
+        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
+        return o, ok
+
+
+def _bsdf_class():
+    """The BSDF class for the current variant (``mi.BSDF`` is per variant)."""
+
+    class TwoScaleDrJitBSDF(mi.BSDF):
+        """The two-scale BRDF in Dr.Jit (front side only, glossy reflection)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            self.model = Model(_material(props))
+            self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            self.m_components = [self.m_flags]
+
+        @staticmethod
+        def _active(ctx, active):
+            return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
+
+        def _eval(self, si, wo):
+            """ρ(wi=wo, wo=si.wi) · cos θ(wo)."""
+            return self.model.eval(wo, si.wi) * dr.maximum(wo.z, 0.0)
+
+        def eval(self, ctx, si, wo, active=True):
+            return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            active = self._active(ctx, active)
+            return (dr.select(active, self._eval(si, wo), 0.0),
+                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            # The light direction from the runtime's sampler given the camera
+            # direction (as twoscale.mitsuba), its density and eval / pdf.
+            u = mi.Vector3f(sample1, sample2.x, sample2.y)
+            wo, ok = self.model.sample_direction(si.wi, u)
+            bs = mi.BSDFSample3f()
+            bs.wo = wo
+            bs.pdf = dr.select(ok, self.model.pdf(si.wi, wo), 0.0)
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+            bs.sampled_component = mi.UInt32(0)
+            active = self._active(ctx, active) & ok & (bs.pdf > 0.0)
+            weight = self._eval(si, wo) / dr.select(active, bs.pdf, 1.0)
+            return bs, dr.select(active, weight, 0.0)
+
+        def traverse(self, callback):
+            # No parameter is differentiable yet (issue 25 item 3).
+            pass
+
+        def to_string(self):
+            return f"TwoScaleDrJitBSDF[{self.model.material!r}]"
+
+    return TwoScaleDrJitBSDF
+
+
+def register() -> None:
+    """register(): registers the ``twoscale_drjit`` BSDF with the current Mitsuba
+    variant. No Dr.Jit flag is changed."""
+    if not mi.variant():
+        raise RuntimeError("call mi.set_variant(...) before twoscale.drjit_bsdf.register()")
+    cls = _bsdf_class()
+    mi.register_bsdf(NAME, lambda props: cls(props))
