@@ -177,6 +177,14 @@ typedef struct {
    * Its length in bytes.
    */
   uintptr_t diffuse_fresnel_len;
+  /**
+   * `t6-albedo.tbl`.
+   */
+  const uint8_t *albedo;
+  /**
+   * Its length in bytes.
+   */
+  uintptr_t albedo_len;
 } ts_table_bytes;
 
 /**

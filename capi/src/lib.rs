@@ -103,6 +103,10 @@ pub struct ts_table_bytes {
     pub diffuse_fresnel: *const u8,
     /// Its length in bytes.
     pub diffuse_fresnel_len: usize,
+    /// `t6-albedo.tbl`.
+    pub albedo: *const u8,
+    /// Its length in bytes.
+    pub albedo_len: usize,
 }
 
 /// Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
@@ -612,6 +616,7 @@ pub unsafe extern "C" fn ts_tables_from_bytes(bytes: *const ts_table_bytes) -> *
             TableId::SigmaRatio => (b.sigma_ratio, b.sigma_ratio_len),
             TableId::Convolution => (b.convolution, b.convolution_len),
             TableId::DiffuseFresnel => (b.diffuse_fresnel, b.diffuse_fresnel_len),
+            TableId::Albedo => (b.albedo, b.albedo_len),
             TableId::ShBrdf => (std::ptr::null(), 0),
         };
         let mut copies = TABLES
