@@ -183,6 +183,14 @@ typedef struct {
    * Its length in bytes.
    */
   uintptr_t diffuse_fresnel_len;
+  /**
+   * `t6-albedo.tbl`.
+   */
+  const uint8_t *albedo;
+  /**
+   * Its length in bytes.
+   */
+  uintptr_t albedo_len;
 } ts_table_bytes;
 
 /**
@@ -459,7 +467,7 @@ int ts_eval_rgb(const ts_material *m,
 /**
  * ρ(wi, wo) (sr⁻¹) at four wavelengths `lambda` (µm, each in
  * [0.36, 0.83]) into `out`, as spectral renderers carry them: the model that
- * serves every wavelength from one construction (docs/model.md §2.10),
+ * serves every wavelength from one construction (docs/model.md §2.12),
  * built by the first call on the material (milliseconds; thread-safe). For
  * presets (their measured index) and materials whose `eta` is one (n, k)
  * for every channel; other materials give `TS_ERR_INVALID`, as does a

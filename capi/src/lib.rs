@@ -116,6 +116,10 @@ pub struct ts_table_bytes {
     pub diffuse_fresnel: *const u8,
     /// Its length in bytes.
     pub diffuse_fresnel_len: usize,
+    /// `t6-albedo.tbl`.
+    pub albedo: *const u8,
+    /// Its length in bytes.
+    pub albedo_len: usize,
 }
 
 /// Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
@@ -660,6 +664,7 @@ pub unsafe extern "C" fn ts_tables_from_bytes(bytes: *const ts_table_bytes) -> *
             TableId::SigmaRatio => (b.sigma_ratio, b.sigma_ratio_len),
             TableId::Convolution => (b.convolution, b.convolution_len),
             TableId::DiffuseFresnel => (b.diffuse_fresnel, b.diffuse_fresnel_len),
+            TableId::Albedo => (b.albedo, b.albedo_len),
             TableId::ShBrdf => (std::ptr::null(), 0),
         };
         let mut copies = TABLES
@@ -943,7 +948,7 @@ pub unsafe extern "C" fn ts_eval_rgb(
 
 /// ρ(wi, wo) (sr⁻¹) at four wavelengths `lambda` (µm, each in
 /// [0.36, 0.83]) into `out`, as spectral renderers carry them: the model that
-/// serves every wavelength from one construction (docs/model.md §2.10),
+/// serves every wavelength from one construction (docs/model.md §2.12),
 /// built by the first call on the material (milliseconds; thread-safe). For
 /// presets (their measured index) and materials whose `eta` is one (n, k)
 /// for every channel; other materials give `TS_ERR_INVALID`, as does a

@@ -14,8 +14,8 @@ use std::io::{BufRead, Write};
 use twoscale::brdf::ChannelBake;
 use twoscale::desc::MaterialDesc;
 use twoscale::{
-    ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table, TableId,
-    TableSet,
+    AlbedoTable, ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table,
+    TableId, TableSet,
 };
 
 use twoscale::validate::{self, Invalid, Shortest, Shortest32};
@@ -334,6 +334,7 @@ pub struct Tables<'a> {
     sigma_ratio: Option<SigmaRatioTable<'a>>,
     convolution: Option<ConvTable<'a>>,
     diffuse_fresnel: Option<DiffuseFresnelTable<'a>>,
+    albedo: Option<AlbedoTable<'a>>,
 }
 
 impl<'a> Tables<'a> {
@@ -360,6 +361,9 @@ impl<'a> Tables<'a> {
                     tables.diffuse_fresnel =
                         Some(DiffuseFresnelTable::from_bytes(bytes).map_err(error())?);
                 }
+                TableId::Albedo => {
+                    tables.albedo = Some(AlbedoTable::from_bytes(bytes).map_err(error())?);
+                }
                 _ => {}
             }
         }
@@ -385,6 +389,7 @@ impl<'a> Tables<'a> {
             sigma_ratio: self.sigma_ratio()?,
             convolution: *self.convolution()?,
             diffuse_fresnel: self.diffuse_fresnel.ok_or(RowError::NoTables)?,
+            albedo: self.albedo.ok_or(RowError::NoTables)?,
         })
     }
 }

@@ -96,6 +96,7 @@ pub fn embedded(id: TableId) -> Option<&'static [u8]> {
         TableId::SigmaRatio => Some(set.sigma_ratio),
         TableId::Convolution => Some(set.convolution),
         TableId::DiffuseFresnel => Some(set.diffuse_fresnel),
+        TableId::Albedo => Some(set.albedo),
         _ => None,
     }
 }

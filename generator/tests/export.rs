@@ -69,6 +69,7 @@ fn reduced_precisions_are_exported_within_their_budget_or_refused() {
     assert_eq!(allowed(TableId::SigmaRatio), ["f32", "unorm16"]);
     assert_eq!(allowed(TableId::DiffuseFresnel), ["f32"]);
     assert_eq!(allowed(TableId::Convolution), ["f32", "unorm16"]);
+    assert_eq!(allowed(TableId::Albedo), ["f32", "unorm16"]);
 }
 
 #[test]
@@ -217,6 +218,33 @@ fn c_headers_compile_and_hold_the_runtime_values() {
         let f = f64::from(fresnel.f_dr_int(eta));
         // A few f32 ulps (summation order, logf of the position).
         expected.push((format!("F_dr(η = {eta})"), f, 4e-7));
+    }
+    // T6's C lookup (its coordinates in double, as the runtime) against the runtime's.
+    let t6 = open(TableId::Albedo);
+    let albedo = twoscale::AlbedoTable::from_bytes(t6.bytes()).unwrap();
+    for k in 0..200 {
+        let p = rng.uniform_in(0.2, 5.0) as f32;
+        let beta = rng.log_uniform_in(1e-4, 10.0) as f32;
+        let cos = if k % 2 == 0 {
+            rng.uniform() as f32
+        } else {
+            rng.log_uniform_in(1e-6, 1.0) as f32
+        };
+        let masking = k % 2;
+        body.push_str(&format!(
+            "    printf(\"%a\\n\", (double)ts_t6_albedo_albedo({cos:e}f, {beta:e}f, {p:e}f, {masking}));\n"
+        ));
+        let m = [
+            twoscale::brdf::Masking::Separable,
+            twoscale::brdf::Masking::HeightCorrelated,
+        ][masking];
+        let e = f64::from(albedo.albedo(cos, beta, p, m));
+        // f32 summation order (2.4e-7 at worst when written).
+        expected.push((
+            format!("E(cos = {cos:e}, β = {beta}, p = {p}, {m:?})"),
+            e,
+            1e-6,
+        ));
     }
     // T3b's C lookup over the exported codes (u16 per node) against the runtime's.
     let conv = twoscale::ConvTable::from_bytes(t3_file.bytes()).unwrap();

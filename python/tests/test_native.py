@@ -310,7 +310,7 @@ def test_explicit_material_equals_preset():
 def test_eval_spectral_matches_the_rgb_channels_at_their_wavelengths():
     """At the paper's wavelengths the spectral model of a preset is its RGB
     model's channel (the spectral model interpolates between models 0.04 µm
-    apart, docs/model.md §2.10: within 0.5%)."""
+    apart, docs/model.md §2.12: within 0.5%)."""
     gold = twoscale.Material.preset("gold-rough")
     n = 2000
     wi = hemisphere(n)

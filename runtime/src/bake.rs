@@ -38,7 +38,7 @@ use crate::smith::SmithShape;
 use zerocopy::FromZeros;
 
 /// Nodes of [`DirectionBake`].
-const MU_NODES: usize = 257;
+pub(crate) const MU_NODES: usize = 257;
 /// Nodes of [`MaskingBake`].
 const MASKING_NODES: usize = 1025;
 /// `u` nodes of [`ConvBake`].

@@ -47,6 +47,7 @@
 //! [`TwoScale::sample`] returns (directions that would fall below the horizon
 //! are not returned, so `∫ pdf ≤ 1`).
 
+use crate::albedo::AlbedoTable;
 pub use crate::bake::BakeVisitor;
 use crate::bake::{
     ConvBake, DirectionBake, DirectionCell, DirectionValues, MaskingBake, RadialNormBake,
@@ -230,6 +231,9 @@ pub struct Tables<'a> {
     pub sigma_ratio: SigmaRatioTable<'a>,
     /// T5, F_dr,int (plastic and subsurface bases).
     pub diffuse_fresnel: DiffuseFresnelTable<'a>,
+    /// T6, the directional albedo of the specular lobe (the
+    /// energy-compensation lobe, [`MultipleScattering::KullaConty`]).
+    pub albedo: AlbedoTable<'a>,
     /// The source of `C(θh; u, c, β, p)` (`Sync`, so that one model can be
     /// shared by a renderer's threads).
     pub convolution: &'a (dyn Convolution + Sync),

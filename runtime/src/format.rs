@@ -82,7 +82,7 @@ pub struct TableDescriptor {
     /// Names of the generation parameters stored in [`Header::params`]
     /// (unused slots are zero and unnamed): the fields of the table's
     /// parameter struct ([`SmithG1Params`], [`SigmaRatioParams`],
-    /// [`DiffuseFresnelParams`], [`ConvParams`], [`ShBrdfParams`]).
+    /// [`DiffuseFresnelParams`], [`ConvParams`], [`ShBrdfParams`], [`AlbedoParams`]).
     pub param_names: &'static [&'static str],
     /// How the runtime interpolates the payload; the reader refuses a file
     /// whose header says otherwise ([`Table::expecting`]).
@@ -216,6 +216,19 @@ table_ids! {
         params: ConvParams,
         kernel: CatmullRom,
         value_type: U16,
+        aux: "",
+        in_set: true,
+    }
+    /// T6: the directional albedo `E(μ; β, p)` of the EPD microfacet lobe
+    /// with F = 1, per masking mode; see [`crate::albedo`].
+    Albedo = 7 {
+        number: 6,
+        stem: "t6-albedo",
+        description: "directional albedo E(mu; beta, p) of the EPD microfacet lobe with F = 1 (docs/model.md 2.10); channels: separable, height-correlated masking; axes y = L/(1+L), L = ln(1+t), t = sigma tan(theta_i), sigma = s0/(1+s0^2), s0 = (1+k_p) beta, and z = (x-1)/(x+1), x = (k_p beta/width_centre)^width_exponent, and p; cubic B-spline coefficients",
+        axes: ["incidence_y", "width_z", "p"],
+        params: AlbedoParams,
+        kernel: CubicBSpline,
+        value_type: F32,
         aux: "",
         in_set: true,
     }
@@ -388,6 +401,22 @@ header_slots!(ConvParams {
     angle.edge_fade_tan,
     angle.edge_softening_fade,
 });
+
+header_params! {
+    /// T6's generation parameters.
+    AlbedoParams {
+        /// `γ_c` of the width coordinate (`crate::albedo::WIDTH_CENTRE`).
+        width_centre,
+        /// `κ` of the width coordinate (`crate::albedo::WIDTH_EXPONENT`).
+        width_exponent,
+        /// Gauss–Legendre points per piece of the node quadrature.
+        quadrature_points,
+        /// β at which the nodes of `z = −1` (β → 0) are computed.
+        beta_at_first_node,
+        /// β at which the nodes of `z = 1` (β → ∞) are computed.
+        beta_at_last_node,
+    }
+}
 
 header_params! {
     /// T4's generation parameters.

@@ -14,6 +14,7 @@
 // `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
 #![allow(clippy::manual_clamp)]
 
+pub mod albedo;
 mod bake;
 pub mod brdf;
 pub mod bxdf;
@@ -41,6 +42,7 @@ mod test_rng;
 pub mod validate;
 mod visible;
 
+pub use albedo::AlbedoTable;
 pub use brdf::{Rgb, TwoScale};
 pub use bxdf::{Bxdf, BxdfFlags, BxdfSample};
 pub use conv::{ConvFitTable, ConvTable, Convolution};

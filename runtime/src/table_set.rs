@@ -1,4 +1,4 @@
-//! The tables the BRDF reads (T1, T2, T3, T5), validated together, and the
+//! The tables the BRDF reads (T1, T2, T3, T5, T6), validated together, and the
 //! shipped material presets built from them.
 //!
 //! ```
@@ -15,6 +15,7 @@
 //! [`TableSet::from_bytes`] (any 64-byte-aligned bytes, `no_std`) and
 //! [`TableSet::open`] (feature `std`: read-only memory maps of a directory).
 
+use crate::albedo::AlbedoTable;
 use crate::brdf::{Material, Options, Rgb, Tables};
 use crate::conv::ConvTable;
 use crate::format::{FormatError, TableId};
@@ -28,7 +29,7 @@ use core::fmt;
 /// is the file `<TableId::name()>.tbl`.
 ///
 /// [`TableDescriptor::in_set`]: crate::format::TableDescriptor::in_set
-pub const TABLES: [TableId; 4] = set_tables();
+pub const TABLES: [TableId; 5] = set_tables();
 
 const fn set_tables<const N: usize>() -> [TableId; N] {
     let mut out = [TableId::SmithG1; N];
@@ -47,7 +48,7 @@ const fn set_tables<const N: usize>() -> [TableId; N] {
     out
 }
 
-/// The bytes of the four files (each 64-byte aligned, e.g. from
+/// The bytes of the five files (each 64-byte aligned, e.g. from
 /// [`include_table!`](crate::include_table) or a memory map).
 #[derive(Clone, Copy, Debug)]
 pub struct TableBytes<'a> {
@@ -59,6 +60,8 @@ pub struct TableBytes<'a> {
     pub convolution: &'a [u8],
     /// `t5-diffuse-fresnel.tbl`.
     pub diffuse_fresnel: &'a [u8],
+    /// `t6-albedo.tbl`.
+    pub albedo: &'a [u8],
 }
 
 impl<'a> TableBytes<'a> {
@@ -72,6 +75,7 @@ impl<'a> TableBytes<'a> {
             sigma_ratio: bytes(TableId::SigmaRatio)?,
             convolution: bytes(TableId::Convolution)?,
             diffuse_fresnel: bytes(TableId::DiffuseFresnel)?,
+            albedo: bytes(TableId::Albedo)?,
         })
     }
 }
@@ -132,7 +136,7 @@ impl fmt::Display for UnknownMaterial<'_> {
 impl std::error::Error for UnknownMaterial<'_> {}
 
 /// The tables the two-scale BRDF reads, each validated (header, checksum,
-/// finite values) and checked to be of its kind. `Copy`: a set is four
+/// finite values) and checked to be of its kind. `Copy`: a set is five
 /// views of borrowed bytes.
 #[derive(Clone, Copy, Debug)]
 pub struct TableSet<'a> {
@@ -144,10 +148,12 @@ pub struct TableSet<'a> {
     pub convolution: ConvTable<'a>,
     /// T5, F_dr,int of the plastic and subsurface bases.
     pub diffuse_fresnel: DiffuseFresnelTable<'a>,
+    /// T6, the directional albedo of the specular lobe (energy compensation).
+    pub albedo: AlbedoTable<'a>,
 }
 
 impl<'a> TableSet<'a> {
-    /// Validates the four files; the error names the first file at fault.
+    /// Validates the five files; the error names the first file at fault.
     pub fn from_bytes(bytes: TableBytes<'a>) -> Result<Self, TableSetError> {
         let at = |table: TableId| move |error: FormatError| TableSetError::Format { table, error };
         Ok(TableSet {
@@ -158,6 +164,7 @@ impl<'a> TableSet<'a> {
                 .map_err(at(TableId::Convolution))?,
             diffuse_fresnel: DiffuseFresnelTable::from_bytes(bytes.diffuse_fresnel)
                 .map_err(at(TableId::DiffuseFresnel))?,
+            albedo: AlbedoTable::from_bytes(bytes.albedo).map_err(at(TableId::Albedo))?,
         })
     }
 
@@ -167,6 +174,7 @@ impl<'a> TableSet<'a> {
             smith: self.smith,
             sigma_ratio: self.sigma_ratio,
             diffuse_fresnel: self.diffuse_fresnel,
+            albedo: self.albedo,
             convolution: &self.convolution,
         }
     }
@@ -209,6 +217,7 @@ impl TableSet<'static> {
             sigma_ratio: &[],
             convolution: &[],
             diffuse_fresnel: &[],
+            albedo: &[],
         })
     }
 
@@ -230,7 +239,7 @@ impl TableSet<'static> {
 
 #[cfg(feature = "std")]
 impl TableSet<'static> {
-    /// Memory-maps the four files of `dir` (read-only) and validates them.
+    /// Memory-maps the five files of `dir` (read-only) and validates them.
     /// The set owns the maps: they are released when it is dropped. Table
     /// files are immutable; replacing one while mapped must be a rename.
     pub fn open(dir: impl AsRef<std::path::Path>) -> Result<OwnedTableSet, TableSetError> {

@@ -20,6 +20,7 @@ mod t3_interp;
 mod t3_node_cost;
 mod t3_thresholds;
 mod t4_band_limits;
+mod t6_axes;
 
 use clap::{Parser, Subcommand};
 use common::Distribution;
@@ -272,6 +273,17 @@ enum Study {
         #[arg(long, default_value_t = 4096)]
         batch: usize,
     },
+    /// T6's node counts and p mapping against its interpolated error, size
+    /// and build time (docs/design/t6-albedo-axes.md).
+    T6Axes {
+        /// Random points (each measured for both maskings).
+        #[arg(long, default_value_t = 20000)]
+        points: usize,
+        /// Layouts `ny,nz,np,power` (repeatable).
+        #[arg(long = "layout", value_parser = t6_axes::parse_layout,
+              default_values = ["40,56,10,-0.5", "40,48,13,-0.5", "36,48,14,-0.35", "32,44,14,-0.35", "36,40,16,-0.35"])]
+        layouts: Vec<[f64; 4]>,
+    },
     /// T4's error against the band limit L
     /// (docs/design/t4-band-limits.md).
     T4BandLimits {
@@ -371,6 +383,7 @@ fn main() -> ExitCode {
             t3_thresholds::run();
             Ok(())
         }
+        Study::T6Axes { points, layouts } => t6_axes::run(&layouts, points),
         Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
         Study::RgbIntegration { pairs, seed } => rgb_integration::run(pairs, seed),
         Study::BrdfTiming { rounds, batch } => brdf_instructions::timing(rounds, batch),

@@ -97,14 +97,14 @@ int main(int argc, char **argv) {
     CHECK(embedded != NULL);
     ts_tables *opened = ts_tables_open(dir);
     CHECK(opened != NULL);
-    const char *files[4] = {"t1-smith-g1.tbl", "t2-sigma-ratio.tbl", "t3-convolution.tbl",
-                            "t5-diffuse-fresnel.tbl"};
-    unsigned char *buf[4];
-    size_t len[4];
-    for (int k = 0; k < 4; k++) buf[k] = read_file(dir, files[k], &len[k]);
+    const char *files[5] = {"t1-smith-g1.tbl", "t2-sigma-ratio.tbl", "t3-convolution.tbl",
+                            "t5-diffuse-fresnel.tbl", "t6-albedo.tbl"};
+    unsigned char *buf[5];
+    size_t len[5];
+    for (int k = 0; k < 5; k++) buf[k] = read_file(dir, files[k], &len[k]);
     /* buf[k] + 1 is deliberately not 64-byte aligned: the library copies. */
-    ts_table_bytes bytes = {buf[0] + 1, len[0], buf[1] + 1, len[1],
-                            buf[2] + 1, len[2], buf[3] + 1, len[3]};
+    ts_table_bytes bytes = {buf[0] + 1, len[0], buf[1] + 1, len[1], buf[2] + 1,
+                            len[2],     buf[3] + 1, len[3], buf[4] + 1, len[4]};
     ts_tables *copied = ts_tables_from_bytes(&bytes);
     CHECK(copied != NULL);
 
@@ -312,6 +312,9 @@ int main(int argc, char **argv) {
     t.diffuse_fresnel = NULL;
     EXPECT_NULL(ts_tables_from_bytes(&t), TS_ERR_NULL, "t5-diffuse-fresnel.tbl");
     t = bytes;
+    t.albedo_len = len[4] - 8;
+    EXPECT_NULL(ts_tables_from_bytes(&t), TS_ERR_TABLES, "t6-albedo.tbl");
+    t = bytes;
     t.smith = bytes.diffuse_fresnel;
     t.smith_len = bytes.diffuse_fresnel_len;
     EXPECT_NULL(ts_tables_from_bytes(&t), TS_ERR_TABLES, "t1-smith-g1.tbl");
@@ -331,7 +334,7 @@ int main(int argc, char **argv) {
     ts_material_free(m);
     ts_tables_free(embedded);
     ts_tables_free(opened);
-    for (int k = 0; k < 4; k++) free(buf[k]);
+    for (int k = 0; k < 5; k++) free(buf[k]);
     if (failures) {
         fprintf(stderr, "%d checks failed\n", failures);
         return 1;

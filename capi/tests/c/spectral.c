@@ -1,6 +1,6 @@
 /*
  * ts_eval_spectral: a preset at four wavelengths against its RGB channels at
- * the paper's wavelengths (within 0.5%, docs/model.md §2.10), a material
+ * the paper's wavelengths (within 0.5%, docs/model.md §2.12), a material
  * with one index, and each refusal as its status code. Run under valgrind
  * memcheck in CI.
  */

@@ -253,6 +253,54 @@ return (float)(q * r0);
     )
 }
 
+/// T6's lookup in C: the tricubic B-spline at the incidence and width
+/// coordinates of `twoscale::albedo` (computed in double, as the runtime
+/// does), channel `masking`. The C lookups read the header's first exported
+/// precision (`value`, the C expression of stored value `k`) as the runtime
+/// does (docs/export.md); `p` is the identifier prefix, `u` its upper case.
+pub fn albedo(p: &str, u: &str, value: &str) -> String {
+    let v = |k: &str| value_at(value, k);
+    format!(
+        r#"/* E(mu; beta, p) of the EPD microfacet lobe with F = 1, masking 0 (separable) or
+ * 1 (height-correlated): with k_p = Gamma(3/(2p)) / (pi Gamma(1/p)),
+ * y = L/(1+L), L = ln(1 + t), t = sigma tan(theta_i), sigma = s0/(1+s0^2), s0 = (1 + k_p) beta and
+ * z = (x-1)/(x+1), x = (k_p beta / {centre})^{exponent}; p clamped to [0.2, 5],
+ * the result to [0, 1]. */
+static inline float {p}_albedo(float cos_theta_i, float beta, float p, int masking) {{
+double pp = fmin(fmax((double)p, 0.2), 5.0);
+double kp = tgamma(1.5 / pp) / (3.14159265358979323846 * tgamma(1.0 / pp));
+double b = beta > 0.0f ? (double)beta : 0.0;
+double s0 = (1.0 + kp) * b, sigma = s0 < 1e150 ? s0 / (1.0 + s0 * s0) : 1.0 / s0;
+double c = fmin(fmax((double)cos_theta_i, 0.0), 1.0);
+double l = c > 0.0 ? log1p(sigma * sqrt((1.0 - c) * (1.0 + c)) / c) : (sigma > 0.0 ? INFINITY : 0.0);
+double y = isfinite(l) ? l / (1.0 + l) : 1.0;
+double x = pow(kp * b / {centre}, {exponent});
+double z = b > 0.0 ? (isfinite(x) ? (x - 1.0) / (x + 1.0) : 1.0) : -1.0;
+float t0, t1, t2, w0[4], w1[4], w2[4];
+int i0 = ts_cell({p}_incidence_y_position((float)y), {u}_INCIDENCE_Y_NODES, &t0);
+int i1 = ts_cell({p}_width_z_position((float)z), {u}_WIDTH_Z_NODES, &t1);
+int i2 = ts_cell({p}_p_position((float)pp), {u}_P_NODES, &t2);
+int n1 = {u}_WIDTH_Z_NODES + 2, n2 = {u}_P_NODES + 2;
+ts_bspline_weights(t0, w0);
+ts_bspline_weights(t1, w1);
+ts_bspline_weights(t2, w2);
+float e = 0.0f;
+for (int a = 0; a < 4; a++)
+    for (int d = 0; d < 4; d++)
+        for (int f = 0; f < 4; f++) {{
+            int k = (((i0 + a) * n1 + i1 + d) * n2 + i2 + f) * 2 + masking;
+            e += w0[a] * w1[d] * w2[f] * {};
+        }}
+return fminf(fmaxf(e, 0.0f), 1.0f);
+}}
+
+"#,
+        v("k"),
+        centre = twoscale::albedo::WIDTH_CENTRE,
+        exponent = twoscale::albedo::WIDTH_EXPONENT,
+    )
+}
+
 /// T3's lookup in C: the parameter-axis weights and C from T3b (as `ConvTable::at_tan`). The C lookups read the header's first exported precision
 /// (`value`, the C expression of stored value `k`) as the runtime does
 /// (docs/export.md); `p` is the identifier prefix, `u` its upper case.

@@ -86,7 +86,7 @@ impl Format {
 /// The tables `export` knows: those of the runtime's
 /// [`TableSet`](twoscale::TableSet), each with an [`Export`] in the registry
 /// (T4 is not exported; a unit test of [`tables`] checks both).
-pub const EXPORTABLE: [TableId; 4] = twoscale::table_set::TABLES;
+pub const EXPORTABLE: [TableId; 5] = twoscale::table_set::TABLES;
 
 /// The table named `name` (a file stem or a unique prefix, as for `build`:
 /// [`tables::select`]), if `export` supports it.

@@ -12,6 +12,7 @@ pub mod t2;
 pub mod t3;
 pub mod t4;
 pub mod t5;
+pub mod t6;
 
 /// A table the generator knows how to build and verify: the generator's
 /// side of the table's [`TableDescriptor`](twoscale::format::TableDescriptor)
@@ -103,6 +104,7 @@ pub fn all() -> Vec<&'static dyn TableKind> {
         &t1::SmithG1,
         &t2::SigmaRatio,
         &t5::DiffuseFresnel,
+        &t6::Albedo,
         &t3::Conv,
     ]
 }

@@ -54,7 +54,7 @@ use crate::sh::{IsotropicBrdf, Runtime, default_quadrature, project};
 pub const WORKSPACE_TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
 
 /// The tables the two-scale model reads: the runtime's set.
-pub const INPUTS: [TableId; 4] = twoscale::table_set::TABLES;
+pub const INPUTS: [TableId; 5] = twoscale::table_set::TABLES;
 
 /// Verification target: `max |f_SH − f| / max f` over the random pairs, with
 /// `f = ρ cos θi cos θo` (what the matrix represents; dividing by the cosines

@@ -495,6 +495,131 @@ pub fn g1(p: f64, a: f64) -> Result<f64, QuadError> {
     lambda(p, a).map(|l| 1.0 / (1.0 + l))
 }
 
+/// Smith Λ of one shape `p` as a fast interpolant, for the integrals that
+/// need Λ at thousands of directions (the directional albedo,
+/// [`crate::reference::albedo`]): piecewise Chebyshev interpolation of
+/// [`lambda`] in `x = ln(ã + 0.01)`, `ã = k_p a ∈ [0, 10⁴]` (T1's scaled
+/// variable, in which Λ is smooth for every p: `Λ ≈ ã − ½` once `ã ≳ 1`),
+/// [`CURVE_PANELS`] equal panels of degree [`CURVE_DEGREE`]; beyond
+/// `ã = 10⁴` the asymptote `k_p a − ½ + m_p/a` (next term `O(1/a²)`, below
+/// 1e-8 there). Building it costs `CURVE_PANELS · (CURVE_DEGREE + 1)` calls
+/// of [`lambda`] (about 40 ms); a lookup about 50 ns.
+///
+/// Accuracy (tests: 4000 random `a` per p for p ∈ {0.2, 0.35, 0.7, 1, 2.5,
+/// 5}): `|ΔΛ| / (1 + Λ)` — the relative error of `G1 = 1/(1 + Λ)` — at most
+/// 2.2e-14 (p = 0.2; 6e-15 elsewhere); asserted ≤ 1e-13.
+#[derive(Clone, Debug)]
+pub struct LambdaCurve {
+    p: f64,
+    k_p: f64,
+    m_p: f64,
+    x_lo: f64,
+    /// Panels per unit of `x`.
+    scale: f64,
+    /// Chebyshev coefficients per panel.
+    panels: Vec<[f64; CURVE_DEGREE + 1]>,
+}
+
+/// Panels of [`LambdaCurve`].
+pub const CURVE_PANELS: usize = 48;
+/// Degree of each panel of [`LambdaCurve`].
+pub const CURVE_DEGREE: usize = 20;
+/// `ã` beyond which [`LambdaCurve`] uses the asymptote.
+const CURVE_A_SCALED_MAX: f64 = 1e4;
+/// The offset of [`LambdaCurve`]'s variable `ln(ã + offset)`.
+const CURVE_OFFSET: f64 = 0.01;
+
+impl LambdaCurve {
+    /// Interpolates Λ at shape `p` (errors: those of [`lambda`]).
+    pub fn new(p: f64) -> Result<Self, QuadError> {
+        check_p(p)?;
+        let k = k_p(p);
+        let x_lo = libm::log(CURVE_OFFSET);
+        let x_hi = libm::log(CURVE_A_SCALED_MAX + CURVE_OFFSET);
+        let width = (x_hi - x_lo) / CURVE_PANELS as f64;
+        let n = CURVE_DEGREE + 1;
+        let mut panels = Vec::with_capacity(CURVE_PANELS);
+        for j in 0..CURVE_PANELS {
+            let centre = x_lo + width * (j as f64 + 0.5);
+            // Values at the Chebyshev points t_m = cos(π (m + ½)/n).
+            let mut values = [0.0; CURVE_DEGREE + 1];
+            for (m, v) in values.iter_mut().enumerate() {
+                let t = libm::cos(PI * (m as f64 + 0.5) / n as f64);
+                let a_scaled = (libm::exp(centre + 0.5 * width * t) - CURVE_OFFSET).max(0.0);
+                *v = lambda(p, a_scaled / k)?;
+            }
+            let mut coefficients = [0.0; CURVE_DEGREE + 1];
+            for (q, c) in coefficients.iter_mut().enumerate() {
+                let sum: f64 = values
+                    .iter()
+                    .enumerate()
+                    .map(|(m, v)| v * libm::cos(PI * q as f64 * (m as f64 + 0.5) / n as f64))
+                    .sum();
+                *c = if q == 0 { 1.0 } else { 2.0 } * sum / n as f64;
+            }
+            panels.push(coefficients);
+        }
+        Ok(LambdaCurve {
+            p,
+            k_p: k,
+            m_p: m_p(p),
+            x_lo,
+            scale: 1.0 / width,
+            panels,
+        })
+    }
+
+    /// The shape p.
+    pub fn p(&self) -> f64 {
+        self.p
+    }
+
+    /// `k_p` of the asymptote ([`k_p`]).
+    pub fn k_p(&self) -> f64 {
+        self.k_p
+    }
+
+    /// Λ(a) for `a ≥ 0` (`a = ∞` gives ∞; NaN gives NaN).
+    pub fn lambda(&self, a: f64) -> f64 {
+        if a.is_nan() {
+            return f64::NAN;
+        }
+        if a <= 0.0 {
+            return 0.0;
+        }
+        let a_scaled = self.k_p * a;
+        if a_scaled >= CURVE_A_SCALED_MAX {
+            return self.k_p * a - 0.5 + self.m_p / a;
+        }
+        let position = (libm::log(a_scaled + CURVE_OFFSET) - self.x_lo) * self.scale;
+        let j = (position.max(0.0) as usize).min(CURVE_PANELS - 1);
+        let t = 2.0 * (position - j as f64) - 1.0;
+        // Clenshaw's recurrence.
+        let c = &self.panels[j];
+        let (mut b1, mut b2) = (0.0, 0.0);
+        for &ck in c[1..].iter().rev() {
+            let b0 = 2.0 * t * b1 - b2 + ck;
+            b2 = b1;
+            b1 = b0;
+        }
+        (t * b1 - b2 + c[0]).max(0.0)
+    }
+
+    /// `c · Λ(s/c)` for the cosine `c ≥ 0` and sine `s ≥ 0` of an angle
+    /// (here `a = s/c = tan θ`): finite at `c = 0`, where it is `k_p s`
+    /// (the asymptote `c Λ = k_p s − c/2 + m_p c²/s`).
+    pub fn cos_lambda(&self, c: f64, s: f64) -> f64 {
+        if c.is_nan() || c <= 0.0 {
+            return self.k_p * s.max(0.0);
+        }
+        let a = s / c;
+        if self.k_p * a >= CURVE_A_SCALED_MAX {
+            return self.k_p * s - 0.5 * c + self.m_p * c * c / s;
+        }
+        c * self.lambda(a)
+    }
+}
+
 /// Closed-form Smith Λ of the Beckmann distribution (EPD with `p = 1`),
 /// `a = α tan θ`, `μ = 1/a`:
 ///
@@ -1289,6 +1414,36 @@ mod tests {
                 assert!(y.is_finite() && y >= 0.0, "a={a} q=1-{q}: {y}");
             }
             a *= 1.3;
+        }
+    }
+
+    /// [`LambdaCurve`] against [`lambda`] at random `a` (half log-uniform
+    /// over [1e-4, 1e6], half uniform in the curve's variable up to
+    /// `ã = 10⁴`): the relative error of `1 + Λ` is at most 1e-13.
+    #[test]
+    fn lambda_curve_matches_lambda() {
+        let mut rng = crate::rng::SplitMix64::new(27);
+        for p in [0.2, 0.35, 0.7, 1.0, 2.5, 5.0] {
+            let curve = LambdaCurve::new(p).unwrap();
+            let mut worst: f64 = 0.0;
+            for k in 0..4000 {
+                let a = if k % 2 == 0 {
+                    rng.log_uniform_in(1e-4, 1e6)
+                } else {
+                    let x = rng.uniform_in((0.01f64).ln(), (1e4f64 + 0.01).ln());
+                    (x.exp() - 0.01).max(0.0) / k_p(p)
+                };
+                let exact = lambda(p, a).unwrap();
+                let err = (curve.lambda(a) - exact).abs() / (1.0 + exact);
+                worst = worst.max(err);
+            }
+            eprintln!("LambdaCurve p = {p}: max |ΔΛ|/(1 + Λ) = {worst:.2e}");
+            assert!(worst <= 1e-13, "p = {p}: {worst:e}");
+            // c Λ(s/c) is continuous into c = 0.
+            let s = 0.8f64;
+            let at_zero = curve.cos_lambda(0.0, s);
+            let near = curve.cos_lambda(1e-9, (1.0f64 - 1e-18).sqrt() * s);
+            assert!((at_zero - near).abs() < 1e-8, "{at_zero} {near}");
         }
     }
 }

@@ -5,6 +5,8 @@
 //! failures and invalid parameters are reported as
 //! [`QuadError`](crate::quad::QuadError); nothing here panics on bad input.
 //!
+//! * [`albedo`]: the directional albedo `E(μ; β, p)` of the EPD microfacet
+//!   lobe with F = 1 and its cosine-weighted mean `E_avg` (docs/model.md §2.10).
 //! * [`brdf`]: the two-scale BRDF of a conductor (HP17 24-33) with exact
 //!   Λ, σrel and C, and the exact-C adapter of the runtime's `Convolution` trait.
 //! * [`epd`]: the Exponential Power Distribution NDF of (HP17 34–35), its
@@ -18,6 +20,7 @@
 //!   diffraction colour term Q of (HP17 10), and the diffuse Fresnel
 //!   reflectances of a dielectric (docs/model.md §2.6).
 
+pub mod albedo;
 pub mod brdf;
 pub mod conv;
 pub mod epd;

@@ -1,5 +1,5 @@
 //! The model's linear-sRGB reflectance by integration over the spectrum
-//! (docs/design/rgb-integration.md, docs/model.md §2.10):
+//! (docs/design/rgb-integration.md, docs/model.md §2.12):
 //!
 //! ```text
 //! ρ_c(i,o) = ∫ ρ(i,o,λ) w_c(λ) dλ                       (w_c: crate::colour)

@@ -1,5 +1,5 @@
 //! The model at any wavelength of [0.36, 0.83] µm from one construction
-//! (docs/model.md §2.10): models at [`SPECTRAL_WAVELENGTHS`] sharing the
+//! (docs/model.md §2.12): models at [`SPECTRAL_WAVELENGTHS`] sharing the
 //! surface's bakes, their surface lobes divided by F(θd) at their
 //! wavelength, interpolated linearly in λ and multiplied by F(θd) at λ:
 //!
