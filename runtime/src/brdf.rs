@@ -231,8 +231,8 @@ pub struct Tables<'a> {
     pub sigma_ratio: SigmaRatioTable<'a>,
     /// T5, F_dr,int (plastic and subsurface bases).
     pub diffuse_fresnel: DiffuseFresnelTable<'a>,
-    /// T6, the directional albedo of the specular lobe (the
-    /// energy-compensation lobe, [`MultipleScattering::KullaConty`]).
+    /// T6, the directional albedo of the specular lobe (what the
+    /// energy compensation of docs/model.md §2.10 needs).
     pub albedo: AlbedoTable<'a>,
     /// The source of `C(θh; u, c, β, p)` (`Sync`, so that one model can be
     /// shared by a renderer's threads).
