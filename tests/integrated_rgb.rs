@@ -275,7 +275,8 @@ fn sampler_follows_its_pdf() {
 /// one-wavelength model built at that λ with the same interpolated index:
 /// relative error within 0.5% at p99 and 2% at most (the target),
 /// where the one-wavelength value exceeds 1e-3 of the largest seen; the
-/// four-wavelength form equals four single calls.
+/// four-wavelength form equals four single calls; `sample` returns `pdf`
+/// and `eval` at its direction.
 #[test]
 fn spectral_matches_one_wavelength_models() {
     use twoscale::brdf::Spectral;
@@ -283,6 +284,8 @@ fn spectral_matches_one_wavelength_models() {
     let tables = set.brdf_tables();
     let options = Options::default();
     let mut rng = SplitMix64::new(5);
+    // The sampler check's uniforms, apart from the accuracy draw's.
+    let mut sample_rng = SplitMix64::new(6);
     let mut failed = Vec::new();
     let mut materials: Vec<(String, SpectralMaterial<'static>)> = SPECTRAL_PRESETS
         .iter()
@@ -323,6 +326,11 @@ fn spectral_matches_one_wavelength_models() {
                     f64::from(one.eval(i, o)),
                     f64::from(model.eval(i, o, lambda)),
                 ));
+                let u = [0, 1, 2].map(|_| sample_rng.uniform() as f32);
+                if let Some(s) = model.sample(i, u, lambda) {
+                    assert_eq!(s.pdf, model.pdf(i, s.o, lambda));
+                    assert_eq!(s.value, model.eval(i, s.o, lambda));
+                }
                 let ls = [lambda, 0.4, 0.55, 0.8];
                 let four = model.eval4(i, o, ls);
                 for (l, v) in ls.iter().zip(four) {

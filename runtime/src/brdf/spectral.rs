@@ -113,14 +113,19 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
 
     /// ρ(i, o) at `lambda` µm (module documentation). 0 below the horizon.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3], lambda: f32) -> f32 {
-        self.eval4(i, o, [lambda; 4])[0]
+        self.eval_at(i, o, [lambda])[0]
     }
 
     /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
     /// the pair's geometry, D and G once, each model needed once.
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
+        self.eval_at(i, o, lambdas)
+    }
+
+    /// ρ(i, o) at `N` wavelengths.
+    fn eval_at<const N: usize>(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; N]) -> [f32; N] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
-            return [0.0; 4];
+            return [0.0; N];
         };
         let cos_d = pair.geometry.cos_d as f32;
         // Each model's lobes and F(θd), computed when first needed.
@@ -166,10 +171,17 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     /// with the sampler of the nearest model; the value is
     /// [`Spectral::eval`] at `lambda`.
     pub fn sample(&self, i: [f32; 3], u: [f32; 3], lambda: f32) -> Option<Sample> {
-        let s = self.nearest(lambda).sample(i, u)?;
+        let node = self.nearest(lambda);
+        let (o, lobe) = node.sample_direction(i, u)?;
+        let pdf = finite_or_zero(node.pdf_at(&node.geometry(i, o)?));
+        if !(pdf > 0.0) {
+            return None;
+        }
         Some(Sample {
-            value: self.eval(i, s.o, lambda),
-            ..s
+            o,
+            pdf,
+            value: self.eval(i, o, lambda),
+            lobe,
         })
     }
 }
