@@ -919,3 +919,73 @@ fn t3b_material_slice_gives_the_full_lookup_values() {
     eprintln!("C, slice vs full T3b lookup: max relative difference {worst:.2e}");
     assert!(worst < 1e-4, "{worst}");
 }
+
+/// The diffraction lobe's sampler (the spectrum's draw mixed with the
+/// half-vector draw of the C bake, docs/design/halo-sampling.md) against its
+/// pdf with the embedded T3b (so that C is baked): χ² and `∫ pdf` = success
+/// rate for HP17's geometry and strong halos (σs 0.1 µm; b 1–20 µm; β
+/// 0.01–0.5; p 0.6–2), θi ∈ {0°, 60°, 85°}, 3·10⁵ samples each; and the
+/// whole model (lobe choice by energy) at 85°.
+#[test]
+fn halo_sampling_chi2() {
+    let set = twoscale::TableSet::embedded();
+    let tables = set.brdf_tables();
+    let gold = Complex::new(0.58, 2.15);
+    let surfaces = [
+        surface(0.0598, 1.0, 0.0273, 4.8418, 2.0),
+        surface(0.1, 1.0, 0.1, 3.0, 1.6),
+        surface(0.01, 0.6, 0.1, 1.0, 2.0),
+        surface(0.5, 2.0, 0.1, 20.0, 2.0),
+    ];
+    let mut cases = Vec::new();
+    for (k, s) in surfaces.iter().enumerate() {
+        for deg in [0.0, 60.0, 85.0] {
+            cases.push((k, *s, deg, Some(Lobe::Diffraction)));
+        }
+        cases.push((k, *s, 85.0, None));
+    }
+    let alpha = suite::sidak(0.01, cases.len());
+    let n = 300_000;
+    let mut failures = Vec::new();
+    for (seed, &(k, s, deg, lobe)) in cases.iter().enumerate() {
+        let model = TwoScale::conductor(&tables, s, 0.526, gold);
+        let i = from_angles(f64::to_radians(deg), 0.3);
+        let check = chi_square_sampler(
+            i,
+            |u| match lobe {
+                Some(lobe) => model.sample_lobe(lobe, i, [u[1], u[2]]),
+                None => model.sample(i, u).map(|s| s.o),
+            },
+            |o| match lobe {
+                Some(lobe) => f64::from(model.pdf_lobe(lobe, i, o)),
+                None => f64::from(model.pdf(i, o)),
+            },
+            n,
+            0.5 * f64::from(s.beta),
+            seed as u64 + 900,
+        );
+        eprintln!(
+            "halo surface {k}, θi = {deg}°, {lobe:?}: p-value {:.4} (χ² {:.1}, dof {}), ∫pdf = {:.6}, sampled {:.6}",
+            check.chi.p_value,
+            check.chi.statistic,
+            check.chi.dof,
+            check.pdf_integral,
+            check.success
+        );
+        let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
+        if check.chi.p_value < alpha
+            || check.pdf_integral > 1.0 + 1e-4
+            || (check.pdf_integral - check.success).abs() > 5.0 * se + 1e-4
+        {
+            failures.push((
+                k,
+                deg,
+                lobe,
+                check.chi.p_value,
+                check.pdf_integral,
+                check.success,
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}

@@ -83,6 +83,17 @@ def _catmull_rom_weights(t):
     )
 
 
+def _last_at_most(n, below, steps):
+    """`visible::last_at_most`: the last `k < n` with `below(k)` (true at 0,
+    monotone), by halving (`steps ≥ ⌈log₂ n⌉`)."""
+    base, size = mi.UInt32(0), mi.UInt32(n)
+    for _ in range(steps):
+        half = size // 2
+        base = dr.select(below(base + half), base + half, base)
+        size -= half
+    return base
+
+
 def _acos_approx(x):
     """`math::acos_approx` (Abramowitz & Stegun 4.4.46), f64."""
     a = dr.minimum(dr.abs(x), 1.0)
@@ -198,8 +209,129 @@ class _Channel:
         return [dr.select(ok, w[0] / total, 1.0), dr.select(ok, w[1] / total, 0.0),
                 dr.select(ok, w[2] / total, 0.0)]
 
-    def diffraction_pdf(self, wi, wo):
-        """`TwoScale::diffraction_pdf` (HP17 51-55), f64."""
+    def diffraction_pdf(self, wi, wo, geo):
+        """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
+        and the half-vector draw (`HaloBake::pdf`), f64."""
+        share = self.s["halo_spectrum_share"]
+        spectrum = self.spectrum_pdf(wi, wo)
+        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"]), 0.0)
+        return share * spectrum + (1.0 - share) * half
+
+    def _row_cell(self, wi):
+        """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
+        fraction, linear in `u` (f64)."""
+        n_u = self.shapes["halo_u"][0]
+        top = float(self.t["halo_u"][n_u - 1])
+        u = dr.clip(self.d["big_b"] * wi.z, 0.0, top)
+
+        def node(j):
+            return dr.gather(mi.Float64, self.t["halo_u"], j)
+
+        j = _last_at_most(n_u - 1, lambda j: node(j) <= u, 6)
+        u0, u1 = node(j), node(j + 1)
+        return j, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0), 0.0)
+
+    def _halo_node(self, name, row, k):
+        n_s = self.shapes["halo_zeta"][1]
+        return mi.Float64(dr.gather(mi.Float, self.t[name], row * n_s + k))
+
+    @staticmethod
+    def _half_range(a, b):
+        """`halo::half_range`: `(H, sin H)`."""
+        x = b / a
+        wide = b >= a
+        return (dr.select(wide, math.pi, dr.acos(dr.clip(-x, -1.0, 1.0))),
+                dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0))))
+
+    def _row_pdf(self, row, z):
+        """`HaloBake::row_pdf`."""
+        n_s = self.shapes["halo_zeta"][1]
+        total = self._halo_node("halo_cum", row, n_s - 1)
+        k = _last_at_most(n_s - 1, lambda k: self._halo_node("halo_zeta", row, k) <= z, 8)
+        z0, z1 = self._halo_node("halo_zeta", row, k), self._halo_node("halo_zeta", row, k + 1)
+        d0, d1 = self._halo_node("halo_dens", row, k), self._halo_node("halo_dens", row, k + 1)
+        cell = 0.5 * (d0 + d1) * (z1 - z0)
+        tau = dr.clip((z - z0) / (z1 - z0), 0.0, 1.0)
+        d = d0 + tau * (d1 - d0)
+        mass = self._halo_node("halo_cum", row, k + 1) - self._halo_node("halo_cum", row, k)
+        ok = (total > 0.0) & (z <= self._halo_node("halo_zeta", row, n_s - 1)) & (cell > 0.0)
+        return dr.select(ok, mass / total * d / cell, 0.0)
+
+    def halo_pdf(self, wi, sin_h, cos_h):
+        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) / (4 N(θh))`, f64."""
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        a, b = sin_i * sin_h, wi.z * cos_h
+        big_h, sin_big_h = self._half_range(a, b)
+        norm = 2.0 * (a * sin_big_h + b * big_h)
+        zeta = sin_h * sin_h / (1.0 + cos_h)
+        j, t = self._row_cell(wi)
+        p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta), 0.0)
+        p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta), 0.0)
+        return dr.select(norm > 0.0, p / (4.0 * norm), 0.0)
+
+    def halo_sample(self, wi, pick, along):
+        """`HaloBake::sample_h`: a half-vector (f64) and whether the row had mass."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        n_s = self.shapes["halo_zeta"][1]
+        j, t = self._row_cell(wi)
+        lower = pick < 1.0 - t
+        row = dr.select(lower, j, j + 1)
+        azimuth = dr.select(lower, pick / (1.0 - t), (pick - (1.0 - t)) / t)
+        azimuth = dr.clip(azimuth, 0.0, below_one)
+        total = self._halo_node("halo_cum", row, n_s - 1)
+        target = along * total
+        k = _last_at_most(n_s - 1, lambda k: self._halo_node("halo_cum", row, k) <= target, 8)
+        c0, c1 = self._halo_node("halo_cum", row, k), self._halo_node("halo_cum", row, k + 1)
+        r = dr.select(c1 > c0, dr.clip((target - c0) / (c1 - c0), 0.0, 1.0), 0.0)
+        d0, d1 = self._halo_node("halo_dens", row, k), self._halo_node("halo_dens", row, k + 1)
+        q = r * 0.5 * (d0 + d1)
+        den = d0 + dr.sqrt(dr.maximum(d0 * d0 + 2.0 * (d1 - d0) * q, 0.0))
+        tau = dr.select(den > 0.0, dr.minimum(2.0 * q / den, 1.0), r)
+        z0, z1 = self._halo_node("halo_zeta", row, k), self._halo_node("halo_zeta", row, k + 1)
+        z = z0 + tau * (z1 - z0)
+        cos_h = 1.0 - z
+        sin_h = dr.sqrt(dr.maximum(z * (2.0 - z), 0.0))
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        a, b = sin_i * sin_h, wi.z * cos_h
+        side = dr.select(azimuth < 0.5, -1.0, 1.0)
+        rest = dr.select(azimuth < 0.5, 2.0 * azimuth, 2.0 * azimuth - 1.0)
+        big_h, sin_big_h = self._half_range(a, b)
+        psi = side * self._solve_azimuth(a, b, big_h, rest * (a * sin_big_h + b * big_h))
+        has = sin_i > 0.0
+        cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
+        sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
+        cp, sp = dr.cos(psi), dr.sin(psi)
+        h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
+                        sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
+        return h, total > 0.0
+
+    @staticmethod
+    def _solve_azimuth(a, b, big_h, target):
+        """`halo::solve_azimuth`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until it converges, at most 40 steps)."""
+        total = a * dr.sin(big_h) + b * big_h
+        psi = dr.select(total > 0.0, big_h * dr.clip(target / total, 0.0, 1.0), 0.0)
+        lo, hi = dr.zeros(mi.Float64, dr.width(psi)), mi.Float64(big_h)
+
+        def body(step, done, psi, lo, hi):
+            f = a * dr.sin(psi) + b * psi - target
+            hi = dr.select(f > 0.0, psi, hi)
+            lo = dr.select(f > 0.0, lo, psi)
+            slope = a * dr.cos(psi) + b
+            nxt = psi - f / slope
+            nxt = dr.select((slope > 0.0) & (nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+            done = dr.abs(nxt - psi) < 1e-12
+            return step + 1, done, nxt, lo, hi
+
+        _, _, psi, _, _ = dr.while_loop(
+            (mi.UInt32(0), mi.Bool(False), psi, lo, hi),
+            lambda step, done, psi, lo, hi: (step < 40) & ~done,
+            body,
+        )
+        return psi
+
+    def spectrum_pdf(self, wi, wo):
+        """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
         s = self.s
         if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
             return mi.Float64(0.0)
@@ -352,13 +484,7 @@ class _Channel:
         ok = norm > 0.0
         target = u0 * norm
 
-        def last_at_most(n, below, steps):
-            base, size = mi.UInt32(0), mi.UInt32(n)
-            for _ in range(steps):
-                half = size // 2
-                base = dr.select(below(base + half), base + half, base)
-                size -= half
-            return base
+        last_at_most = _last_at_most
 
         j = last_at_most(j_end + 1, lambda j: phi_node(j) <= target, 8)
         x0, p0 = x_node(j), p_node(j)
@@ -432,8 +558,23 @@ class _Channel:
         return t
 
     def diffraction_sample(self, wi, u0, u1):
-        """The diffraction lobe's direction (`TwoScale::sample_lobe`, HP17
-        51-55) and whether it exists (f64)."""
+        """The diffraction lobe's direction (`TwoScale::sample_diffraction`:
+        the spectrum's draw with its share, else a reflected half-vector of
+        `halo_sample`) and whether it exists (f64)."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        share = self.s["halo_spectrum_share"]
+        spectral = u1 < share
+        os_, ok_s = self.spectrum_sample(wi, u0, u1 / share)
+        v = dr.minimum((u1 - share) / (1.0 - share), below_one)
+        m, ok_h = self.halo_sample(wi, v, u0)
+        k = 2.0 * dr.dot(wi, m)
+        oh = k * m - wi
+        ok_h &= k > 0.0
+        return dr.select(spectral, os_, oh), dr.select(spectral, ok_s, ok_h)
+
+    def spectrum_sample(self, wi, u0, u1):
+        """The spectrum's draw (`TwoScale::sample_spectrum`, HP17 51-55) and
+        whether it exists (f64)."""
         s = self.s
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
         n = self.shapes["radial_inv_m"][0]
@@ -628,7 +769,7 @@ class Model:
             w = channel.lobe_weights(wi.z)
             value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
             if channel.diffraction:
-                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
+                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo, geo), 0.0)
             value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
             total += mi.Float64(_finite_or_zero(mi.Float(value)))
         return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)

@@ -416,6 +416,27 @@ pub(crate) struct ConvBake {
     /// `ln C` row-major `[u][θh]` with one ghost node on each side of both
     /// axes (linear extrapolation), so that every cell has four taps.
     ln_c: [f32; PADDED_U * PADDED_S],
+    /// `1/w(u)` of each row (its θh nodes are [`row_tans`] of it).
+    pub(crate) row_inv_w: [f32; CONV_U_NODES],
+    /// The `u` of each row.
+    pub(crate) row_u: [f32; CONV_U_NODES],
+}
+
+/// The `tan θh` nodes of a row with `1/w = inv_w`: `x = (1 + sin θ / w)/cos θ`
+/// even in [`math::log2_axis`] from 1 to [`angle_span`], inverted as
+/// `tan θ = tan(A − B)` with `tan A = w x`, `tan B = w/√(1 + w²(x² − 1))`;
+/// in f32, as the slice's angle is evaluated (module documentation).
+pub(crate) fn row_tans(inv_w: f32) -> [f32; CONV_S_NODES] {
+    let w = 1.0 / f64::from(inv_w);
+    let s_span = f64::from(angle_span(inv_w));
+    let mut tans = [0.0f32; CONV_S_NODES];
+    for (k, tan) in tans.iter_mut().enumerate() {
+        let x = math::exp2_axis(k as f64 / (CONV_S_NODES - 1) as f64 * s_span).max(1.0);
+        let tan_a = w * x;
+        let tan_b = w / math::sqrt(1.0 + w * w * (x * x - 1.0));
+        *tan = ((tan_a - tan_b) / (1.0 + tan_a * tan_b)) as f32;
+    }
+    tans
 }
 
 impl ConvBake {
@@ -450,19 +471,10 @@ impl ConvBake {
             }
             let u = 0.5 * (lo + hi);
             let u = if j + 1 == CONV_U_NODES { big_b } else { u };
-            // This row's θh nodes: x = (1 + sin θ / w)/cos θ inverted,
-            // tan θ = tan(A − B) with tan A = w x, tan B = w/√(1 + w²(x² − 1)).
             let inv_w = bake.inv_width(u);
-            let w = 1.0 / f64::from(inv_w);
-            let s_span = f64::from(angle_span(inv_w));
-            // In f32, as the slice's angle is evaluated (module documentation).
-            let mut tans = [0.0f32; CONV_S_NODES];
-            for (k, tan) in tans.iter_mut().enumerate() {
-                let x = math::exp2_axis(k as f64 / (CONV_S_NODES - 1) as f64 * s_span).max(1.0);
-                let tan_a = w * x;
-                let tan_b = w / math::sqrt(1.0 + w * w * (x * x - 1.0));
-                *tan = ((tan_a - tan_b) / (1.0 + tan_a * tan_b)) as f32;
-            }
+            bake.row_inv_w[j] = inv_w;
+            bake.row_u[j] = u;
+            let tans = row_tans(inv_w);
             let row = &mut bake.ln_c[(j + 1) * PADDED_S + 1..(j + 1) * PADDED_S + 1 + CONV_S_NODES];
             // ln C = ln s + the profile (s = 1 inside T3's u range).
             match slice.ln_profile_at_tans(u, &tans, row) {
@@ -529,6 +541,12 @@ impl ConvBake {
         v.scalar("conv_u0", f64::from(U0));
         v.scalar("conv_cos_h_min", COS_H_MIN);
         v.array("conv_ln_c", &[PADDED_U, PADDED_S], &self.ln_c);
+    }
+
+    /// `ln C` at the node `k` of row `j` (no ghost nodes).
+    #[inline]
+    pub(crate) fn node(&self, j: usize, k: usize) -> f32 {
+        self.ln_c[(j + 1) * PADDED_S + k + 1]
     }
 
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).

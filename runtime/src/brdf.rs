@@ -55,6 +55,7 @@ use crate::bake::{
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::Epd;
 use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
+use crate::halo::HaloBake;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
@@ -321,9 +322,9 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// What a [`TwoScale`] bakes for its material and wavelength (F, Q̄'s
 /// factors and σrel over `cos θ`, G1 over the slope, the sampler's
 /// visible-slope density, and C over `(u, θh)` when the source of C is T3b;
-/// modules `bake` and `visible`): 77 KB of plain numbers (the visible-slope
-/// tables 40 KB, C 18 KB, the direction bake 12 KB, G1 4 KB, the
-/// diffraction sampler's `1/M` 2 KB).
+/// modules `bake`, `visible` and `halo`): 130 KB of plain numbers (the
+/// halo sampler's densities 52 KB, the visible-slope tables 40 KB, C 18 KB,
+/// the direction bake 12 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
 ///
 /// All zeros is a valid (empty) value, so storage can be allocated zeroed on
 /// the heap (`ChannelBake::boxed`, feature `std`) or provided by the caller
@@ -345,6 +346,9 @@ pub struct ChannelBake {
     /// Whether `conv` holds C (the source of C offers a slice, as T3b does);
     /// else the source is read directly.
     conv_baked: bool,
+    /// The halo sampler's densities over the half-vector, from `conv`
+    /// (valid when `conv_baked`).
+    halo: HaloBake,
 }
 
 impl ChannelBake {
@@ -357,7 +361,7 @@ impl ChannelBake {
         })
     }
 
-    /// Empty storage by value (45 KB on the caller's stack).
+    /// Empty storage by value (130 KB on the caller's stack).
     pub fn zeroed() -> ChannelBake {
         ChannelBake::new_zeroed()
     }
@@ -367,13 +371,19 @@ impl ChannelBake {
     fn conv(&self) -> Option<&ConvBake> {
         self.conv_baked.then_some(&self.conv)
     }
+
+    /// The halo sampler's densities, when C is baked.
+    #[inline]
+    fn halo(&self) -> Option<&HaloBake> {
+        self.conv_baked.then_some(&self.halo)
+    }
 }
 
 /// The two-scale BRDF at one wavelength (see the module documentation).
 ///
 /// Construction bakes what depends only on the material and wavelength into
 /// a [`ChannelBake`] (so that `eval` reads small tables), held as `B`: by
-/// value (the default, 45 KB; [`TwoScale::new`]), boxed
+/// value (the default, 130 KB; [`TwoScale::new`]), boxed
 /// (`TwoScale::boxed`, feature `std`) or borrowed (`&mut ChannelBake`),
 /// any `B: Borrow<ChannelBake>`; [`Rgb`] is three of them. `Clone` (when `B`
 /// is), not `Copy`.
@@ -483,7 +493,7 @@ impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
     /// [`ChannelBake`] (cost: `cargo bench --bench brdf -- construct`). The
-    /// value is 45 KB: on small stacks use `TwoScale::boxed` or
+    /// value is 130 KB: on small stacks use `TwoScale::boxed` or
     /// [`TwoScale::new_in`].
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
@@ -620,10 +630,20 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
             None => false,
         };
-        let weights = self
-            .bake()
-            .direction
-            .lobe_weight_nodes(|at, cos| self.weights_at(at, cos));
+        if bake.conv_baked {
+            bake.halo.init(&bake.conv);
+        }
+        let specular = tables
+            .albedo
+            .column(surface.beta, surface.p, self.options.masking);
+        let halo = self.halo_albedo_nodes();
+        let weights = self.bake().direction.lobe_weight_nodes(|at, cos| {
+            let energies = LobeEnergies {
+                specular: f64::from(specular.albedo(cos)),
+                halo: halo_albedo_at(&halo, cos),
+            };
+            self.weights_at(at, cos, energies)
+        });
         self.bake.borrow_mut().direction.set_lobe_weights(&weights);
     }
 
@@ -704,6 +724,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 flag(self.options.halo_weight == HaloWeight::Incident),
             ),
             ("conv_baked", flag(self.bake().conv_baked)),
+            ("halo_spectrum_share", SPECTRUM_SHARE),
         ] {
             v.scalar(name, value);
         }
@@ -712,6 +733,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         bake.masking.visit(v);
         bake.radial_norm.visit(v);
         bake.conv.visit(v);
+        bake.halo.visit(v);
         bake.visible.visit(v);
     }
 
@@ -948,22 +970,24 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// The lobe-selection probabilities `[specular, diffraction, base]` for
-    /// incidence `i` (sum 1; all 0 for `i` below the horizon):
+    /// incidence `i` (sum 1; all 0 for `i` below the horizon), proportional
+    /// to estimates of the lobes' directional albedos at θi
+    /// (docs/design/halo-sampling.md):
     ///
     /// ```text
-    /// A_imp = exp(−(2π σs cos θi / λ)²)                              (HP17 48)
-    /// E_s   = F(η, cos θi)         (1 with white colour terms)
-    /// E_b   = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
-    ///         (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
-    /// w     ∝ [A_imp E_s, (1 − A_imp) E_s, E_b]
+    /// E_s = A(θi) F(η, cos θi) E(μ; β, p)      A(θi) = exp(−(4π σrel(θi) cos θi / λ)²) (HP17 25),
+    ///                                           E of T6 (F = 1), F = 1 with white colour terms
+    /// E_d = ∫ ρ_CTD cos θo dωo                   by the diffraction lobe's own sampler, 55 lattice
+    ///                                           points at 17 incidences, linear in √cos θi between
+    /// E_b = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
+    ///       (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
+    /// w   ∝ [E_s, max(E_d, 10⁻³ ΣE), E_b]      (E_d's floor only where the lobe exists)
     /// ```
     ///
-    /// The surface lobes share F(θi) as the estimate of their energy and split
-    /// it by (HP17 48) as printed. When every estimate is 0 (η = 1 and no
-    /// base) the split `[A_imp, 1 − A_imp, 0]` is used. The weights are
-    /// tabulated with the material (linear in `√cos θi` between 257 nodes):
-    /// `sample` and `pdf` read the same table, so the weights add no error to
-    /// the pdf.
+    /// When every estimate is 0 (η = 1 and no base) the split
+    /// `[A, 1 − A, 0]` is used. The weights are tabulated with the material
+    /// (linear in `√cos θi` between 257 nodes): `sample` and `pdf` read the
+    /// same table, so the weights add no error to the pdf.
     pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
         let Some(wi) = upper_unit(i) else {
             return [0.0; 3];
@@ -978,11 +1002,55 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         self.bake().direction.lobe_weights(cos_i as f32)
     }
 
-    /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`.
-    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64) -> [f64; 3] {
-        let t = 2.0 * PI * f64::from(self.surface.sigma_s) * cos_i / self.lambda;
-        let a_imp = math::exp(-t * t);
-        let e_s = self.fresnel_of(at_i);
+    /// The diffraction lobe's directional albedo at [`HALO_ALBEDO_NODES`]
+    /// incidences even in `√cos θi`, estimated with its own sampler on a
+    /// rank-1 lattice of [`HALO_ALBEDO_POINTS`] points (deterministic;
+    /// zeros without a diffraction lobe). Needs the bakes but not the
+    /// lobe weights.
+    fn halo_albedo_nodes(&self) -> [f64; HALO_ALBEDO_NODES] {
+        let mut out = [0.0; HALO_ALBEDO_NODES];
+        if !self.has_lobes().0 {
+            return out;
+        }
+        let n = HALO_ALBEDO_POINTS;
+        for (k, slot) in out.iter_mut().enumerate().skip(1) {
+            let x = k as f64 / (HALO_ALBEDO_NODES - 1) as f64;
+            let cos = x * x;
+            let i = [
+                math::sqrt((1.0 - cos * cos).max(0.0)) as f32,
+                0.0,
+                cos as f32,
+            ];
+            let mut sum = 0.0;
+            for j in 0..n {
+                let u0 = (j as f64 + 0.5) / n as f64;
+                let u1 = ((j * HALO_ALBEDO_STRIDE) as f64 + 0.5) / n as f64;
+                let u = [u0 as f32, (u1 - math::floor(u1)) as f32];
+                let Some(o) = self.sample_lobe(Lobe::Diffraction, i, u) else {
+                    continue;
+                };
+                let Some(geometry) = self.geometry(i, o) else {
+                    continue;
+                };
+                let pdf = self.diffraction_pdf(&geometry);
+                if pdf > 0.0 {
+                    let value = f64::from(self.lobes(&self.with_masking(geometry)).diffraction);
+                    sum += value * geometry.wo[2] / pdf;
+                }
+            }
+            let e = sum / n as f64;
+            *slot = if e.is_finite() { e } else { 0.0 };
+        }
+        out
+    }
+
+    /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`
+    /// and the lobes' albedo estimates `e`.
+    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64, e: LobeEnergies) -> [f64; 3] {
+        let sigma_rel = f64::from(self.surface.sigma_s) * at_i.sigma_ratio();
+        let t = self.x_scale * cos_i * cos_i * sigma_rel * sigma_rel;
+        let a = math::exp(-t);
+        let e_s = a * self.fresnel_of(at_i) * e.specular;
         let mut e_b = self.lambertian;
         if !self.white() {
             let into = 1.0 - at_i.fresnel();
@@ -995,12 +1063,16 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 BaseLayer::Subsurface { albedo } => into * f64::from(albedo),
             };
         }
-        let w = [a_imp * e_s, (1.0 - a_imp) * e_s, e_b];
+        let mut e_d = e.halo.max(0.0);
+        if self.has_lobes().0 {
+            e_d = e_d.max(HALO_FLOOR * (e_s + e_d + e_b));
+        }
+        let w = [e_s, e_d, e_b];
         let total = w[0] + w[1] + w[2];
         if total > 0.0 && total.is_finite() {
             w.map(|x| x / total)
         } else {
-            [a_imp, 1.0 - a_imp, 0.0]
+            [a, 1.0 - a, 0.0]
         }
     }
 
@@ -1063,10 +1135,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// [`TwoScale::pdf_lobe`] at a pair's geometry.
     fn lobe_pdf(&self, lobe: Lobe, geometry: &Geometry) -> f64 {
-        let Geometry { wi, wo, .. } = *geometry;
+        let wo = geometry.wo;
         match lobe {
             Lobe::Specular => self.specular_pdf(geometry),
-            Lobe::Diffraction => self.diffraction_pdf(wi, wo),
+            Lobe::Diffraction => self.diffraction_pdf(geometry),
             Lobe::Base => wo[2] / PI,
         }
     }
@@ -1096,7 +1168,35 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         math::acos_approx(x.max(-1.0).min(1.0))
     }
 
-    fn diffraction_pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    /// The diffraction lobe's density: the mixture of the spectrum's draw
+    /// (share [`SPECTRUM_SHARE`]) and the half-vector draw of
+    /// [`HaloBake`], `p(h) / (4 i·h)`, when the C bake is there; else the
+    /// spectrum's draw alone.
+    fn diffraction_pdf(&self, geometry: &Geometry) -> f64 {
+        let Geometry {
+            wi,
+            wo,
+            cos_d,
+            cos_h,
+            sin_h,
+            ..
+        } = *geometry;
+        let spectrum = self.spectrum_pdf(wi, wo);
+        match self.bake().halo() {
+            Some(halo) => {
+                let half = if cos_d > 0.0 {
+                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h)
+                } else {
+                    0.0
+                };
+                SPECTRUM_SHARE * spectrum + (1.0 - SPECTRUM_SHARE) * half
+            }
+            None => spectrum,
+        }
+    }
+
+    /// The density of the spectrum's draw (HP17 51-55).
+    fn spectrum_pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
         let Some((b, sin_i, inv_m)) = self.diffraction_setup(wi) else {
             return 0.0;
         };
@@ -1139,32 +1239,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
-            Lobe::Diffraction => {
-                let (b, sin_i, inv_m) = self.diffraction_setup(wi)?;
-                let m = 1.0 / inv_m;
-                let c = f64::from(self.surface.c);
-                let t = -2.0 / (c - 1.0) * f64::from(math::ln_1pf((-m * u[0]) as f32)); // (HP17 51)
-                let r =
-                    (math::sqrt(f64::from(math::exp_m1f(t as f32)).max(0.0)) / b).min(1.0 + sin_i);
-                let psi = (2.0 * u[1] - 1.0) * Self::phi_max(r, sin_i); // (HP17 53-54)
-                let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
-                    (wi[0] / sin_i, wi[1] / sin_i)
-                } else {
-                    (1.0, 0.0)
-                };
-                let (cp, sp) = (math::cos(psi), math::sin(psi));
-                let dir = [
-                    cos_phi_i * cp - sin_phi_i * sp,
-                    sin_phi_i * cp + cos_phi_i * sp,
-                ];
-                let ox = r * dir[0] - wi[0]; // (HP17 55)
-                let oy = r * dir[1] - wi[1];
-                let z2 = 1.0 - ox * ox - oy * oy;
-                if !(z2 > 0.0) {
-                    return None;
-                }
-                [ox, oy, math::sqrt(z2)]
-            }
+            Lobe::Diffraction => self.sample_diffraction(wi, u)?,
             Lobe::Base => {
                 let r = math::sqrt(u[0]);
                 let phi = 2.0 * PI * u[1];
@@ -1177,6 +1252,53 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         };
         let o = upper_unit(to_f32(o))?;
         Some(to_f32(o))
+    }
+
+    /// The diffraction lobe's draw: with probability [`SPECTRUM_SHARE`]
+    /// (picked by `u[1]`, rescaled) the spectrum's, else a half-vector from
+    /// [`HaloBake`] (`u[1]` rescaled again picks its row and then the
+    /// azimuth, `u[0]` gives θh) reflected, when the C bake is there.
+    fn sample_diffraction(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
+        let Some(halo) = self.bake().halo() else {
+            return self.sample_spectrum(wi, u);
+        };
+        if u[1] < SPECTRUM_SHARE {
+            return self.sample_spectrum(wi, [u[0], u[1] / SPECTRUM_SHARE]);
+        }
+        let v = ((u[1] - SPECTRUM_SHARE) / (1.0 - SPECTRUM_SHARE)).min(f64::from(BELOW_ONE));
+        let m = halo.sample_h(wi, self.big_b * wi[2], v, u[0])?;
+        let k = 2.0 * dot(wi, m);
+        if !(k > 0.0) {
+            return None;
+        }
+        Some([k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]])
+    }
+
+    /// The spectrum's draw (HP17 51-55; [`TwoScale::sample_lobe`]).
+    fn sample_spectrum(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
+        let (b, sin_i, inv_m) = self.diffraction_setup(wi)?;
+        let m = 1.0 / inv_m;
+        let c = f64::from(self.surface.c);
+        let t = -2.0 / (c - 1.0) * f64::from(math::ln_1pf((-m * u[0]) as f32)); // (HP17 51)
+        let r = (math::sqrt(f64::from(math::exp_m1f(t as f32)).max(0.0)) / b).min(1.0 + sin_i);
+        let psi = (2.0 * u[1] - 1.0) * Self::phi_max(r, sin_i); // (HP17 53-54)
+        let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
+            (wi[0] / sin_i, wi[1] / sin_i)
+        } else {
+            (1.0, 0.0)
+        };
+        let (cp, sp) = (math::cos(psi), math::sin(psi));
+        let dir = [
+            cos_phi_i * cp - sin_phi_i * sp,
+            sin_phi_i * cp + cos_phi_i * sp,
+        ];
+        let ox = r * dir[0] - wi[0]; // (HP17 55)
+        let oy = r * dir[1] - wi[1];
+        let z2 = 1.0 - ox * ox - oy * oy;
+        if !(z2 > 0.0) {
+            return None;
+        }
+        Some([ox, oy, math::sqrt(z2)])
     }
 
     /// Samples an outgoing direction for incidence `i` from three uniforms:
@@ -1212,6 +1334,37 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 }
 
+/// The albedo estimates of the lobes at one incidence, for
+/// [`TwoScale::weights_at`].
+#[derive(Clone, Copy, Debug)]
+struct LobeEnergies {
+    /// `E(μ; β, p)` of T6 (F = 1, no A).
+    specular: f64,
+    /// `∫ ρ_CTD cos θo dωo`.
+    halo: f64,
+}
+
+/// Incidences of [`TwoScale::halo_albedo_nodes`] (every 16th node of the
+/// direction bake's 257).
+const HALO_ALBEDO_NODES: usize = 17;
+/// Lattice points per incidence, and the lattice's generator (Fibonacci).
+const HALO_ALBEDO_POINTS: usize = 55;
+const HALO_ALBEDO_STRIDE: usize = 34;
+/// The diffraction lobe's smallest share of the estimated albedo.
+const HALO_FLOOR: f64 = 1e-3;
+
+/// The halo albedo between [`HALO_ALBEDO_NODES`], linear in `√cos θi`.
+fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
+    let x = math::sqrt(cos.max(0.0).min(1.0)) * (HALO_ALBEDO_NODES - 1) as f64;
+    let k = (x as usize).min(HALO_ALBEDO_NODES - 2);
+    let t = x - k as f64;
+    nodes[k] + t * (nodes[k + 1] - nodes[k])
+}
+
+/// The share of the spectrum's draw (HP17 51-55) in the diffraction lobe's
+/// mixture with the half-vector draw (docs/design/halo-sampling.md).
+const SPECTRUM_SHARE: f64 = 0.1;
+
 /// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
 /// past the last interval falls on the last lobe of positive weight.
 fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
@@ -1233,7 +1386,7 @@ fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
 /// The channels share the geometry, D and G of each evaluation (they must
 /// share the surface, as [`Rgb::new`] makes them). The bakes are held as `B`,
-/// as [`TwoScale`]'s: by value ([`Rgb::new`], 136 KB), boxed (`Rgb::boxed`)
+/// as [`TwoScale`]'s: by value ([`Rgb::new`], 390 KB), boxed (`Rgb::boxed`)
 /// or in caller-provided storage ([`Rgb::new_in`]).
 #[derive(Clone)]
 pub struct Rgb<'a, B = ChannelBake> {
@@ -1254,7 +1407,7 @@ pub struct RgbSample {
 
 impl<'a> Rgb<'a> {
     /// The three channels of `material` at [`RGB_WAVELENGTHS`]. The value is
-    /// 136 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
+    /// 390 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
         let bakes = [
             ChannelBake::zeroed(),

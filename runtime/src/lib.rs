@@ -25,6 +25,7 @@ pub mod epd;
 pub mod format;
 pub mod fresnel;
 pub mod gamma;
+mod halo;
 pub mod hp15;
 pub mod interp;
 pub mod kcorr;

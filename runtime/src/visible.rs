@@ -373,7 +373,7 @@ impl VisibleSlopeBake {
 /// The last index `k < n` with `below(k)` (`below` true at 0 and
 /// monotone), by halving without data-dependent branches.
 #[inline]
-fn last_at_most(n: usize, below: impl Fn(usize) -> bool) -> usize {
+pub(crate) fn last_at_most(n: usize, below: impl Fn(usize) -> bool) -> usize {
     let (mut base, mut len) = (0usize, n);
     while len > 1 {
         let half = len / 2;

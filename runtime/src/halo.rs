@@ -1,0 +1,279 @@
+//! The halo sampler's density over the half-vector, tabulated once per
+//! material and wavelength from the C bake (docs/model.md §2.7;
+//! docs/design/halo-sampling.md).
+//!
+//! The halo is `ρ_CTD ∝ Q̄ G (1 − A)/σrel² · C(θh; u)`, `u = B cos θd`: over
+//! the half-vector it is shaped by `C`, which depends on θh (isotropic about
+//! the normal) and on `u`. [`HaloBake`] takes each row `u_j` of the C bake
+//! ([`ConvBake`]) and makes it a density over `ζ = 1 − cos θh`
+//! (`dω_h = dζ dφ`): piecewise linear between the row's own θh nodes, with
+//! the node values `C(θh,k; u_j)`. The sampler draws, for an incidence `i`,
+//! ζ from the rows around `u = B cos θi`, then the azimuth of `h` about the
+//! normal with a density `∝ (i·h)₊` (as visible normals are weighted):
+//!
+//! ```text
+//! p(h)   = Σ_j w_j(B cos θi) p_j(ζ) · (i·h)₊ / N(θh)
+//! p_j(ζ) = m_jk / M_j · d_j(ζ) / ((d_jk + d_j,k+1)/2 · Δζ_k)     ζ in cell k
+//! N(θh)  = ∫ (a cos ψ + b)₊ dψ = 2 (a sin H + b H),   a = sin θi sin θh, b = cos θi cos θh,
+//!          H = π if b ≥ a, else acos(−b/a)
+//! pdf(o) = p(h) / (4 i·h) = Σ_j w_j p_j(ζ) / (4 N(θh))
+//! ```
+//!
+//! with `w_j` the weights of the rows around `u`, linear in `u` between the
+//! rows' own `u_j` (a mixture: the row is picked with its weight; found in
+//! f64 by a binary search, so that ports reproduce the pick), `d_j` the piecewise-linear density, `m_jk` the
+//! cell's mass as stored in the row's cumulative and `M_j` the row's total.
+//! Within a cell the CDF of ζ is a quadratic, solved in closed form; the
+//! azimuth's CDF `(a sin ψ + b ψ)/(a sin H + b H)` on each side is inverted
+//! by Newton's method in a shrinking bracket. [`HaloBake::pdf`] evaluates
+//! the same expression, so the density is the one drawn (to rounding).
+//! Where `i·h ≤ 0` nothing is drawn. Beyond the C bake's last node
+//! (`cos θh = 10⁻³`) nothing is drawn.
+
+use crate::bake::{BakeVisitor, CONV_S_NODES, CONV_U_NODES, ConvBake, row_tans};
+use crate::math;
+use crate::visible::last_at_most;
+use core::f64::consts::PI;
+use zerocopy::FromZeros;
+
+/// The halo sampler's per-row densities over `ζ = 1 − cos θh` (module
+/// documentation): 52 KB.
+#[derive(Clone, Debug, FromZeros)]
+pub(crate) struct HaloBake {
+    /// The `u` of each row (increasing from 0 to `B`).
+    u: [f64; CONV_U_NODES],
+    /// `ζ` at each row's nodes (increasing from 0).
+    zeta: [[f32; CONV_S_NODES]; CONV_U_NODES],
+    /// The density over `ζ` at the nodes, `C` normalised per row.
+    dens: [[f32; CONV_S_NODES]; CONV_U_NODES],
+    /// Its integral from 0 to each node (trapezoid, summed in f64; the
+    /// last is the row's total `M_j`, 1 up to rounding).
+    cum: [[f32; CONV_S_NODES]; CONV_U_NODES],
+}
+
+impl HaloBake {
+    /// Tabulates the densities of `conv`'s rows in place.
+    pub fn init(&mut self, conv: &ConvBake) {
+        for j in 0..CONV_U_NODES {
+            self.u[j] = f64::from(conv.row_u[j]);
+            let tans = row_tans(conv.row_inv_w[j]);
+            let top = (0..CONV_S_NODES)
+                .map(|k| conv.node(j, k))
+                .fold(f32::MIN, f32::max);
+            let mut f = [0.0f64; CONV_S_NODES];
+            let mut integral = 0.0f64;
+            for k in 0..CONV_S_NODES {
+                let t = f64::from(tans[k]);
+                let sec = math::sqrt(1.0 + t * t);
+                // ζ = 1 − cos θ = tan²θ / (1 + tan²θ + sec θ), without cancellation.
+                self.zeta[j][k] = (t * t / (1.0 + t * t + sec)) as f32;
+                f[k] = math::exp(f64::from(conv.node(j, k) - top));
+                if k > 0 {
+                    let dz = f64::from(self.zeta[j][k]) - f64::from(self.zeta[j][k - 1]);
+                    integral += 0.5 * dz * (f[k] + f[k - 1]);
+                }
+            }
+            if !(integral > 0.0 && integral.is_finite()) {
+                self.dens[j] = [0.0; CONV_S_NODES];
+                self.cum[j] = [0.0; CONV_S_NODES];
+                continue;
+            }
+            for (d, value) in self.dens[j].iter_mut().zip(f) {
+                *d = (value / integral) as f32;
+            }
+            // The cumulative of the stored (f32) densities, summed in f64.
+            let mut sum = 0.0f64;
+            self.cum[j][0] = 0.0;
+            for k in 1..CONV_S_NODES {
+                let dz = f64::from(self.zeta[j][k]) - f64::from(self.zeta[j][k - 1]);
+                sum += 0.5 * dz * (f64::from(self.dens[j][k]) + f64::from(self.dens[j][k - 1]));
+                self.cum[j][k] = sum as f32;
+            }
+        }
+    }
+
+    /// Hands the tables to `v` (`halo_zeta`, `halo_dens`, `halo_cum`
+    /// `[33, 130]`; `halo_u` `[33]` (f64); rows as `conv_ln_c`'s without ghosts).
+    pub fn visit(&self, v: &mut dyn BakeVisitor) {
+        let shape = [CONV_U_NODES, CONV_S_NODES];
+        v.array("halo_zeta", &shape, self.zeta.as_flattened());
+        v.array("halo_dens", &shape, self.dens.as_flattened());
+        v.array("halo_cum", &shape, self.cum.as_flattened());
+        v.array_f64("halo_u", &[CONV_U_NODES], &self.u);
+    }
+
+    /// Draws `h` for the incidence `wi` and `u = B cos θi` from two
+    /// uniforms in [0, 1): `pick` picks the row (the lower one below
+    /// `1 − t`) and, rescaled, the azimuth; `along` gives `ζ`. `None` when
+    /// the row holds no density.
+    pub fn sample_h(&self, wi: [f64; 3], u_i: f64, pick: f64, along: f64) -> Option<[f64; 3]> {
+        let (j, t) = self.row_cell(u_i);
+        let (row, azimuth) = if pick < 1.0 - t {
+            (j, pick / (1.0 - t))
+        } else {
+            (j + 1, (pick - (1.0 - t)) / t)
+        };
+        let azimuth = azimuth.max(0.0).min(f64::from(math::BELOW_ONE));
+        let (zeta, dens, cum) = (&self.zeta[row], &self.dens[row], &self.cum[row]);
+        let total = f64::from(cum[CONV_S_NODES - 1]);
+        if !(total > 0.0) {
+            return None;
+        }
+        let target = along * total;
+        let k = last_at_most(CONV_S_NODES - 1, |k| f64::from(cum[k]) <= target);
+        let (c0, c1) = (f64::from(cum[k]), f64::from(cum[k + 1]));
+        let r = if c1 > c0 {
+            ((target - c0) / (c1 - c0)).max(0.0).min(1.0)
+        } else {
+            0.0
+        };
+        // ∫₀^τ (d0 + (d1 − d0) s) ds = r (d0 + d1)/2, the root in [0, 1].
+        let (d0, d1) = (f64::from(dens[k]), f64::from(dens[k + 1]));
+        let q = r * 0.5 * (d0 + d1);
+        let disc = (d0 * d0 + 2.0 * (d1 - d0) * q).max(0.0);
+        let den = d0 + math::sqrt(disc);
+        let tau = if den > 0.0 {
+            (2.0 * q / den).min(1.0)
+        } else {
+            r
+        };
+        let (z0, z1) = (f64::from(zeta[k]), f64::from(zeta[k + 1]));
+        let z = z0 + tau * (z1 - z0);
+        let cos_h = 1.0 - z;
+        let sin_h = math::sqrt((z * (2.0 - z)).max(0.0));
+        // ψ = φh − φi from (a cos ψ + b)₊: the side from the azimuth's
+        // first half, the magnitude from the rest.
+        let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
+        let (a, b) = (sin_i * sin_h, wi[2] * cos_h);
+        let (side, rest) = if azimuth < 0.5 {
+            (-1.0, 2.0 * azimuth)
+        } else {
+            (1.0, 2.0 * azimuth - 1.0)
+        };
+        let (big_h, sin_big_h) = half_range(a, b);
+        let psi = side * solve_azimuth(a, b, big_h, rest * (a * sin_big_h + b * big_h));
+        let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
+            (wi[0] / sin_i, wi[1] / sin_i)
+        } else {
+            (1.0, 0.0)
+        };
+        let (cp, sp) = (math::cos(psi), math::sin(psi));
+        let (cos_phi, sin_phi) = (
+            cos_phi_i * cp - sin_phi_i * sp,
+            sin_phi_i * cp + cos_phi_i * sp,
+        );
+        Some([sin_h * cos_phi, sin_h * sin_phi, cos_h])
+    }
+
+    /// The density over the outgoing direction of reflecting `wi` about
+    /// [`HaloBake::sample_h`]'s draw for `u = B cos θi`, at a half-vector
+    /// with `sin θh`, `cos θh` (module documentation: `Σ_j w_j p_j(ζ) / (4 N(θh))`).
+    pub fn pdf(&self, wi: [f64; 3], u_i: f64, sin_h: f64, cos_h: f64) -> f64 {
+        let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
+        let (a, b) = (sin_i * sin_h, wi[2] * cos_h);
+        let (big_h, sin_big_h) = half_range(a, b);
+        let norm = 2.0 * (a * sin_big_h + b * big_h);
+        if !(norm > 0.0) {
+            return 0.0;
+        }
+        let zeta = sin_h * sin_h / (1.0 + cos_h);
+        self.pdf_zeta(u_i, zeta) / (4.0 * norm)
+    }
+
+    /// The density of ζ drawn for `u = B cos θi`, `Σ_j w_j p_j(ζ)`.
+    fn pdf_zeta(&self, u_i: f64, zeta: f64) -> f64 {
+        let (j, t) = self.row_cell(u_i);
+        let mut p = 0.0;
+        if t < 1.0 {
+            p += (1.0 - t) * self.row_pdf(j, zeta);
+        }
+        if t > 0.0 {
+            p += t * self.row_pdf(j + 1, zeta);
+        }
+        p
+    }
+
+    /// The row below `u` (clamped to the rows) and the fraction towards the
+    /// next, linear in `u`.
+    #[inline]
+    fn row_cell(&self, u: f64) -> (usize, f64) {
+        let u = u.max(0.0).min(self.u[CONV_U_NODES - 1]);
+        let j = last_at_most(CONV_U_NODES - 1, |j| self.u[j] <= u);
+        let (u0, u1) = (self.u[j], self.u[j + 1]);
+        let t = if u1 > u0 {
+            ((u - u0) / (u1 - u0)).max(0.0).min(1.0)
+        } else {
+            0.0
+        };
+        (j, t)
+    }
+
+    /// `p_j(ζ)` of row `j` (module documentation); 0 beyond its last node.
+    #[inline]
+    fn row_pdf(&self, j: usize, z: f64) -> f64 {
+        let (zeta, dens, cum) = (&self.zeta[j], &self.dens[j], &self.cum[j]);
+        let total = f64::from(cum[CONV_S_NODES - 1]);
+        if !(total > 0.0 && z <= f64::from(zeta[CONV_S_NODES - 1])) {
+            return 0.0;
+        }
+        let k = last_at_most(CONV_S_NODES - 1, |k| f64::from(zeta[k]) <= z);
+        let (z0, z1) = (f64::from(zeta[k]), f64::from(zeta[k + 1]));
+        let (d0, d1) = (f64::from(dens[k]), f64::from(dens[k + 1]));
+        let cell = 0.5 * (d0 + d1) * (z1 - z0);
+        if !(cell > 0.0) {
+            return 0.0;
+        }
+        let tau = ((z - z0) / (z1 - z0)).max(0.0).min(1.0);
+        let d = d0 + tau * (d1 - d0);
+        (f64::from(cum[k + 1]) - f64::from(cum[k])) / total * d / cell
+    }
+}
+
+/// `(H, sin H)`: the half-width of the azimuths `ψ` where `a cos ψ + b > 0`
+/// (`a, b ≥ 0`): π when `b ≥ a`, else `acos(−b/a)`.
+#[inline]
+fn half_range(a: f64, b: f64) -> (f64, f64) {
+    if b >= a {
+        (PI, 0.0)
+    } else {
+        let x = b / a;
+        (math::acos(-x), math::sqrt((1.0 - x * x).max(0.0)))
+    }
+}
+
+/// The `ψ ∈ [0, H]` with `a sin ψ + b ψ = target` (`0 ≤ target ≤ a sin H +
+/// b H`; the left side increases on [0, H]): Newton's method kept in a
+/// shrinking bracket (a step leaving it bisects), to `1e-12` in ψ.
+fn solve_azimuth(a: f64, b: f64, big_h: f64, target: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, big_h);
+    let total = a * math::sin(big_h) + b * big_h;
+    let mut psi = if total > 0.0 {
+        big_h * (target / total).max(0.0).min(1.0)
+    } else {
+        0.0
+    };
+    for _ in 0..AZIMUTH_STEPS {
+        let f = a * math::sin(psi) + b * psi - target;
+        if f > 0.0 {
+            hi = psi;
+        } else {
+            lo = psi;
+        }
+        let slope = a * math::cos(psi) + b;
+        let next = psi - f / slope;
+        let next = if slope > 0.0 && next > lo && next < hi {
+            next
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - psi).abs() < 1e-12 {
+            return next;
+        }
+        psi = next;
+    }
+    psi
+}
+
+/// At most this many Newton steps for the azimuth (bisection alone would
+/// need ~40 for 1e-12 of π).
+const AZIMUTH_STEPS: usize = 40;
