@@ -12,10 +12,11 @@ the bakes' node axes and cubic weights are not a texture's.
 
 **What is ported.** :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
 :meth:`Model.pdf` (``Rgb::pdf``: the visible-slope tables, the diffraction
-law, the cosine lobe, the baked lobe weights, averaged over the channels) and
+mixture of the spectrum's law and the halo's half-vector densities, the cosine lobe, the baked lobe weights, averaged over the channels) and
 :meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
-loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
+loop, the diffraction lobe with the azimuth's Newton solve as another, and
+the cosine lobe). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Not yet: gradients (``traverse``
 exposes nothing), spectral variants. Particle tracing is not supported (as

@@ -245,7 +245,8 @@ pub struct Tables<'a> {
 pub enum Lobe {
     /// `A_spec · ρ_CT`, sampled through the EPD (HP17 49-50).
     Specular,
-    /// `ρ_CTD`, sampled from the spectrum around the specular direction (HP17 51-55).
+    /// `ρ_CTD`, sampled from the spectrum around the specular direction (HP17
+    /// 51-55) mixed with a half-vector draw that follows C (`crate::halo`).
     Diffraction,
     /// `ρ_base + k_d/π`, cosine-weighted.
     Base,
@@ -1119,10 +1120,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * specular: the density of reflecting `i` about a visible EPD normal
     ///   (the tabulated `D_vis`, `crate::visible`: `P2_tab g_tab / (8 N_tab β²
     ///   |i'| cos⁴θh)`, docs/model.md §2.1), 0 where `i·h ≤ 0`;
-    /// * diffraction (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
+    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (`SPECTRUM_SHARE` = 0.1
+    ///   ε; the spectrum's alone when C is not baked). The spectrum's
+    ///   (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
-    ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`;
+    ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`; the
+    ///   half-vector draw's `Σ_j w_j p_j(ζ) / (4 N(θh))` (`crate::halo`);
     /// * base: `cos θo / π`.
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
@@ -1223,7 +1227,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///
     /// * specular: `m` a visible normal of the EPD (the tabulated visible-slope
     ///   sampler of docs/model.md §2.1, `u` its two uniforms), `o = 2(i·m)m − i`;
-    /// * diffraction (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
+    /// * diffraction: with probability ε (`SPECTRUM_SHARE` = 0.1, picked by `u₁`,
+    ///   rescaled) the spectrum's draw, else the half-vector draw of
+    ///   `crate::halo` reflected; the spectrum's draw
+    ///   (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
     ///   `ψ = (2u₁ − 1) φmax(r)`, `d = r (cos(φi + ψ), sin(φi + ψ))`,
     ///   `o_p = d − i_p`. (HP17 54-55) write the same arc as `φf = φi + π ± φmax`
     ///   with `o_p = −i_p + λ f`; the arc that keeps `o_p` in the disc is
