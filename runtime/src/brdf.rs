@@ -978,8 +978,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// ```text
     /// E_s = A(θi) F(η, cos θi) E(μ; β, p)      A(θi) = exp(−(4π σrel(θi) cos θi / λ)²) (HP17 25),
     ///                                           E of T6 (F = 1), F = 1 with white colour terms
-    /// E_d = ∫ ρ_CTD cos θo dωo                   by the diffraction lobe's own sampler, 55 lattice
-    ///                                           points at 17 incidences, linear in √cos θi between
+    /// E_d = ∫ ρ_CTD cos θo dωo                   by the diffraction lobe's own sampler, 34 lattice
+    ///                                           points at 9 incidences, linear in √cos θi between
     /// E_b = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
     ///       (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
     /// w   ∝ [E_s, max(E_d, 10⁻³ ΣE), E_b]      (E_d's floor only where the lobe exists)
@@ -1351,12 +1351,12 @@ struct LobeEnergies {
     halo: f64,
 }
 
-/// Incidences of [`TwoScale::halo_albedo_nodes`] (every 16th node of the
+/// Incidences of [`TwoScale::halo_albedo_nodes`] (every 32nd node of the
 /// direction bake's 257).
-const HALO_ALBEDO_NODES: usize = 17;
+const HALO_ALBEDO_NODES: usize = 9;
 /// Lattice points per incidence, and the lattice's generator (Fibonacci).
-const HALO_ALBEDO_POINTS: usize = 55;
-const HALO_ALBEDO_STRIDE: usize = 34;
+const HALO_ALBEDO_POINTS: usize = 34;
+const HALO_ALBEDO_STRIDE: usize = 21;
 /// The diffraction lobe's smallest share of the estimated albedo.
 const HALO_FLOOR: f64 = 1e-3;
 
