@@ -830,6 +830,25 @@ fn narrow_grazing_specular_sampling() {
     );
 }
 
+/// Prints `check` and whether it fails: χ² below `alpha`, `∫ pdf` above
+/// `1 + 1e-5`, or `∫ pdf` off the success rate by more than 5 standard
+/// errors of `n` draws (+ 5e-5, the cell rule's error).
+fn sampler_check_fails(
+    label: &str,
+    check: &suite::brdf::SamplerCheck,
+    n: usize,
+    alpha: f64,
+) -> bool {
+    eprintln!(
+        "{label}: p-value {:.4} (χ² {:.1}, dof {}), ∫pdf = {:.6}, sampled {:.6}",
+        check.chi.p_value, check.chi.statistic, check.chi.dof, check.pdf_integral, check.success
+    );
+    let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
+    check.chi.p_value < alpha
+        || check.pdf_integral > 1.0 + 1e-5
+        || (check.pdf_integral - check.success).abs() > 5.0 * se + 5e-5
+}
+
 /// The visible-normal sampler of the specular lobe (docs/model.md §2.1)
 /// against its pdf: χ² and `∫ pdf` = success rate for p ∈ {0.3, 1, 4}, a
 /// narrow (β = 0.01) and a wide (β = 1) lobe, θi ∈ {45°, 85°}, 4·10⁵
@@ -865,19 +884,8 @@ fn visible_normal_sampling_chi2() {
             0.5 * f64::from(beta),
             k as u64 + 300,
         );
-        eprintln!(
-            "visible normals p = {p}, β = {beta}, θi = {deg}°: p-value {:.4} (χ² {:.1}, dof {}), ∫pdf = {:.6}, sampled {:.6}",
-            check.chi.p_value,
-            check.chi.statistic,
-            check.chi.dof,
-            check.pdf_integral,
-            check.success
-        );
-        let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
-        if check.chi.p_value < alpha
-            || check.pdf_integral > 1.0 + 1e-5
-            || (check.pdf_integral - check.success).abs() > 5.0 * se + 5e-5
-        {
+        let label = format!("visible normals p = {p}, β = {beta}, θi = {deg}°");
+        if sampler_check_fails(&label, &check, n, alpha) {
             failures.push((
                 p,
                 beta,
@@ -964,19 +972,8 @@ fn halo_sampling_chi2() {
             0.5 * f64::from(s.beta),
             seed as u64 + 900,
         );
-        eprintln!(
-            "halo surface {k}, θi = {deg}°, {lobe:?}: p-value {:.4} (χ² {:.1}, dof {}), ∫pdf = {:.6}, sampled {:.6}",
-            check.chi.p_value,
-            check.chi.statistic,
-            check.chi.dof,
-            check.pdf_integral,
-            check.success
-        );
-        let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
-        if check.chi.p_value < alpha
-            || check.pdf_integral > 1.0 + 1e-4
-            || (check.pdf_integral - check.success).abs() > 5.0 * se + 1e-4
-        {
+        let label = format!("halo surface {k}, θi = {deg}°, {lobe:?}");
+        if sampler_check_fails(&label, &check, n, alpha) {
             failures.push((
                 k,
                 deg,

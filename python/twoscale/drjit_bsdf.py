@@ -84,6 +84,31 @@ def _catmull_rom_weights(t):
     )
 
 
+def _newton_in_bracket(residual, slope, t, hi, tol):
+    """The root in [0, hi] of the increasing `residual` from `t`: Newton's
+    method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
+    bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
+    steps (`visible::solve_cell`, `halo::solve_azimuth`)."""
+    lo = dr.zeros(mi.Float64, dr.width(t))
+
+    def body(step, done, t, lo, hi):
+        f = residual(t)
+        lo = dr.select(f < 0.0, t, lo)
+        hi = dr.select(f < 0.0, hi, t)
+        d = slope(t)
+        nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
+        nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+        done = dr.abs(nxt - t) <= tol
+        return step + 1, done, nxt, lo, hi
+
+    _, _, t, _, _ = dr.while_loop(
+        (mi.UInt32(0), mi.Bool(False), t, lo, hi),
+        lambda step, done, t, lo, hi: (step < 40) & ~done,
+        body,
+    )
+    return t
+
+
 def _last_at_most(n, below, steps):
     """`visible::last_at_most`: the last `k < n` with `below(k)` (true at 0,
     monotone), by halving (`steps ≥ ⌈log₂ n⌉`)."""
@@ -312,24 +337,8 @@ class _Channel:
         symbolic loop, each lane until it converges, at most 40 steps)."""
         total = a * dr.sin(big_h) + b * big_h
         psi = dr.select(total > 0.0, big_h * dr.clip(target / total, 0.0, 1.0), 0.0)
-        lo, hi = dr.zeros(mi.Float64, dr.width(psi)), mi.Float64(big_h)
-
-        def body(step, done, psi, lo, hi):
-            f = a * dr.sin(psi) + b * psi - target
-            hi = dr.select(f > 0.0, psi, hi)
-            lo = dr.select(f > 0.0, lo, psi)
-            slope = a * dr.cos(psi) + b
-            nxt = psi - f / slope
-            nxt = dr.select((slope > 0.0) & (nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
-            done = dr.abs(nxt - psi) < 1e-12
-            return step + 1, done, nxt, lo, hi
-
-        _, _, psi, _, _ = dr.while_loop(
-            (mi.UInt32(0), mi.Bool(False), psi, lo, hi),
-            lambda step, done, psi, lo, hi: (step < 40) & ~done,
-            body,
-        )
-        return psi
+        return _newton_in_bracket(lambda psi: a * dr.sin(psi) + b * psi - target,
+                                  lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h), 1e-12)
 
     def spectrum_pdf(self, wi, wo):
         """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
@@ -538,25 +547,9 @@ class _Channel:
         disc = f0 * f0 + 2.0 * b * rest
         denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
         t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
-        lo, hi = dr.zeros(mi.Float64, dr.width(t)), mi.Float64(tau_max)
         tol = 1e-13 * (dr.abs(x0) + tau_max)
-
-        def body(step, done, t, lo, hi):
-            f = cell_integral(x0, p0, k, t) - rest
-            lo = dr.select(f < 0.0, t, lo)
-            hi = dr.select(f < 0.0, hi, t)
-            d = density(t)
-            nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
-            nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
-            done = dr.abs(nxt - t) <= tol
-            return step + 1, done, nxt, lo, hi
-
-        _, _, t, _, _ = dr.while_loop(
-            (mi.UInt32(0), mi.Bool(False), t, lo, hi),
-            lambda step, done, t, lo, hi: (step < 40) & ~done,
-            body,
-        )
-        return t
+        return _newton_in_bracket(lambda t: cell_integral(x0, p0, k, t) - rest, density,
+                                  t, mi.Float64(tau_max), tol)
 
     def diffraction_sample(self, wi, u0, u1):
         """The diffraction lobe's direction (`TwoScale::sample_diffraction`:
