@@ -27,8 +27,9 @@ impl Convolution for Unbaked<'_> {
 fn errors(set: &TableSet<'_>, material: &Material, pairs: usize, seed: u64) -> Vec<f64> {
     let unbaked_source = Unbaked(set.convolution);
     let unbaked_tables = set.brdf_tables_with(&unbaked_source);
-    let baked = set.rgb(material, Options::default());
-    let unbaked = Rgb::new(&unbaked_tables, material, Options::default());
+    // Boxed: two models by value (390 KB each) overflow a test thread's stack.
+    let baked = Rgb::boxed(&set.brdf_tables(), material, Options::default());
+    let unbaked = Rgb::boxed(&unbaked_tables, material, Options::default());
     let mut rng = SplitMix64::new(seed);
     let mut out = Vec::with_capacity(3 * pairs);
     for _ in 0..pairs {
