@@ -25,7 +25,9 @@ use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::{ConvTable, FormatError, SigmaRatioTable, SmithG1Table, TableId};
+use twoscale::brdf::{IntegratedRgb, Options, Spectral};
+use twoscale::optical::SpectralMaterial;
+use twoscale::{ConvTable, FormatError, Rgb, SigmaRatioTable, SmithG1Table, TableId};
 
 /// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
 pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -231,15 +233,7 @@ pub fn lobes(
             .draw()
             .map_err(draw_error)?;
         for (k, term) in TERMS.iter().enumerate() {
-            // Runs above the plot's floor (a log axis has no 0).
-            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-            for (&t, v) in thetas.iter().zip(values) {
-                if v[k] > lo {
-                    runs.last_mut().expect("one run").push((t, v[k]));
-                } else if !runs.last().expect("one run").is_empty() {
-                    runs.push(Vec::new());
-                }
-            }
+            let runs = runs_above(thetas.iter().zip(values).map(|(&t, v)| (t, v[k])), lo);
             let style = ShapeStyle::from(&term.color).stroke_width(if k == 0 { 2 } else { 1 });
             if runs.iter().all(Vec::is_empty) {
                 // Listed all the same: absent (a conductor has no base), or
@@ -257,7 +251,7 @@ pub fn lobes(
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
                 continue;
             }
-            for (r, run) in runs.into_iter().filter(|r| !r.is_empty()).enumerate() {
+            for (r, run) in runs.into_iter().enumerate() {
                 let series = chart
                     .draw_series(LineSeries::new(run, style))
                     .map_err(draw_error)?;
@@ -279,6 +273,255 @@ pub fn lobes(
     }
     root.present().map_err(draw_error)
 }
+
+/// The runs of `points` above `lo` (a log axis has no 0): one polyline per
+/// run, empty when none.
+fn runs_above(points: impl Iterator<Item = (f64, f64)>, lo: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for (t, v) in points {
+        if v > lo {
+            runs.last_mut().expect("one run").push((t, v));
+        } else if !runs.last().expect("one run").is_empty() {
+            runs.push(Vec::new());
+        }
+    }
+    runs.retain(|r| !r.is_empty());
+    runs
+}
+
+/// The wavelengths (µm) of [`spectral_lobes`] and a colour for each.
+const SPECTRAL_LINES: [(f32, RGBColor); 5] = [
+    (0.40, RGBColor(118, 0, 196)),
+    (0.50, RGBColor(0, 160, 170)),
+    (0.60, RGBColor(230, 130, 0)),
+    (0.70, RGBColor(200, 0, 0)),
+    (0.80, RGBColor(100, 0, 0)),
+];
+
+/// Draws ρ of preset `name` over the spectrum (`material`) in the plane of
+/// incidence at [`SPECTRAL_LINES`]'s wavelengths, one panel per incidence,
+/// through `brdf::Spectral` (HP17 Fig. 15: the halo widens with λ), to `path`.
+pub fn spectral_lobes(
+    name: &str,
+    material: &SpectralMaterial<'_>,
+    source: &TableSource,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let inputs = source.model_inputs()?;
+    let parsed = inputs.parse()?;
+    let tables = parsed.brdf_tables();
+    let model = Spectral::boxed(&tables, material, Options::default());
+    let curves: Vec<(f64, Vec<f64>, Vec<[f64; SPECTRAL_LINES.len()]>)> = INCIDENCES
+        .iter()
+        .map(|&theta_i| {
+            let ti = theta_i.to_radians();
+            let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
+            let thetas = outgoing_angles(theta_i);
+            let values = thetas
+                .iter()
+                .map(|&t| {
+                    let to = t.to_radians();
+                    let o = [to.sin() as f32, 0.0, to.cos() as f32];
+                    SPECTRAL_LINES.map(|(lambda, _)| f64::from(model.eval(i, o, lambda)))
+                })
+                .collect();
+            (theta_i, thetas, values)
+        })
+        .collect();
+    let peak = curves
+        .iter()
+        .flat_map(|(_, _, v)| v.iter().flatten().copied())
+        .fold(0.0f64, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return Err(PlotError::ZeroBrdf(name.to_string()));
+    }
+    let hi = 10f64.powf(peak.log10().ceil() + 0.3);
+    let lo = hi * 1e-6;
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let root = root
+        .titled(
+            &format!("{name}: ρ in the plane of incidence at five wavelengths (log scale)"),
+            (FONT, 20),
+        )
+        .map_err(draw_error)?;
+    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(&curves) {
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("θi = {theta_i}°"), (FONT, 15))
+            .margin(6)
+            .x_label_area_size(32)
+            .y_label_area_size(58)
+            .build_cartesian_2d(-90f64..90f64, (lo..hi).log_scale())
+            .map_err(draw_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("θo (°), + on the mirror side")
+            .y_desc("ρ (sr⁻¹)")
+            .x_labels(7)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style((FONT, 11))
+            .axis_desc_style((FONT, 12))
+            .draw()
+            .map_err(draw_error)?;
+        for (k, &(lambda, color)) in SPECTRAL_LINES.iter().enumerate() {
+            let style = ShapeStyle::from(&color).stroke_width(1);
+            let runs = runs_above(thetas.iter().zip(values).map(|(&t, v)| (t, v[k])), lo);
+            for (r, run) in runs.into_iter().enumerate() {
+                let series = chart
+                    .draw_series(LineSeries::new(run, style))
+                    .map_err(draw_error)?;
+                if r == 0 {
+                    series
+                        .label(format!("λ = {lambda} µm"))
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 11))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(draw_error)?;
+    }
+    root.present().map_err(draw_error)
+}
+
+/// The incidence (°) of [`rgb_comparison`].
+const COMPARISON_INCIDENCE: f64 = 45.0;
+
+/// Draws preset `name`'s RGB in the plane of incidence at θi = 45°,
+/// integrated over the spectrum (`brdf::IntegratedRgb`, solid) against the
+/// paper's three wavelengths (`brdf::Rgb`, dashed): ρ per channel (linear
+/// scale, around the mirror direction) and each channel over red (the
+/// colour), to `path`.
+pub fn rgb_comparison(
+    name: &str,
+    material: &SpectralMaterial<'_>,
+    source: &TableSource,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let inputs = source.model_inputs()?;
+    let parsed = inputs.parse()?;
+    let tables = parsed.brdf_tables();
+    let options = Options::default();
+    let paper = Rgb::boxed(&tables, &material.paper_rgb(), options);
+    let integrated = IntegratedRgb::boxed(&tables, material, options);
+    let ti = COMPARISON_INCIDENCE.to_radians();
+    let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
+    let thetas: Vec<f64> = (0..=600)
+        .map(|k| COMPARISON_INCIDENCE - 30.0 + 0.1 * f64::from(k))
+        .filter(|t| t.abs() <= 89.5)
+        .collect();
+    let values: Vec<([f64; 3], [f64; 3])> = thetas
+        .iter()
+        .map(|&t| {
+            let to = t.to_radians();
+            let o = [to.sin() as f32, 0.0, to.cos() as f32];
+            (
+                integrated.eval(i, o).map(f64::from),
+                paper.eval(i, o).map(f64::from),
+            )
+        })
+        .collect();
+    let peak = values
+        .iter()
+        .flat_map(|(a, b)| a.iter().chain(b))
+        .copied()
+        .fold(0.0f64, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return Err(PlotError::ZeroBrdf(name.to_string()));
+    }
+    let channels = [
+        ("R", RGBColor(200, 30, 30)),
+        ("G", RGBColor(30, 150, 30)),
+        ("B", RGBColor(30, 60, 200)),
+    ];
+    let x_range = (thetas[0], thetas[thetas.len() - 1]);
+    let root = BitMapBackend::new(path, (SIZE.0, SIZE.1 / 2 + 40)).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let root = root
+        .titled(
+            &format!(
+                "{name}, θi = {COMPARISON_INCIDENCE}°: RGB integrated over the spectrum (solid) \
+                 vs at 0.645, 0.526, 0.444 µm (dashed)"
+            ),
+            (FONT, 15),
+        )
+        .map_err(draw_error)?;
+    let panels = root.split_evenly((1, 2));
+    // Left: ρ per channel; right: each channel over red.
+    for (p, panel) in panels.iter().enumerate() {
+        let y_max = if p == 0 { peak * 1.05 } else { 1.2 };
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(32)
+            .y_label_area_size(52)
+            .build_cartesian_2d(x_range.0..x_range.1, 0f64..y_max)
+            .map_err(draw_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("θo (°), in the plane of incidence")
+            .y_desc(if p == 0 {
+                "ρ (sr⁻¹)"
+            } else {
+                "ρ_c / ρ_R"
+            })
+            .x_labels(7)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .label_style((FONT, 11))
+            .axis_desc_style((FONT, 12))
+            .draw()
+            .map_err(draw_error)?;
+        for (c, &(label, color)) in channels.iter().enumerate() {
+            if p == 1 && c == 0 {
+                continue;
+            }
+            // Where red is above 1e-3 of the peak (the ratio is colour there).
+            let pick = |v: &[f64; 3]| if p == 0 { v[c] } else { v[c] / v[0] };
+            let shown = |v: &[f64; 3]| p == 0 || v[0] > 1e-3 * peak;
+            let solid: Vec<(f64, f64)> = thetas
+                .iter()
+                .zip(&values)
+                .filter(|(_, (a, _))| shown(a))
+                .map(|(&t, (a, _))| (t, pick(a)))
+                .collect();
+            let dashed: Vec<(f64, f64)> = thetas
+                .iter()
+                .zip(&values)
+                .filter(|(_, (_, b))| shown(b))
+                .map(|(&t, (_, b))| (t, pick(b)))
+                .collect();
+            let style = ShapeStyle::from(&color).stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(solid, style))
+                .map_err(draw_error)?
+                .label(format!("{label} integrated"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            let thin = ShapeStyle::from(&color).stroke_width(1);
+            chart
+                .draw_series(DashedLineSeries::new(dashed, 6, 4, thin))
+                .map_err(draw_error)?
+                .label(format!("{label} three wavelengths"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], thin));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 10))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(draw_error)?;
+    }
+    root.present().map_err(draw_error)
+}
+
+/// The metal of the README's comparison picture ([`rgb_comparison`]).
+pub const COMPARISON_PRESET: &str = "gold-hp17-geometry";
 
 /// Errors at points of a 2-D view of a table's domain: `(x, y, error)` in
 /// plot coordinates.
@@ -565,9 +808,11 @@ pub struct PlotArgs {
     pub font: PathBuf,
 }
 
-/// `generator plot`: the lobes of each material (`lobes-<name>.png`) and
-/// the error maps (`error-t1.png`, `error-t2.png`, `error-t3.png`) in
-/// `args.out`.
+/// `generator plot`: the lobes of each material (`lobes-<name>.png`), of
+/// each preset over the spectrum (`spectral-<name>.png`), the README's
+/// comparison of integrated and three-wavelength RGB
+/// (`rgb-integration-gold-hp17-geometry.png`) and the error maps
+/// (`error-t1.png`, `error-t2.png`, `error-t3.png`) in `args.out`.
 pub fn run(args: &PlotArgs) -> Result<(), Error> {
     load_font(&args.font)?;
     let materials = &args.materials;
@@ -596,6 +841,18 @@ pub fn run(args: &PlotArgs) -> Result<(), Error> {
         let path = out.join(format!("lobes-{}.png", material.name));
         lobes(material, channel, lambda, &args.tables, &path)?;
         eprintln!("wrote {}", path.display());
+        // A preset (same name and layer) has its index over the spectrum.
+        let preset = twoscale::materials::spectral(&material.name);
+        if let Some(spectral) = preset.filter(|s| s.layer == material.layer) {
+            let path = out.join(format!("spectral-{}.png", material.name));
+            spectral_lobes(&material.name, &spectral, &args.tables, &path)?;
+            eprintln!("wrote {}", path.display());
+            if material.name == COMPARISON_PRESET {
+                let path = out.join(format!("rgb-integration-{}.png", material.name));
+                rgb_comparison(&material.name, &spectral, &args.tables, &path)?;
+                eprintln!("wrote {}", path.display());
+            }
+        }
     }
     if args.errors {
         let (source, points, seed) = (&args.tables, args.points, args.seed);
