@@ -6,13 +6,19 @@ use generator::reference::epd;
 use generator::rng::SplitMix64;
 use generator::table_source::TableSource;
 
-fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
+/// The answer, output and errors of query `quantity` over `input` with the
+/// committed tables.
+fn run_with(
+    quantity: &str,
+    options: &query::Options,
+    input: &str,
+) -> (Result<query::Summary, query::QueryError>, String, String) {
     let mut out = Vec::new();
     let mut err = Vec::new();
     let result = query::run(
-        "g1",
+        quantity,
         &TableSource::Dir(suite::tables_dir()),
-        &query::Options::default(),
+        options,
         input.as_bytes(),
         &mut out,
         &mut err,
@@ -22,6 +28,10 @@ fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, Strin
         String::from_utf8(out).unwrap(),
         String::from_utf8(err).unwrap(),
     )
+}
+
+fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
+    run_with("g1", &query::Options::default(), input)
 }
 
 #[test]
@@ -173,23 +183,7 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
         material: Some(owned.clone()),
         ..query::Options::default()
     };
-    let source = TableSource::Dir(suite::tables_dir());
-    let run = |quantity: &str, options: &query::Options, input: &str| {
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let result = query::run(
-            quantity,
-            &source,
-            options,
-            input.as_bytes(),
-            &mut out,
-            &mut err,
-        );
-        (
-            result,
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-        )
-    };
+    let run = run_with;
     let pairs = [
         ([0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
         ([0.1, 0.2, 0.97], [-0.3, -0.1, 0.95]),
@@ -274,26 +268,12 @@ fn brdf_with_a_lambda_column_is_the_spectral_model() {
     let owned = MaterialDesc::from_toml_str(text).unwrap();
     let desc = owned.get();
     let spectral = desc.spectral.unwrap();
-    let source = TableSource::Dir(suite::tables_dir());
     let run = |material: MaterialDesc<'_>, input: &str| {
         let options = query::Options {
             material: Some(material.to_owned_desc()),
             ..query::Options::default()
         };
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let result = query::run(
-            "brdf",
-            &source,
-            &options,
-            input.as_bytes(),
-            &mut out,
-            &mut err,
-        );
-        (
-            result,
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-        )
+        run_with("brdf", &options, input)
     };
     let rows = [
         (0.45f32, [0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),

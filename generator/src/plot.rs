@@ -161,59 +161,61 @@ fn outgoing_angles(theta_i: f64) -> Vec<f64> {
     v
 }
 
-/// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
-/// with the tables of `source` to `path`.
-pub fn lobes(
-    material: &Material,
-    channel: usize,
-    lambda: f64,
-    source: &TableSource,
-    path: &Path,
-) -> Result<(), PlotError> {
-    let inputs = source.model_inputs()?;
-    let parsed = inputs.parse()?;
-    let tables = parsed.brdf_tables();
-    let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
-    // Per incidence: θo and the terms at each.
-    let curves: Vec<(f64, Vec<f64>, Vec<[f64; 4]>)> = INCIDENCES
+/// One curve of a lobe picture: its legend label, colour and line width.
+struct Curve {
+    label: String,
+    color: RGBColor,
+    width: u32,
+}
+
+/// Per incidence of [`INCIDENCES`]: θi, the outgoing angles in the plane of
+/// incidence and `values(i, o)` at each.
+type PlaneCurves<const K: usize> = Vec<(f64, Vec<f64>, Vec<[f64; K]>)>;
+
+/// `values(i, o)` in the plane of incidence, per incidence of [`INCIDENCES`].
+fn plane_curves<const K: usize>(values: impl Fn([f32; 3], [f32; 3]) -> [f64; K]) -> PlaneCurves<K> {
+    INCIDENCES
         .iter()
         .map(|&theta_i| {
             let ti = theta_i.to_radians();
             let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
             let thetas = outgoing_angles(theta_i);
-            let values = thetas
+            let v = thetas
                 .iter()
                 .map(|&t| {
                     let to = t.to_radians();
-                    let lobes = brdf.eval_lobes(i, [to.sin() as f32, 0.0, to.cos() as f32]);
-                    TERMS.map(|term| f64::from((term.pick)(&lobes)))
+                    values(i, [to.sin() as f32, 0.0, to.cos() as f32])
                 })
                 .collect();
-            (theta_i, thetas, values)
+            (theta_i, thetas, v)
         })
-        .collect();
+        .collect()
+}
+
+/// Draws `curves` (one panel per incidence, log scale over six decades
+/// below the peak) titled `title` to `path`; `name` is the material's, for
+/// the error of an all-zero BRDF.
+fn draw_plane_curves<const K: usize>(
+    path: &Path,
+    title: &str,
+    name: &str,
+    curves: &PlaneCurves<K>,
+    series: &[Curve; K],
+) -> Result<(), PlotError> {
     let peak = curves
         .iter()
-        .flat_map(|(_, _, v)| v.iter().map(|t| t[0]))
+        .flat_map(|(_, _, v)| v.iter().flatten().copied())
         .fold(0.0f64, f64::max);
     if !(peak > 0.0 && peak.is_finite()) {
-        return Err(PlotError::ZeroBrdf(material.name.clone()));
+        return Err(PlotError::ZeroBrdf(name.to_string()));
     }
     let hi = 10f64.powf(peak.log10().ceil() + 0.3);
     let lo = hi * 1e-6;
 
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_error)?;
-    let root = root
-        .titled(
-            &format!(
-                "{}: ρ in the plane of incidence, λ = {lambda} µm (log scale)",
-                material.name
-            ),
-            (FONT, 20),
-        )
-        .map_err(draw_error)?;
-    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(&curves) {
+    let root = root.titled(title, (FONT, 20)).map_err(draw_error)?;
+    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(curves) {
         let mut chart = ChartBuilder::on(panel)
             .caption(format!("θi = {theta_i}°"), (FONT, 15))
             .margin(6)
@@ -232,17 +234,17 @@ pub fn lobes(
             .axis_desc_style((FONT, 12))
             .draw()
             .map_err(draw_error)?;
-        for (k, term) in TERMS.iter().enumerate() {
+        for (k, curve) in series.iter().enumerate() {
             let runs = runs_above(thetas.iter().zip(values).map(|(&t, v)| (t, v[k])), lo);
-            let style = ShapeStyle::from(&term.color).stroke_width(if k == 0 { 2 } else { 1 });
-            if runs.iter().all(Vec::is_empty) {
+            let style = ShapeStyle::from(&curve.color).stroke_width(curve.width);
+            if runs.is_empty() {
                 // Listed all the same: absent (a conductor has no base), or
                 // below the plot.
                 let largest = values.iter().map(|v| v[k]).fold(0.0f64, f64::max);
                 let label = if largest > 0.0 {
-                    format!("{}: all < {lo:.0e}", term.name)
+                    format!("{}: all < {lo:.0e}", curve.label)
                 } else {
-                    format!("{}: none", term.name)
+                    format!("{}: none", curve.label)
                 };
                 chart
                     .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
@@ -252,30 +254,68 @@ pub fn lobes(
                 continue;
             }
             for (r, run) in runs.into_iter().enumerate() {
-                let series = chart
+                let drawn = chart
                     .draw_series(LineSeries::new(run, style))
                     .map_err(draw_error)?;
                 if r == 0 {
-                    series
-                        .label(term.name)
+                    drawn
+                        .label(curve.label.as_str())
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 11))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_error)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 11)?;
     }
     root.present().map_err(draw_error)
 }
 
+/// Draws the legend of `chart`'s labelled series at `position`, text of `size`.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+    size: u32,
+) -> Result<(), PlotError> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_error)
+}
+
+/// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
+/// with the tables of `source` to `path`.
+pub fn lobes(
+    material: &Material,
+    channel: usize,
+    lambda: f64,
+    source: &TableSource,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let inputs = source.model_inputs()?;
+    let parsed = inputs.parse()?;
+    let tables = parsed.brdf_tables();
+    let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
+    let curves = plane_curves(|i, o| {
+        let lobes = brdf.eval_lobes(i, o);
+        TERMS.map(|term| f64::from((term.pick)(&lobes)))
+    });
+    let series = TERMS.each_ref().map(|term| Curve {
+        label: term.name.to_string(),
+        color: term.color,
+        width: if term.name == TERMS[0].name { 2 } else { 1 },
+    });
+    let title = format!(
+        "{}: ρ in the plane of incidence, λ = {lambda} µm (log scale)",
+        material.name
+    );
+    draw_plane_curves(path, &title, &material.name, &curves, &series)
+}
+
 /// The runs of `points` above `lo` (a log axis has no 0): one polyline per
-/// run, empty when none.
+/// run, none when no point is above.
 fn runs_above(points: impl Iterator<Item = (f64, f64)>, lo: f64) -> Vec<Vec<(f64, f64)>> {
     let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
     for (t, v) in points {
@@ -311,83 +351,15 @@ pub fn spectral_lobes(
     let parsed = inputs.parse()?;
     let tables = parsed.brdf_tables();
     let model = Spectral::boxed(&tables, material, Options::default());
-    let curves: Vec<(f64, Vec<f64>, Vec<[f64; SPECTRAL_LINES.len()]>)> = INCIDENCES
-        .iter()
-        .map(|&theta_i| {
-            let ti = theta_i.to_radians();
-            let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
-            let thetas = outgoing_angles(theta_i);
-            let values = thetas
-                .iter()
-                .map(|&t| {
-                    let to = t.to_radians();
-                    let o = [to.sin() as f32, 0.0, to.cos() as f32];
-                    SPECTRAL_LINES.map(|(lambda, _)| f64::from(model.eval(i, o, lambda)))
-                })
-                .collect();
-            (theta_i, thetas, values)
-        })
-        .collect();
-    let peak = curves
-        .iter()
-        .flat_map(|(_, _, v)| v.iter().flatten().copied())
-        .fold(0.0f64, f64::max);
-    if !(peak > 0.0 && peak.is_finite()) {
-        return Err(PlotError::ZeroBrdf(name.to_string()));
-    }
-    let hi = 10f64.powf(peak.log10().ceil() + 0.3);
-    let lo = hi * 1e-6;
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(draw_error)?;
-    let root = root
-        .titled(
-            &format!("{name}: ρ in the plane of incidence at five wavelengths (log scale)"),
-            (FONT, 20),
-        )
-        .map_err(draw_error)?;
-    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(&curves) {
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("θi = {theta_i}°"), (FONT, 15))
-            .margin(6)
-            .x_label_area_size(32)
-            .y_label_area_size(58)
-            .build_cartesian_2d(-90f64..90f64, (lo..hi).log_scale())
-            .map_err(draw_error)?;
-        chart
-            .configure_mesh()
-            .x_desc("θo (°), + on the mirror side")
-            .y_desc("ρ (sr⁻¹)")
-            .x_labels(7)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style((FONT, 11))
-            .axis_desc_style((FONT, 12))
-            .draw()
-            .map_err(draw_error)?;
-        for (k, &(lambda, color)) in SPECTRAL_LINES.iter().enumerate() {
-            let style = ShapeStyle::from(&color).stroke_width(1);
-            let runs = runs_above(thetas.iter().zip(values).map(|(&t, v)| (t, v[k])), lo);
-            for (r, run) in runs.into_iter().enumerate() {
-                let series = chart
-                    .draw_series(LineSeries::new(run, style))
-                    .map_err(draw_error)?;
-                if r == 0 {
-                    series
-                        .label(format!("λ = {lambda} µm"))
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-                }
-            }
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 11))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_error)?;
-    }
-    root.present().map_err(draw_error)
+    let curves =
+        plane_curves(|i, o| SPECTRAL_LINES.map(|(lambda, _)| f64::from(model.eval(i, o, lambda))));
+    let series = SPECTRAL_LINES.map(|(lambda, color)| Curve {
+        label: format!("λ = {lambda} µm"),
+        color,
+        width: 1,
+    });
+    let title = format!("{name}: ρ in the plane of incidence at five wavelengths (log scale)");
+    draw_plane_curves(path, &title, name, &curves, &series)
 }
 
 /// The incidence (°) of [`rgb_comparison`].
@@ -508,14 +480,7 @@ pub fn rgb_comparison(
                 .label(format!("{label} three wavelengths"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], thin));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, 10))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_error)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight, 10)?;
     }
     root.present().map_err(draw_error)
 }
