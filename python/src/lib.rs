@@ -243,7 +243,7 @@ type SampleArrays<'py> = (
 
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-/// halo_weight=None): the RGB two-scale model of one material, built once
+/// halo_weight=None, rgb_mode=None): the RGB two-scale model of one material, built once
 /// (the runtime bakes its per-material tables) and evaluated over arrays of
 /// directions.
 ///
