@@ -158,6 +158,25 @@ def test_register_needs_a_variant_and_the_module_loads_on_first_use():
     assert done.returncode == 0, done.stdout + done.stderr
 
 
+def test_rgb_mode_is_the_materials():
+    """rgb_mode passes to the material: a preset integrated over the
+    spectrum evaluates as Material.preset(..., rgb_mode="integrated"), and
+    differs from the paper's wavelengths (gold's blue)."""
+    bsdf = mi.load_dict({"type": "twoscale", "material": "gold-rough", "rgb_mode": "integrated"})
+    material = twoscale.Material.preset("gold-rough", rgb_mode="integrated")
+    paper = twoscale.Material.preset("gold-rough")
+    cam = np.array([[np.sin(0.7), 0.0, np.cos(0.7)]] * 16)
+    light = np.array([[-np.sin(0.6 + 0.02 * k), 0.0, np.cos(0.6 + 0.02 * k)] for k in range(16)])
+    si, ctx = make_si(cam), mi.BSDFContext()
+    wo = mi.Vector3f(np.ascontiguousarray(light.T.astype(np.float32)))
+    value = np.asarray(bsdf.eval(ctx, si, wo)).T
+    expected = material.eval(light, cam) * light[:, 2:3]
+    np.testing.assert_allclose(value, expected, rtol=1e-6)
+    assert not np.allclose(value, paper.eval(light, cam) * light[:, 2:3], rtol=1e-2)
+    with pytest.raises(Exception, match="rgb_mode 'integrated' needs an index over the spectrum"):
+        mi.load_dict({"type": "twoscale", "beta": 0.1, "p": 1.0, "eta": GOLD, "rgb_mode": "integrated"})
+
+
 def test_material_file(tmp_path):
     """``filename`` loads a material file (a fit's TOML), found through
     Mitsuba's file resolver as scene files find theirs; it gives the whole

@@ -28,6 +28,10 @@ name           type     meaning
 ``sigma_rel``,          paper's model), with ``material`` or explicit
 ``colour``,             parameters
 ``halo_weight``
+``rgb_mode``   string   ``paper-wavelengths`` (default) or ``integrated``
+                        (``twoscale.RGB_MODES``: RGB integrated over the
+                        spectrum; a preset's measured index, or one
+                        ``n k`` for every channel)
 ============== ======== ====================================================
 
 **Direction convention.** Mitsuba's ``si.wi`` points towards the camera
@@ -68,8 +72,9 @@ import twoscale
 #: Plugin name.
 NAME = "twoscale"
 
-#: Material keywords passed through as strings (the runtime's options).
-OPTION_KEYS = tuple(twoscale.OPTIONS)
+#: Material keywords passed through as strings (the runtime's options and
+#: the RGB mode).
+OPTION_KEYS = (*twoscale.OPTIONS, "rgb_mode")
 #: Material keywords passed through as floats.
 FLOAT_KEYS = ("beta", "p", "sigma_s", "b", "c", "albedo", "lambertian")
 
