@@ -304,15 +304,18 @@ impl EtaArgument {
         if let Ok(pairs) = eta.extract::<Vec<[f32; 2]>>() {
             return Ok(EtaArgument::Channels(pairs));
         }
-        let (lam, n, k) = eta
-            .extract::<(Vec<f32>, Vec<f32>, Vec<f32>)>()
-            .map_err(|_| {
+        // Any sequence of three 1-D sequences: a tuple, a list, a (3, N) array.
+        let arrays = eta
+            .extract::<Vec<Vec<f32>>>()
+            .ok()
+            .filter(|a| a.len() == 3)
+            .ok_or_else(|| {
                 value_error(format!(
                     "eta must be three (n, k) pairs or (lam, n, k), three 1-D arrays, got {}",
                     describe(eta)
                 ))
             })?;
-        desc::spectrum_rows(&lam, &n, &k)
+        desc::spectrum_rows(&arrays[0], &arrays[1], &arrays[2])
             .map(EtaArgument::Spectrum)
             .map_err(|e| value_error(e.to_string()))
     }

@@ -373,6 +373,10 @@ def test_a_spectral_eta_is_the_preset_it_copies():
         np.testing.assert_array_equal(given.pdf(wi, wo), preset.pdf(wi, wo))
     lam = np.linspace(0.36, 0.83, 64)
     np.testing.assert_array_equal(given.eval_spectral(wi, wo, lam), preset.eval_spectral(wi, wo, lam))
+    # A list of three arrays and a (3, N) array are the same spectrum.
+    for eta in ([rows[:, 0], rows[:, 1], rows[:, 2]], rows.T):
+        again = twoscale.Material(eta=eta, rgb_mode=mode, **geometry)
+        np.testing.assert_array_equal(again.eval(wi, wo), preset.eval(wi, wo))
     assert twoscale.Material.preset("gold-rough").rgb_mode == "paper-wavelengths"
 
 
