@@ -271,6 +271,21 @@ struct Material {
 }
 
 impl Material {
+    /// The model at any wavelength of `spectral` (this material's index over
+    /// the spectrum), built by the first call.
+    fn spectral_model(
+        &self,
+        spectral: &SpectralMaterial<'static>,
+    ) -> &Spectral<'static, Box<ChannelBake>> {
+        self.spectral_model.get_or_init(|| {
+            Box::new(Spectral::boxed(
+                &TABLES.brdf_tables(),
+                spectral,
+                self.options,
+            ))
+        })
+    }
+
     /// The model of `material`, its bakes allocated zeroed on the heap and
     /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
     /// is enough (`tests/test_small_stack.py`).
@@ -454,13 +469,7 @@ impl Material {
                 lam[k][0]
             )));
         }
-        let model = self.spectral_model.get_or_init(|| {
-            Box::new(Spectral::boxed(
-                &TABLES.brdf_tables(),
-                spectral,
-                self.options,
-            ))
-        });
+        let model = self.spectral_model(spectral);
         let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k], lam[k][0])));
         Ok(shaped(py, &v.shape, values))
     }
@@ -561,18 +570,56 @@ impl Material {
         self.model
             .channels
             .iter()
-            .map(|channel| {
-                let mut visitor = DictVisitor {
-                    dict: PyDict::new(py),
-                    error: None,
-                };
-                channel.visit_bakes(&mut visitor);
-                match visitor.error {
-                    Some(e) => Err(e),
-                    None => Ok(visitor.dict),
-                }
-            })
+            .map(|channel| bake_dict(py, |v| channel.visit_bakes(v)))
             .collect()
+    }
+
+    /// spectral_bakes(): the constants and bakes of the model at any
+    /// wavelength (`eval_spectral`'s), for ports of it
+    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 11 models', µm),
+    /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, and
+    /// `models`, a list of 11 dicts as `bakes()` gives them (not a stable
+    /// interface). Raises `ValueError` as `eval_spectral` does for a
+    /// material without an index over the spectrum.
+    fn spectral_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let Some(spectral) = &self.spectral else {
+            return Err(value_error(
+                "spectral_bakes needs an index over the spectrum: a preset, or one (n, k) for every channel",
+            ));
+        };
+        let model = self.spectral_model(spectral);
+        let dict = bake_dict(py, |v| model.visit_index(v))?;
+        let models = model
+            .nodes()
+            .iter()
+            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
+            .collect::<PyResult<Vec<_>>>()?;
+        dict.set_item("models", models)?;
+        Ok(dict)
+    }
+
+    /// with_layer(*, albedo=None, lambertian=None): this material with the
+    /// base layer's albedo and/or the Lambertian k_d replaced (the same
+    /// geometry, index, spectrum and options), rebuilt and re-baked; refused
+    /// as the constructor refuses them (`ValueError`). For the Mitsuba
+    /// plugin's `parameters_changed`.
+    #[pyo3(signature = (*, albedo=None, lambertian=None))]
+    fn with_layer(&self, albedo: Option<f32>, lambertian: Option<f32>) -> PyResult<Self> {
+        let mut layer = self.material.layer;
+        if let Some(albedo) = albedo {
+            layer.base = validate::base_layer(layer.base.kind(), Some(albedo))
+                .map_err(|e| value_error(e.to_string()))?;
+        }
+        if let Some(lambertian) = lambertian {
+            layer.lambertian = lambertian;
+        }
+        layer.validate().map_err(invalid)?;
+        let material = twoscale::brdf::Material {
+            layer,
+            ..self.material
+        };
+        let spectral = self.spectral.map(|s| SpectralMaterial { layer, ..s });
+        Ok(Material::with_spectrum(material, self.options, spectral))
     }
 
     /// β, the EPD's roughness (slope scale), dimensionless.
@@ -665,6 +712,22 @@ fn columns<const K: usize>(
         same_rows((names[0], n), (name, view.len()))?;
     }
     Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// The dict that `visit` fills through a [`DictVisitor`].
+fn bake_dict<'py>(
+    py: Python<'py>,
+    visit: impl FnOnce(&mut dyn BakeVisitor),
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut visitor = DictVisitor {
+        dict: PyDict::new(py),
+        error: None,
+    };
+    visit(&mut visitor);
+    match visitor.error {
+        Some(e) => Err(e),
+        None => Ok(visitor.dict),
+    }
 }
 
 /// Collects `TwoScale::visit_bakes` into a dict (the first error is kept).

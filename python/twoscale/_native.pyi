@@ -7,7 +7,7 @@ conversion.
 """
 
 import os
-from typing import final
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -78,6 +78,10 @@ class Material:
     ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...
     def eval_reference(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]: ...
     def bakes(self) -> list[dict[str, float | NDArray[np.float32] | NDArray[np.float64]]]: ...
+    def spectral_bakes(self) -> dict[str, Any]: ...
+    def with_layer(
+        self, *, albedo: float | None = None, lambertian: float | None = None
+    ) -> Material: ...
     @property
     def beta(self) -> float: ...
     @property

@@ -17,9 +17,28 @@ law, the cosine lobe, the baked lobe weights, averaged over the channels) and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
 loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
-its density and weight ``eval / pdf``. Not yet: gradients (``traverse``
-exposes nothing), spectral variants. Particle tracing is not supported (as
-in ``twoscale.mitsuba``).
+its density and weight ``eval / pdf``. Particle tracing is not supported
+(as in ``twoscale.mitsuba``).
+
+**Gradients.** The bakes are fixed per material (the runtime interprets the
+tables; a lookup's node positions have no useful derivative), so
+``traverse`` exposes only the parameters that enter *after* the lookups, in
+closed form (:attr:`Model.params`, ``mi.ParamFlags.Differentiable``):
+
+- ``lambertian``: k_d, the term ``k_d/π`` (every material);
+- ``albedo``: the base layer's α (plastic: ``T α/(π n²(1 − α F_dr))``;
+  subsurface: HP17 42-47), for a plastic or subsurface base with physical
+  colour;
+- ``halo_factor``: a factor on the diffraction lobe ρ_CTD (default 1; not
+  a runtime parameter: at other values the plugin is no longer
+  ``Material.eval``), for materials with σs > 0.
+
+β, p, σs, b, c and η enter the bakes (C, G1, F, the sampler's tables) and
+are not exposed. ``parameters_changed`` re-bakes the material at the new
+k_d or albedo (``Material.with_layer``: they also set the sampler's lobe
+weights), so the primal value stays the runtime's; the derivative is that
+of the closed form, with the sampler held fixed (its density is not
+differentiated).
 
 **Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
 ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
@@ -123,18 +142,12 @@ class _Channel:
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
         s["visible_r_max"] = self.r_max
-        # Constants of the base layer (`TwoScale::base_value`).
+        # Constants of the base layer (`TwoScale::base_value`; the albedo
+        # and k_d are the plugin's parameters, `Model.params`).
         n = max(abs(s["eta_re"]), 1e-3)
-        f_dr, alpha = s["f_dr_int"], s["albedo"]
-        s["base_lambertian"] = s["lambertian"] / math.pi
+        f_dr = s["f_dr_int"]
         s["base_inv_n_sq"] = 1.0 / (n * n)
-        if s["base"] == 1.0:
-            s["base_plastic"] = alpha / (math.pi * n * n * (1.0 - alpha * f_dr))
-        a_f = (1.0 - f_dr) / (1.0 + f_dr)
-        root = math.sqrt(max(3.0 * (1.0 - alpha), 0.0))
-        s["base_single"] = alpha / (4.0 * math.pi)
-        s["base_multi"] = (alpha / (2.0 * math.pi) * math.exp(-root)
-                           * (1.0 + math.exp(-4.0 / 3.0 * a_f * root)))
+        s["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
         self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
@@ -481,24 +494,36 @@ class _Channel:
              + pp_re * pp_re + pp_im * pp_im)
         return 0.5 * self.d["q_e_norm_sqr"] * q * inv_s_sq
 
-    def base_value(self, f_i, f_o, cos_i, cos_o):
-        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47)."""
+    def base_value(self, f_i, f_o, cos_i, cos_o, params):
+        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47), with the
+        albedo α and k_d of `params` (differentiable: closed forms after
+        the lookups). Plastic: `T α / (π n² (1 − α F_dr))`; subsurface:
+        `T α/(4π (cos θi' + cos θo')) + T α/(2π) e^−r (1 + e^−(4/3) A r)`,
+        `r = √(3(1 − α))`, `T = (1 − F(θi))(1 − F(θo))`."""
         s, d = self.s, self.d
-        lambertian = d["base_lambertian"]
+        lambertian = mi.Float64(params["lambertian"]) * (1.0 / math.pi)
         if s["white"] != 0.0 or s["base"] == 0.0:
-            return mi.Float64(lambertian)
+            return lambertian
+        alpha = mi.Float64(params["albedo"])
         t = (1.0 - f_i) * (1.0 - f_o)
         if s["base"] == 1.0:
-            return t * d["base_plastic"] + lambertian
+            plastic = alpha * d["base_inv_n_sq"] / (math.pi * (1.0 - alpha * d["f_dr_int"]))
+            return t * plastic + lambertian
 
         def refracted(cos):
             return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) * d["base_inv_n_sq"], 0.0))
 
-        single = t * d["base_single"] / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
-        return single + t * d["base_multi"] + lambertian
+        root = dr.sqrt(dr.maximum(3.0 * (1.0 - alpha), 0.0))
+        multi = alpha / (2.0 * math.pi) * dr.exp(-root) * (
+            1.0 + dr.exp(-4.0 / 3.0 * d["base_a_f"] * root))
+        single = t * (alpha / (4.0 * math.pi)) / dr.maximum(
+            refracted(cos_i) + refracted(cos_o), 1e-12)
+        return single + t * multi + lambertian
 
-    def lobes(self, g, geo):
-        """`TwoScale::lobes`: (specular, diffraction, base) at a pair."""
+    def lobes(self, g, geo, params):
+        """`TwoScale::lobes`: (specular, diffraction, base) at a pair, the
+        diffraction lobe times `params["halo_factor"]` and the base layer's
+        with `params`' albedo and k_d (:meth:`base_value`)."""
         s = self.s
         wi, wo = geo["wi"], geo["wo"]
         cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
@@ -542,20 +567,38 @@ class _Channel:
             c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
                                 mi.Float(self.d["big_b"] * cos_d))
             c_value = mi.Float64(dr.maximum(c_value, 0.0))
-            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0)
+            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0) * mi.Float64(
+                params["halo_factor"])
         else:
             diffraction = mi.Float64(0.0)
-        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o)
+        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         return _finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base)
+
+
+def default_params(material: twoscale.Material):
+    """The differentiable parameters of :class:`Model` at `material`'s
+    values (``mi.Float`` kernel inputs): ``lambertian`` (k_d), ``albedo``
+    (the base layer's; 0 for a conductor) and ``halo_factor`` (1)."""
+    return {
+        "lambertian": dr.opaque(mi.Float, material.lambertian),
+        "albedo": dr.opaque(mi.Float, material.albedo or 0.0),
+        "halo_factor": dr.opaque(mi.Float, 1.0),
+    }
 
 
 class Model:
     """The RGB model of a :class:`twoscale.Material` in Dr.Jit: its three
-    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
+    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``.
 
-    def __init__(self, material: twoscale.Material):
+    `params` (:func:`default_params`) hold the parameters that enter after
+    the lookups (k_d, the base albedo, a factor on the diffraction lobe), as
+    Dr.Jit variables that may carry gradients; at the material's values and
+    a factor of 1, :meth:`eval` is the runtime's."""
+
+    def __init__(self, material: twoscale.Material, params=None, bakes=None):
         self.material = material
-        self.channels = [_Channel(b) for b in material.bakes()]
+        self.params = default_params(material) if params is None else params
+        self.channels = [_Channel(b) for b in (material.bakes() if bakes is None else bakes)]
         first = self.channels[0].s
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
@@ -592,11 +635,8 @@ class Model:
             "across": -(wi.x * wo.y - wi.y * wo.x),
         }
 
-    def eval(self, wi, wo):
-        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
-        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
-        below the horizon."""
-        valid, geo = self.geometry(wi, wo)
+    def masking(self, geo):
+        """G at a pair (`TwoScale::with_masking`), f64."""
         wi, wo = geo["wi"], geo["wo"]
         ch = self.channels[0]
 
@@ -609,9 +649,17 @@ class Model:
             g = 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0)
         else:
             g = g1_i * g1_o
+        return g
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
+        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
+        below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
         values = []
         for channel in self.channels:
-            spec, diff, base = channel.lobes(g, geo)
+            spec, diff, base = channel.lobes(g, geo, self.params)
             values.append(mi.Float(_finite_or_zero(
                 mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base)))))
         return dr.select(valid, mi.Color3f(*values), 0.0)
@@ -730,9 +778,34 @@ def _bsdf_class():
             weight = self._eval(si, wo) / dr.select(active, bs.pdf, 1.0)
             return bs, dr.select(active, weight, 0.0)
 
+        def _exposed(self):
+            """The keys of `Model.params` this material has (module doc)."""
+            m = self.model.material
+            keys = ["lambertian"]
+            if m.base != "conductor" and m.options.get("colour") != "white":
+                keys.append("albedo")
+            if self.model.channels_have_diffraction:
+                keys.append("halo_factor")
+            return keys
+
         def traverse(self, callback):
-            # No parameter is differentiable yet (issue 25 item 3).
-            pass
+            for key in self._exposed():
+                callback.put(key, self.model.params[key], mi.ParamFlags.Differentiable)
+
+        def parameters_changed(self, keys):
+            # k_d and the albedo also set the sampler's baked lobe weights:
+            # re-bake the material at their (detached) values; the params
+            # (changed in place by mi.SceneParameters) stay the model's.
+            m, params = self.model.material, self.model.params
+            changed = {}
+            for key in ("albedo", "lambertian"):
+                if key in keys:
+                    value = float(dr.detach(params[key])[0] if dr.is_array_v(params[key])
+                                  else params[key])
+                    if value != float(getattr(m, key) or 0.0):
+                        changed[key] = value
+            if changed:
+                self.model = type(self.model)(m.with_layer(**changed), params)
 
         def to_string(self):
             return f"TwoScaleDrJitBSDF[{self.model.material!r}]"
