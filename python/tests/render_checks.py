@@ -1,5 +1,5 @@
-"""Render checks shared by the Mitsuba plugins' tests (test_mitsuba.py,
-test_drjit_bsdf.py): the white furnace (a material's albedo by quadrature
+"""Render checks of the Mitsuba plugin's tests (test_drjit_bsdf.py,
+test_drjit_spectral.py): the white furnace (a material's albedo by quadrature
 over the runtime's eval, and a render that estimates it in every pixel) and
 the Beckmann limit against Mitsuba's roughconductor."""
 

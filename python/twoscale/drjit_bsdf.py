@@ -1,4 +1,6 @@
-"""A Mitsuba 3 BSDF ``twoscale_drjit`` written in Dr.Jit (issue 25, first steps).
+"""The Mitsuba 3 BSDF ``twoscale`` in Dr.Jit (issue 25), registered by
+:func:`twoscale.mitsuba.register` (parameters and direction convention
+there).
 
 The per-material bakes come from the Rust runtime (:meth:`twoscale.Material.bakes`,
 the only place where the tables are interpreted); they are uploaded once per
@@ -10,15 +12,18 @@ own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
 ``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
 the bakes' node axes and cubic weights are not a texture's.
 
-**What is ported.** :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
+**What is ported.** RGB variants: :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
 :meth:`Model.pdf` (``Rgb::pdf``: the visible-slope tables, the diffraction
 law, the cosine lobe, the baked lobe weights, averaged over the channels) and
 :meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
 loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
-its density and weight ``eval / pdf``. Particle tracing is not supported
-(as in ``twoscale.mitsuba``).
+its density and weight ``eval / pdf``. Particle tracing is not supported.
+Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
+:meth:`twoscale.Material.spectral_bakes`: the 11 models' bakes, interpolated
+in λ, with F(θd) at each of the path's four wavelengths in closed form;
+``pdf`` and ``sample`` those of the model nearest the hero wavelength).
 
 **Gradients.** The bakes are fixed per material (the runtime interprets the
 tables; a lookup's node positions have no useful derivative), so
@@ -40,13 +45,9 @@ weights), so the primal value stays the runtime's; the derivative is that
 of the closed form, with the sampler held fixed (its density is not
 differentiated).
 
-**Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
+**Direction convention** (``twoscale.mitsuba``): ``eval(si, wo) =
 ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
 incident one.
-
-Register with :func:`register` after ``mi.set_variant(...)``; the plugin takes
-the parameters of ``twoscale.mitsuba`` (``material``, ``filename`` or explicit
-ones).
 """
 
 import math
@@ -57,9 +58,6 @@ import numpy as np
 
 import twoscale
 from twoscale.mitsuba import _material
-
-#: Plugin name.
-NAME = "twoscale_drjit"
 
 # The constants of `math::log2_axis` (runtime/src/math.rs), in f32.
 _LOG2_E = np.float32(math.log2(math.e))
@@ -151,7 +149,7 @@ class _Channel:
         self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
-            raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
+            raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
 
     # -- the 1-D bakes -------------------------------------------------
     def direction_cell(self, cos):
@@ -732,15 +730,254 @@ class Model:
         return o, ok
 
 
-def _bsdf_class():
-    """The BSDF class for the current variant (``mi.BSDF`` is per variant)."""
+def _fresnel(n, k, cos):
+    """`fresnel::fresnel`: F of the index `n + ik` (f32) at `cos θ` (f32),
+    unpolarised (HP17 3-4), computed in f64 as the runtime; 0 for η² = 1."""
+    n = dr.minimum(dr.abs(mi.Float64(n)), 1e9)
+    k = dr.minimum(dr.abs(mi.Float64(k)), 1e9)
+    n = dr.select(n * n + k * k < 1e-20, 1e-10, n)
+    e_re, e_im = (n - 1.0) * (n + 1.0) - k * k, 2.0 * n * k
+    cos = dr.clip(mi.Float64(cos), 0.0, 1.0)
+    # c = √(η² − 1 + cos²θ), the runtime's principal root (`C64::sqrt`).
+    x, y = e_re + cos * cos, e_im
+    r = dr.sqrt(x * x + y * y)
+    t = dr.sqrt(0.5 * (r + dr.abs(x)))
+    t_safe = dr.select(t > 0.0, t, 1.0)
+    c_re = dr.select(x >= 0.0, t, dr.abs(y) / (2.0 * t_safe))
+    c_im = dr.select(x >= 0.0, y / (2.0 * t_safe), dr.select(y < 0.0, -t, t))
 
-    class TwoScaleDrJitBSDF(mi.BSDF):
+    def ratio(a_re, a_im):
+        """|a − c|² / |a + c|²."""
+        return (((a_re - c_re) ** 2 + (a_im - c_im) ** 2)
+                / ((a_re + c_re) ** 2 + (a_im + c_im) ** 2))
+
+    f = 0.5 * (ratio(cos, 0.0) + ratio((n * n - k * k) * cos, e_im * cos))
+    f = dr.select((e_re == 0.0) & (e_im == 0.0), 0.0, f)
+    return dr.clip(mi.Float(f), 0.0, 1.0)
+
+
+class SpectralModel(Model):
+    """The model at any wavelength of a :class:`twoscale.Material`
+    (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 11
+    models of ``Material.spectral_bakes()`` sharing the surface, their
+    surface lobes divided by F(θd) and interpolated linearly in λ, times
+    F(θd) at λ in closed form (η linear between 5 nm nodes); the base lobes
+    interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
+    the nearest model (``Spectral::pdf``, ``Spectral::sample``)."""
+
+    def __init__(self, material: twoscale.Material, params=None):
+        spectral = material.spectral_bakes()
+        super().__init__(material, params, spectral["models"])
+        self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
+        self.node_table = mi.Float(spectral["wavelengths"])
+        self.eta = mi.Float(np.ascontiguousarray(spectral["eta"]).ravel())
+        self.eta_nodes = spectral["eta"].shape[0]
+        self.eta_first = float(np.float32(spectral["eta_first"]))
+        self.eta_step = float(np.float32(spectral["eta_step"]))
+        self.white = spectral["white"] != 0.0
+
+    def clamped(self, lam):
+        """λ (µm, f32) clamped to the models' range (NaN → the first)."""
+        return dr.select(lam > self.nodes[0], dr.minimum(lam, self.nodes[-1]), self.nodes[0])
+
+    def cell(self, lam):
+        """`spectral::cell`: the model `k` and fraction `f` of the clamped λ."""
+        k = mi.UInt32(0)
+        for node in self.nodes[1:-1]:
+            k += dr.select(lam > node, 1, 0)
+        a = dr.gather(mi.Float, self.node_table, k)
+        b = dr.gather(mi.Float, self.node_table, k + 1)
+        f = (lam - a) / (b - a)
+        return k, dr.select(f > 0.0, dr.minimum(f, 1.0), 0.0)
+
+    def eta_at(self, lam):
+        """`Spectral::eta_at`: η at λ (f32), linear between the 5 nm nodes."""
+        t = (lam - self.eta_first) / self.eta_step
+        j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), self.eta_nodes - 2)
+        f = dr.clip(t - mi.Float(j), 0.0, 1.0)
+
+        def at(col):
+            a = dr.gather(mi.Float, self.eta, 2 * j + col)
+            b = dr.gather(mi.Float, self.eta, 2 * j + 2 + col)
+            return a + f * (b - a)
+
+        return at(0), at(1)
+
+    def eval_spectral(self, wi, wo, lams):
+        """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
+        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``)."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
+        cos_d = mi.Float(geo["cos_d"])
+        surface, base, total, fresnel = [], [], [], []
+        for channel in self.channels:
+            spec, diff, b = channel.lobes(g, geo, self.params)
+            spec, diff, b = (mi.Float64(mi.Float(x)) for x in (spec, diff, b))
+            surface.append(spec + diff)
+            base.append(b)
+            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b))))
+            fresnel.append(mi.Float64(1.0) if self.white else mi.Float64(
+                channel.direction(channel.direction_cell(cos_d), [6])[0]))
+        out = []
+        for lam in lams:
+            lam = self.clamped(mi.Float(lam))
+            k, f = self.cell(lam)
+
+            def at(values, m):
+                return sum(dr.select(m == j, v, 0.0) for j, v in enumerate(values))
+
+            fa, fb = at(fresnel, k), at(fresnel, k + 1)
+            f = mi.Float64(f)
+            plain = (1.0 - f) * at(total, k) + f * at(total, k + 1)
+            fl = mi.Float64(_fresnel(*self.eta_at(lam), cos_d))
+            fa_safe = dr.select(fa > 0.0, fa, 1.0)
+            fb_safe = dr.select(fb > 0.0, fb, 1.0)
+            coloured = (fl * ((1.0 - f) * at(surface, k) / fa_safe
+                              + f * at(surface, k + 1) / fb_safe)
+                        + (1.0 - f) * at(base, k) + f * at(base, k + 1))
+            use_plain = (fa <= 0.0) | (fb <= 0.0) if not self.white else True
+            value = dr.select(use_plain, plain, coloured)
+            out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
+        return out
+
+    def nearest(self, lam):
+        """`Spectral::nearest`: the index of the model nearest λ."""
+        k, f = self.cell(self.clamped(mi.Float(lam)))
+        return dr.select(f < 0.5, k, k + 1)
+
+    def pdf_spectral(self, wi, wo, lam):
+        """`Spectral::pdf`: `TwoScale::pdf` of the model nearest λ."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        nearest = self.nearest(lam)
+        specular = self.channels[0].visible_pdf(wi, wo)
+        base = wo.z / math.pi
+        total = mi.Float64(0.0)
+        for m, channel in enumerate(self.channels):
+            w = channel.lobe_weights(wi.z)
+            value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
+            if channel.diffraction:
+                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
+            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            total = dr.select(nearest == m, value, total)
+        return dr.select(valid, _finite_or_zero(mi.Float(total)), 0.0)
+
+    def sample_spectral(self, wi, u, lam):
+        """`Spectral::sample`'s direction: `TwoScale::sample_direction` of
+        the model nearest λ (the lobe picked with `u[0]`, its direction
+        from `u[1], u[2]`). Returns the direction and whether one was drawn."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        wi_f = mi.Vector3f(wi)
+        valid = dr.all(dr.isfinite(wi_f))
+        wi = dr.normalize(mi.Vector3d(wi_f))
+        valid &= wi.z > 0.0
+        nearest = self.nearest(lam)
+        pick = mi.Float64(dr.clip(u.x, 0.0, below_one))
+        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
+        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        w = [mi.Float64(0.0)] * 3
+        for m, channel in enumerate(self.channels):
+            wm = channel.lobe_weights(wi.z)
+            w = [dr.select(nearest == m, wm[n], w[n]) for n in range(3)]
+        # `pick_lobe`.
+        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+        for n in range(3):
+            positive = w[n] > 0.0
+            cumulative += dr.select(positive, w[n], 0.0)
+            last = dr.select(positive, n, last)
+            chosen = dr.select((chosen < 0) & positive & (pick < cumulative), n, chosen)
+        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
+        m_, ok = self.channels[0].visible_sample(wi, u1, u2)
+        o = 2.0 * dr.dot(wi, m_) * m_ - wi
+        for m, channel in enumerate(self.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & (nearest == m)
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe == 2, ob, o)
+        ok = dr.select(lobe == 2, True, ok)
+        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
+        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
+        return o, ok
+
+
+def _scalar_bsdf_class():
+    """The BSDF in scalar RGB variants: one direction per call, handed to
+    the runtime (:class:`twoscale.Material`) directly; Dr.Jit's scalar
+    variants have no arrays to gather from. No differentiable parameters."""
+
+    def vector(v):
+        return np.array([v[0], v[1], v[2]], dtype=np.float32)
+
+    class TwoScaleScalarBSDF(mi.BSDF):
+        """The two-scale BRDF, scalar RGB variants (front side, glossy)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            if not mi.is_rgb:
+                raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
+                                   "(scalar_rgb is; spectral variants: llvm_ad_spectral)")
+            self.material = _material(props)
+            self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            self.m_components = [self.m_flags]
+
+        def _on(self, ctx, active):
+            return bool(active) and ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
+
+        def _eval(self, si, wo):
+            value = self.material.eval(vector(wo), vector(si.wi)) * max(float(wo[2]), 0.0)
+            return mi.Color3f(*(float(x) for x in value))
+
+        def _pdf(self, si, wo):
+            return float(self.material.pdf(vector(si.wi), vector(wo)))
+
+        def eval(self, ctx, si, wo, active=True):
+            return self._eval(si, wo) if self._on(ctx, active) else mi.Color3f(0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            return self._pdf(si, wo) if self._on(ctx, active) else 0.0
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            u = np.array([sample1, sample2[0], sample2[1]], dtype=np.float32)
+            wo, pdf, _ = self.material.sample(vector(si.wi), u)
+            bs = mi.BSDFSample3f()
+            bs.wo = mi.Vector3f(*(float(x) for x in wo))
+            bs.pdf = float(pdf) if self._on(ctx, active) else 0.0
+            bs.eta = 1.0
+            bs.sampled_type = +mi.BSDFFlags.GlossyReflection
+            bs.sampled_component = 0
+            if not bs.pdf > 0.0:
+                return bs, mi.Color3f(0.0)
+            return bs, self._eval(si, bs.wo) / bs.pdf
+
+        def to_string(self):
+            return f"TwoScaleBSDF[{self.material!r}]"
+
+    return TwoScaleScalarBSDF
+
+
+def bsdf_class():
+    """The BSDF class for the current variant (``mi.BSDF`` is per variant),
+    registered as ``twoscale`` by :func:`twoscale.mitsuba.register`."""
+    if mi.variant().startswith("scalar"):
+        return _scalar_bsdf_class()
+
+    class TwoScaleBSDF(mi.BSDF):
         """The two-scale BRDF in Dr.Jit (front side only, glossy reflection)."""
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            self.model = Model(_material(props))
+            if mi.is_polarized or not (mi.is_rgb or mi.is_spectral):
+                raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
+                                   "(rgb and unpolarised spectral variants are)")
+            self.model = (SpectralModel if mi.is_spectral else Model)(_material(props))
             self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             self.m_components = [self.m_flags]
 
@@ -748,29 +985,47 @@ def _bsdf_class():
         def _active(ctx, active):
             return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
 
+        @staticmethod
+        def _lams(si):
+            """The path's wavelengths in µm (Mitsuba's are in nm)."""
+            return [si.wavelengths[j] * 1e-3 for j in range(len(si.wavelengths))]
+
         def _eval(self, si, wo):
-            """ρ(wi=wo, wo=si.wi) · cos θ(wo)."""
-            return self.model.eval(wo, si.wi) * dr.maximum(wo.z, 0.0)
+            """ρ(wi=wo, wo=si.wi) · cos θ(wo): RGB, or at the path's wavelengths."""
+            if mi.is_spectral:
+                value = mi.Spectrum(*self.model.eval_spectral(wo, si.wi, self._lams(si)))
+            else:
+                value = self.model.eval(wo, si.wi)
+            return value * dr.maximum(wo.z, 0.0)
+
+        def _pdf(self, si, wo):
+            """The density of `sample` (at the hero wavelength, spectral)."""
+            if mi.is_spectral:
+                return self.model.pdf_spectral(si.wi, wo, self._lams(si)[0])
+            return self.model.pdf(si.wi, wo)
 
         def eval(self, ctx, si, wo, active=True):
             return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
+            return dr.select(self._active(ctx, active), self._pdf(si, wo), 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             active = self._active(ctx, active)
             return (dr.select(active, self._eval(si, wo), 0.0),
-                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
+                    dr.select(active, self._pdf(si, wo), 0.0))
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             # The light direction from the runtime's sampler given the camera
             # direction (as twoscale.mitsuba), its density and eval / pdf.
             u = mi.Vector3f(sample1, sample2.x, sample2.y)
-            wo, ok = self.model.sample_direction(si.wi, u)
+            if mi.is_spectral:
+                wo, ok = self.model.sample_spectral(si.wi, u, self._lams(si)[0])
+            else:
+                wo, ok = self.model.sample_direction(si.wi, u)
             bs = mi.BSDFSample3f()
             bs.wo = wo
-            bs.pdf = dr.select(ok, self.model.pdf(si.wi, wo), 0.0)
+            bs.pdf = dr.select(ok, self._pdf(si, wo), 0.0)
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)
@@ -808,15 +1063,6 @@ def _bsdf_class():
                 self.model = type(self.model)(m.with_layer(**changed), params)
 
         def to_string(self):
-            return f"TwoScaleDrJitBSDF[{self.model.material!r}]"
+            return f"TwoScaleBSDF[{self.model.material!r}]"
 
-    return TwoScaleDrJitBSDF
-
-
-def register() -> None:
-    """register(): registers the ``twoscale_drjit`` BSDF with the current Mitsuba
-    variant. No Dr.Jit flag is changed."""
-    if not mi.variant():
-        raise RuntimeError("call mi.set_variant(...) before twoscale.drjit_bsdf.register()")
-    cls = _bsdf_class()
-    mi.register_bsdf(NAME, lambda props: cls(props))
+    return TwoScaleBSDF
