@@ -88,6 +88,11 @@ def _lerp_gather(table, width, column, i, frac):
     return dr.fma(frac, b - a, a)
 
 
+def _gather4(table, k):
+    """Floats `4k … 4k + 3` of `table`, one packet gather."""
+    return dr.gather(mi.Vector4f, table, k)
+
+
 def _catmull_rom_weights(t):
     """`conv::catmull_rom_weights`."""
     t2 = t * t
@@ -147,6 +152,11 @@ class _Channel:
         s["base_inv_n_sq"] = 1.0 / (n * n)
         s["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
         self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
+        # ln C as overlapping packets: packet j holds nodes j … j + 3 of the
+        # flattened grid (so that a Catmull–Rom row is one packet gather).
+        ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()
+        ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
+        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
@@ -157,8 +167,17 @@ class _Channel:
         return _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
 
     def direction(self, cell, columns):
+        """The direction bake's `columns` at `cell`, linear between its rows
+        (`DirectionBake::at_cell`), read as packets of four columns."""
         i, frac = cell
-        return [_lerp_gather(self.t["direction_rows"], 8, k, i, frac) for k in columns]
+        out = []
+        for half in sorted({k // 4 for k in columns}):
+            a = _gather4(self.t["direction_rows"], 2 * i + half)
+            b = _gather4(self.t["direction_rows"], 2 * i + 2 + half)
+            out += [(k, dr.fma(frac, b[k % 4] - a[k % 4], a[k % 4]))
+                    for k in columns if k // 4 == half]
+        values = dict(out)
+        return [values[k] for k in columns]
 
     def g1(self, r, z):
         """`MaskingBake::g1`."""
@@ -190,10 +209,11 @@ class _Channel:
         wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
         ln_c = mi.Float(0.0)
         for a in range(4):
-            row = (ju + a) * n_s + ks
+            # The four nodes (ks … ks + 3) of row ju + a in one packet.
+            quad = _gather4(self.conv_quads, (ju + a) * n_s + ks)
             inner = mi.Float(0.0)
             for b in range(4):
-                inner += ws[b] * dr.gather(mi.Float, self.t["conv_ln_c"], row + b)
+                inner += ws[b] * quad[b]
             ln_c += wu[a] * inner
         value = dr.exp(ln_c)
         return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
