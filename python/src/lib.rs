@@ -241,6 +241,9 @@ type SampleArrays<'py> = (
     Bound<'py, PyArrayDyn<f32>>,
 );
 
+/// `(wo, pdf)` of [`Material::sample_spectral`].
+type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArrayDyn<f32>>);
+
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
 /// halo_weight=None): the RGB two-scale model of one material, built once
@@ -284,6 +287,49 @@ impl Material {
                 self.options,
             ))
         })
+    }
+
+    /// The rows of `arrays` (`(..., 3)`) and of `lam` (µm, `(...)`, as a
+    /// third array of rows `[λ, λ, λ]`) broadcast together, and the model at
+    /// any wavelength; `ValueError` (naming `method`) without an index over
+    /// the spectrum or for `lam` outside the models' range.
+    fn spectral_rows<'py>(
+        &self,
+        py: Python<'py>,
+        method: &str,
+        arrays: [(&str, &Bound<'py, PyAny>); 2],
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<(Vectors<3>, &Spectral<'static, Box<ChannelBake>>)> {
+        let Some(spectral) = &self.spectral else {
+            return Err(value_error(format!(
+                "{method} needs an index over the spectrum: a preset, or one (n, k) for every channel"
+            )));
+        };
+        // lam as a (..., 3) array, to broadcast with the directions.
+        let np = PyModule::import(py, "numpy")?;
+        let lam = np.call_method1("asarray", (lam, "float64")).map_err(|_| {
+            value_error(format!(
+                "lam must be an array of numbers (µm), got {}",
+                describe(lam)
+            ))
+        })?;
+        let lam3 = np.call_method1(
+            "repeat",
+            (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
+        )?;
+        let [a, b] = arrays;
+        let v = vectors([a, b, ("lam", &lam3)])?;
+        let (lo, hi) = (
+            SPECTRAL_WAVELENGTHS[0],
+            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+        );
+        if let Some(k) = v.rows[2].iter().position(|l| !(l[0] >= lo && l[0] <= hi)) {
+            return Err(value_error(format!(
+                "lam must be in [{lo}, {hi}] µm, got {} at row {k}",
+                v.rows[2][k][0]
+            )));
+        }
+        Ok((v, self.spectral_model(spectral)))
     }
 
     /// The model of `material`, its bakes allocated zeroed on the heap and
@@ -440,38 +486,52 @@ impl Material {
         wo: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let Some(spectral) = &self.spectral else {
-            return Err(value_error(
-                "eval_spectral needs an index over the spectrum: a preset, or one (n, k) for every channel",
-            ));
-        };
-        // lam as a (..., 3) array, to broadcast with the directions.
-        let np = PyModule::import(py, "numpy")?;
-        let lam = np.call_method1("asarray", (lam, "float64")).map_err(|_| {
-            value_error(format!(
-                "lam must be an array of numbers (µm), got {}",
-                describe(lam)
-            ))
-        })?;
-        let lam3 = np.call_method1(
-            "repeat",
-            (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
-        )?;
-        let v = vectors([("wi", wi), ("wo", wo), ("lam", &lam3)])?;
+        let (v, model) = self.spectral_rows(py, "eval_spectral", [("wi", wi), ("wo", wo)], lam)?;
         let [wi, wo, lam] = &v.rows;
-        let (lo, hi) = (
-            SPECTRAL_WAVELENGTHS[0],
-            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
-        );
-        if let Some(k) = lam.iter().position(|l| !(l[0] >= lo && l[0] <= hi)) {
-            return Err(value_error(format!(
-                "lam must be in [{lo}, {hi}] µm, got {} at row {k}",
-                lam[k][0]
-            )));
-        }
-        let model = self.spectral_model(spectral);
         let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k], lam[k][0])));
         Ok(shaped(py, &v.shape, values))
+    }
+
+    /// pdf_spectral(wi, wo, lam): the density (sr⁻¹) of `sample_spectral(wi,
+    /// ·, lam)` at `wo`: the sampler of the model at any wavelength nearest
+    /// `lam` (`Spectral::pdf`). Arguments and errors as `eval_spectral`'s.
+    fn pdf_spectral<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let (v, model) = self.spectral_rows(py, "pdf_spectral", [("wi", wi), ("wo", wo)], lam)?;
+        let [wi, wo, lam] = &v.rows;
+        let values = py.detach(|| rows(v.len(), |k| model.pdf(wi[k], wo[k], lam[k][0])));
+        Ok(shaped(py, &v.shape, values))
+    }
+
+    /// sample_spectral(wi, u, lam): `(wo, pdf)`, a direction drawn for the
+    /// wavelength `lam` (µm) from three uniforms `u` (`Spectral::sample`: the
+    /// sampler of the model nearest `lam`) and its density; `(0, 0, 0)` and 0
+    /// where none is drawn. Arguments and errors as `eval_spectral`'s.
+    fn sample_spectral<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<SpectralSampleArrays<'py>> {
+        let (v, model) = self.spectral_rows(py, "sample_spectral", [("wi", wi), ("u", u)], lam)?;
+        let [wi, u, lam] = &v.rows;
+        let samples = py.detach(|| {
+            rows(v.len(), |k| match model.sample(wi[k], u[k], lam[k][0]) {
+                Some(s) => (s.o, s.pdf),
+                None => ([0.0; 3], 0.0),
+            })
+        });
+        let (dirs, pdf): (Vec<_>, Vec<_>) = samples.into_iter().unzip();
+        Ok((
+            shaped_vectors(py, &v.shape, dirs),
+            shaped(py, &v.shape, pdf),
+        ))
     }
 
     /// pdf(wi, wo): the solid-angle density (sr⁻¹) of `sample(wi, ·)` at
