@@ -17,7 +17,7 @@ import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
-from render_checks import beckmann_limit, direction, furnace_albedo, furnace_render  # noqa: E402,E501
+from render_checks import beckmann_limit, chi2, direction, furnace_albedo, furnace_render  # noqa: E402,E501
 
 mi.set_variant("llvm_ad_rgb")
 import twoscale.drjit_bsdf as tb  # noqa: E402
@@ -234,16 +234,10 @@ CHI2_CASES = [
 @pytest.mark.parametrize("label,props,theta", CHI2_CASES, ids=[c[0] for c in CHI2_CASES])
 def test_chi2(label, props, theta):
     """Mitsuba's χ² test of the plugin's `sample` against its `pdf`, with
-    symbolic mode on (ires=16: the tester integrates the pdf over each cell
-    with 16×16 points; its default, 4, under-resolves lobes of β ≈ 0.06)."""
-    sample, pdf = mi.chi2.BSDFAdapter(tm.NAME, xml(**props), wi=direction(theta))
-    test = mi.chi2.ChiSquareTest(
-        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
-        sample_dim=3, ires=16,
-    )
-    passed = test.run(quiet=True)
+    symbolic mode on (`render_checks.chi2`)."""
+    test = chi2(*mi.chi2.BSDFAdapter(tm.NAME, xml(**props), wi=direction(theta)))
     print(f"chi2 {label}: p = {test.p_value:.4f}")
-    assert passed, test.messages
+    assert test.passed, test.messages
 
 
 @pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
@@ -334,3 +328,41 @@ def test_parameters_changed_rebakes():
     assert worst < TOLERANCE and small_ok
     plain = mi.traverse(mi.load_dict({"type": tm.NAME, "beta": 0.2, "p": 1.0, "eta": GOLD}))
     assert set(plain.keys()) == {"lambertian"}
+
+
+def test_render_gradient_equals_finite_differences():
+    """`dr.backward` of a tiny render (16×16, 1024 spp, Mitsuba's `prb`,
+    direct light from a sun and a constant environment on a white-plastic
+    sphere) with respect to the base albedo equals the central difference
+    of two renders (albedo ± 1%, re-baked, same seed) within 2%. The
+    adjoint pass draws its own samples (Mitsuba requires a seed other than
+    the primal's), so both sides carry Monte Carlo noise: measured 0.10%
+    here; at 512 spp two other seed pairs gave 0.46% and 0.51%."""
+    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "prb", "max_depth": 2},
+        "sensor": {"type": "perspective", "fov": 30, "to_world": look,
+                   "film": {"type": "hdrfilm", "width": 16, "height": 16,
+                            "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": 1024}},
+        "sphere": {"type": "sphere", "bsdf": {"type": tm.NAME, "material": "white-plastic"}},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
+        "sun": {"type": "directional", "direction": [-1, -1, -2],
+                "irradiance": {"type": "rgb", "value": 5.0}},
+    })
+    params = mi.traverse(scene)
+    key, x0, h = "sphere.bsdf.albedo", 0.8, 0.008
+    dr.enable_grad(params[key])
+    params.update()
+    dr.backward(dr.sum(mi.render(scene, params, seed=3, seed_grad=4), axis=None))
+    grad = dr.grad(params[key])[0]
+    dr.disable_grad(params[key])
+    values = []
+    for x in (x0 + h, x0 - h):
+        params[key] = mi.Float(x)
+        params.update()
+        values.append(float(dr.sum(mi.Float64(mi.render(scene, seed=3).array))[0]))
+    fd = (values[0] - values[1]) / (2 * h)
+    print(f"render ∂/∂albedo: backward {grad:.6g}, central difference {fd:.6g}")
+    assert abs(grad / fd - 1) < 0.02

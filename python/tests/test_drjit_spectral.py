@@ -18,7 +18,7 @@ import mitsuba as mi  # noqa: E402
 import twoscale  # noqa: E402
 import twoscale.drjit_bsdf as tb  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
-from render_checks import direction, furnace_albedo, furnace_render  # noqa: E402
+from render_checks import chi2, direction, furnace_albedo, furnace_render  # noqa: E402
 from test_drjit_bsdf import TOLERANCE, pairs, relative_error, seed  # noqa: E402
 
 
@@ -120,14 +120,9 @@ def adapter(props, wi, nm):
 def test_chi2(label, props, theta, nm):
     """Mitsuba's χ² test of `sample` against `pdf` in llvm_ad_spectral at a
     hero wavelength (the nearest model's sampler), symbolic mode on."""
-    sample, pdf = adapter(props, direction(theta), nm)
-    test = mi.chi2.ChiSquareTest(
-        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
-        sample_dim=3, ires=16,
-    )
-    passed = test.run(quiet=True)
+    test = chi2(*adapter(props, direction(theta), nm))
     print(f"chi2 spectral {label} at {nm} nm: p = {test.p_value:.4f}")
-    assert passed, test.messages
+    assert test.passed, test.messages
 
 
 def _spread(material, theta, wavelengths=(0.36, 0.45, 0.55, 0.65, 0.83), k=300):
