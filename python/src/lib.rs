@@ -332,6 +332,23 @@ impl Material {
         Ok((v, self.spectral_model(spectral)))
     }
 
+    /// `f(model, wi, wo, λ)` on every row of `wi`, `wo` and `lam` broadcast
+    /// together ([`Material::spectral_rows`]), as a float32 array.
+    fn spectral_pairs<'py>(
+        &self,
+        py: Python<'py>,
+        method: &str,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+        f: impl Fn(&Spectral<'static, Box<ChannelBake>>, [f32; 3], [f32; 3], f32) -> f32 + Sync,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let (v, model) = self.spectral_rows(py, method, [("wi", wi), ("wo", wo)], lam)?;
+        let [wi, wo, lam] = &v.rows;
+        let values = py.detach(|| rows(v.len(), |k| f(model, wi[k], wo[k], lam[k][0])));
+        Ok(shaped(py, &v.shape, values))
+    }
+
     /// The model of `material`, its bakes allocated zeroed on the heap and
     /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
     /// is enough (`tests/test_small_stack.py`).
@@ -486,10 +503,7 @@ impl Material {
         wo: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let (v, model) = self.spectral_rows(py, "eval_spectral", [("wi", wi), ("wo", wo)], lam)?;
-        let [wi, wo, lam] = &v.rows;
-        let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k], lam[k][0])));
-        Ok(shaped(py, &v.shape, values))
+        self.spectral_pairs(py, "eval_spectral", wi, wo, lam, Spectral::eval)
     }
 
     /// pdf_spectral(wi, wo, lam): the density (sr⁻¹) of `sample_spectral(wi,
@@ -502,10 +516,7 @@ impl Material {
         wo: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let (v, model) = self.spectral_rows(py, "pdf_spectral", [("wi", wi), ("wo", wo)], lam)?;
-        let [wi, wo, lam] = &v.rows;
-        let values = py.detach(|| rows(v.len(), |k| model.pdf(wi[k], wo[k], lam[k][0])));
-        Ok(shaped(py, &v.shape, values))
+        self.spectral_pairs(py, "pdf_spectral", wi, wo, lam, Spectral::pdf)
     }
 
     /// sample_spectral(wi, u, lam): `(wo, pdf)`, a direction drawn for the
