@@ -25,7 +25,7 @@ use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::brdf::{IntegratedRgb, Options, Spectral};
+use twoscale::brdf::{IntegratedRgb, Options, Spectral, Tables};
 use twoscale::optical::SpectralMaterial;
 use twoscale::{ConvTable, FormatError, Rgb, SigmaRatioTable, SmithG1Table, TableId};
 
@@ -340,17 +340,15 @@ const SPECTRAL_LINES: [(f32, RGBColor); 5] = [
 
 /// Draws ρ of preset `name` over the spectrum (`material`) in the plane of
 /// incidence at 0.4, 0.5, 0.6, 0.7 and 0.8 µm, one panel per incidence,
-/// through `brdf::Spectral` (HP17 Fig. 15: the halo widens with λ), to `path`.
+/// through `brdf::Spectral` (HP17 Fig. 15: the halo widens with λ) with
+/// `tables`, to `path`.
 pub fn spectral_lobes(
     name: &str,
     material: &SpectralMaterial<'_>,
-    source: &TableSource,
+    tables: &Tables<'_>,
     path: &Path,
 ) -> Result<(), PlotError> {
-    let inputs = source.model_inputs()?;
-    let parsed = inputs.parse()?;
-    let tables = parsed.brdf_tables();
-    let model = Spectral::boxed(&tables, material, Options::default());
+    let model = Spectral::boxed(tables, material, Options::default());
     let curves =
         plane_curves(|i, o| SPECTRAL_LINES.map(|(lambda, _)| f64::from(model.eval(i, o, lambda))));
     let series = SPECTRAL_LINES.map(|(lambda, color)| Curve {
@@ -369,19 +367,16 @@ const COMPARISON_INCIDENCE: f64 = 45.0;
 /// integrated over the spectrum (`brdf::IntegratedRgb`, solid) against the
 /// paper's three wavelengths (`brdf::Rgb`, dashed): ρ per channel (linear
 /// scale, around the mirror direction) and each channel over red (the
-/// colour), to `path`.
+/// colour), with `tables`, to `path`.
 pub fn rgb_comparison(
     name: &str,
     material: &SpectralMaterial<'_>,
-    source: &TableSource,
+    tables: &Tables<'_>,
     path: &Path,
 ) -> Result<(), PlotError> {
-    let inputs = source.model_inputs()?;
-    let parsed = inputs.parse()?;
-    let tables = parsed.brdf_tables();
     let options = Options::default();
-    let paper = Rgb::boxed(&tables, &material.paper_rgb(), options);
-    let integrated = IntegratedRgb::boxed(&tables, material, options);
+    let paper = Rgb::boxed(tables, &material.paper_rgb(), options);
+    let integrated = IntegratedRgb::boxed(tables, material, options);
     let ti = COMPARISON_INCIDENCE.to_radians();
     let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
     let thetas: Vec<f64> = (0..=600)
@@ -799,6 +794,9 @@ pub fn run(args: &PlotArgs) -> Result<(), Error> {
     // The green channel (as T4's band-limit study).
     let channel = 1;
     let lambda = materials.wavelengths[channel];
+    let inputs = args.tables.model_inputs().map_err(PlotError::from)?;
+    let parsed = inputs.parse().map_err(PlotError::from)?;
+    let tables = parsed.brdf_tables();
     for material in &materials.materials {
         if !args.only.is_empty() && !args.only.contains(&material.name) {
             continue;
@@ -810,11 +808,11 @@ pub fn run(args: &PlotArgs) -> Result<(), Error> {
         let preset = twoscale::materials::spectral(&material.name);
         if let Some(spectral) = preset.filter(|s| s.layer == material.layer) {
             let path = out.join(format!("spectral-{}.png", material.name));
-            spectral_lobes(&material.name, &spectral, &args.tables, &path)?;
+            spectral_lobes(&material.name, &spectral, &tables, &path)?;
             eprintln!("wrote {}", path.display());
             if material.name == COMPARISON_PRESET {
                 let path = out.join(format!("rgb-integration-{}.png", material.name));
-                rgb_comparison(&material.name, &spectral, &args.tables, &path)?;
+                rgb_comparison(&material.name, &spectral, &tables, &path)?;
                 eprintln!("wrote {}", path.display());
             }
         }
