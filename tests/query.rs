@@ -30,6 +30,18 @@ fn run_with(
     )
 }
 
+/// The f64 reference's ρ of `params` at the pair `(i, o)`.
+fn reference_total(
+    params: &generator::reference::brdf::Params,
+    i: [f32; 3],
+    o: [f32; 3],
+    options: &twoscale::brdf::Options,
+) -> f64 {
+    generator::reference::brdf::two_scale(params, i.map(f64::from), o.map(f64::from), options)
+        .unwrap()
+        .total()
+}
+
 fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
     run_with("g1", &query::Options::default(), input)
 }
@@ -221,14 +233,7 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
         let table: f32 = fields[7].parse().unwrap();
         assert_eq!(table.to_bits(), model.eval(i, o)[ch].to_bits(), "{row}");
         let reference: f64 = fields[8].parse().unwrap();
-        let want = generator::reference::brdf::two_scale(
-            &params[ch],
-            i.map(f64::from),
-            o.map(f64::from),
-            &desc.options,
-        )
-        .unwrap()
-        .total();
+        let want = reference_total(&params[ch], i, o, &desc.options);
         assert_eq!(reference, want, "{row}");
     }
     let (result, ..) = run("g1", &options, "p,a\n1,1\n");
@@ -318,14 +323,7 @@ fn brdf_with_a_lambda_column_is_the_spectral_model() {
             ..params
         };
         let reference: f64 = fields[8].parse().unwrap();
-        let want = generator::reference::brdf::two_scale(
-            &at,
-            i.map(f64::from),
-            o.map(f64::from),
-            &desc.options,
-        )
-        .unwrap()
-        .total();
+        let want = reference_total(&at, i, o, &desc.options);
         assert_eq!(reference, want, "{row}");
         // The model is within 3% of the reference at this λ.
         assert!((f64::from(table) / want - 1.0).abs() < 0.03, "{row}");
