@@ -11,8 +11,9 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use twoscale::brdf::ChannelBake;
-use twoscale::desc::MaterialDesc;
+use twoscale::brdf::{ChannelBake, RgbMode, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::desc::OwnedMaterialDesc;
+use twoscale::optical::SpectralMaterial;
 use twoscale::{
     AlbedoTable, ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table,
     TableId, TableSet,
@@ -262,6 +263,11 @@ pub enum QueryError {
     MaterialUnsupported(Quantity),
     /// The material of `--material` is one the reference does not cover.
     Uncovered(brdf::Uncovered),
+    /// `--material` with `rgb_mode = "integrated"` and a `channel` column:
+    /// the reference gives the paper's three wavelengths only.
+    IntegratedUnsupported,
+    /// A `lambda` column for a material without an index over the spectrum.
+    NoSpectrum,
     /// The quantity's tables lack one the model reads (a bug of `run`).
     MissingTables,
     /// The input has no header line.
@@ -301,6 +307,19 @@ impl fmt::Display for QueryError {
                 q.name()
             ),
             QueryError::Uncovered(e) => write!(f, "--material: {e}"),
+            QueryError::IntegratedUnsupported => write!(
+                f,
+                "--material: rows of {} compare with the reference at the paper's wavelengths; \
+                 rgb_mode 'integrated' has none (give rows of {})",
+                MATERIAL_COLUMNS.join(","),
+                SPECTRAL_COLUMNS.join(",")
+            ),
+            QueryError::NoSpectrum => write!(
+                f,
+                "--material: rows of {} need an index over the spectrum: \
+                 eta = {{ lambda, n, k }}, or one (n, k) for every channel",
+                SPECTRAL_COLUMNS.join(",")
+            ),
             QueryError::MissingTables => write!(f, "the table files were not opened"),
             QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
             QueryError::Read(e) => write!(f, "reading input: {e}"),
@@ -474,41 +493,94 @@ impl std::error::Error for RowError {}
 
 /// How `run` treats rows outside a table's domain, and the material of a
 /// `brdf` query.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Options {
     /// Answer them at the clamped point (as the renderer-facing lookups
     /// do) and add the column `in_domain`, instead of reporting them.
     pub clamp: bool,
     /// `brdf` of this material (a material file, `--material FILE`): the
     /// rows give [`MATERIAL_COLUMNS`], `table` is the channel of the RGB
-    /// model (`twoscale::Rgb`, as the C API and Python build it).
-    pub material: Option<MaterialDesc>,
+    /// model (`twoscale::Rgb`, as the C API and Python build it), or
+    /// [`SPECTRAL_COLUMNS`] (a `lambda` column and no `channel`), `table`
+    /// is the model at that wavelength (`twoscale::brdf::Spectral`).
+    pub material: Option<OwnedMaterialDesc>,
 }
 
 /// The input columns of `brdf` with a material: the channel (0, 1, 2: red,
 /// green, blue at `RGB_WAVELENGTHS`) and the two directions.
 pub const MATERIAL_COLUMNS: [&str; 7] = ["channel", "ix", "iy", "iz", "ox", "oy", "oz"];
 
-/// The RGB model of a `brdf --material` query and the reference's
-/// parameters of each channel.
-struct MaterialModel<'a> {
-    model: Rgb<'a, Box<ChannelBake>>,
-    params: [brdf::Params; 3],
-    options: twoscale::brdf::Options,
+/// The input columns of `brdf` with a material over the spectrum: the
+/// wavelength (µm, in [0.36, 0.83]) and the two directions.
+pub const SPECTRAL_COLUMNS: [&str; 7] = ["lambda", "ix", "iy", "iz", "ox", "oy", "oz"];
+
+/// The model of a `brdf --material` query, and the reference's parameters.
+enum MaterialModel<'a> {
+    /// Rows of [`MATERIAL_COLUMNS`]: the RGB model, and the reference's
+    /// parameters of each channel.
+    Channels {
+        model: Box<Rgb<'a, Box<ChannelBake>>>,
+        params: [brdf::Params; 3],
+        options: twoscale::brdf::Options,
+    },
+    /// Rows of [`SPECTRAL_COLUMNS`]: the spectral model, and the reference's
+    /// parameters with `n`, `k`, `λ` set per row from the material's index.
+    Spectral {
+        model: Box<Spectral<'a, Box<ChannelBake>>>,
+        spectral: SpectralMaterial<'a>,
+        params: brdf::Params,
+        options: twoscale::brdf::Options,
+    },
 }
 
 impl MaterialModel<'_> {
-    /// `table` and `reference` of a row of [`MATERIAL_COLUMNS`].
+    /// `table` and `reference` of a row of [`MATERIAL_COLUMNS`] or
+    /// [`SPECTRAL_COLUMNS`].
     fn evaluate(&self, x: &[f64]) -> Result<Vec<String>, RowError> {
-        let channel = x[0];
-        let ch = [0.0, 1.0, 2.0]
-            .iter()
-            .position(|&c| c == channel)
-            .ok_or(RowError::Channel(channel))?;
         let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
         let f = |v: f64| v as f32;
-        let value = self.model.eval(i.map(f), o.map(f))[ch];
-        let reference = brdf::two_scale(&self.params[ch], i, o, &self.options)
+        let (value, params, options) = match self {
+            MaterialModel::Channels {
+                model,
+                params,
+                options,
+            } => {
+                let channel = x[0];
+                let ch = [0.0, 1.0, 2.0]
+                    .iter()
+                    .position(|&c| c == channel)
+                    .ok_or(RowError::Channel(channel))?;
+                (model.eval(i.map(f), o.map(f))[ch], params[ch], options)
+            }
+            MaterialModel::Spectral {
+                model,
+                spectral,
+                params,
+                options,
+            } => {
+                let lambda = f(x[0]);
+                let (lo, hi) = (
+                    SPECTRAL_WAVELENGTHS[0],
+                    SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+                );
+                validate::check(
+                    "lambda",
+                    validate::widen(lambda),
+                    validate::Domain::Closed(validate::widen(lo), validate::widen(hi)),
+                    "µm, the spectral model's range",
+                )
+                .map_err(RowError::Invalid)?;
+                let eta = spectral.eta.at(lambda);
+                let params = brdf::Params {
+                    n: eta.re.into(),
+                    k: eta.im.into(),
+                    lambda: lambda.into(),
+                    ..*params
+                };
+                (model.eval(i.map(f), o.map(f), lambda), params, options)
+            }
+        };
+        let reference = brdf::two_scale(&params, i, o, options)
             .map_err(|e| RowError::Reference(e.to_string()))?;
         Ok(vec![short32(value), short(reference.total())])
     }
@@ -544,12 +616,11 @@ pub fn run(
         Some(_) if quantity != Quantity::Brdf => {
             return Err(QueryError::MaterialUnsupported(quantity));
         }
-        Some(desc) => Some(brdf::Params::rgb(&desc.material).map_err(QueryError::Uncovered)?),
+        Some(desc) => Some((
+            desc.get(),
+            brdf::Params::rgb(&desc.get().material).map_err(QueryError::Uncovered)?,
+        )),
         None => None,
-    };
-    let columns: &'static [&'static str] = match params {
-        Some(_) => &MATERIAL_COLUMNS,
-        None => quantity.columns(),
     };
     let mut lines = input.lines().enumerate();
     let header = loop {
@@ -564,6 +635,24 @@ pub fn run(
         }
     };
     let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    // With a material, a `lambda` column and no `channel` asks for the spectral model.
+    let spectral_rows = params.is_some()
+        && names.iter().any(|n| n == "lambda")
+        && !names.iter().any(|n| n == "channel");
+    let columns: &'static [&'static str] = match params {
+        Some(_) if spectral_rows => &SPECTRAL_COLUMNS,
+        Some(_) => &MATERIAL_COLUMNS,
+        None => quantity.columns(),
+    };
+    match &params {
+        Some((desc, _)) if spectral_rows && desc.spectral.is_none() => {
+            return Err(QueryError::NoSpectrum);
+        }
+        Some((desc, _)) if !spectral_rows && desc.rgb_mode == RgbMode::Integrated => {
+            return Err(QueryError::IntegratedUnsupported);
+        }
+        _ => {}
+    }
     let positions = columns
         .iter()
         .map(|&column| {
@@ -590,11 +679,19 @@ pub fn run(
         Some(_) => Some(views.set().map_err(|_| QueryError::MissingTables)?),
         None => None,
     };
-    let material = match (&options.material, params, &set) {
-        (Some(desc), Some(params), Some(set)) => Some(MaterialModel {
-            model: Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options),
-            params,
-            options: desc.options,
+    let material = match (params, &set) {
+        (Some((desc, params)), Some(set)) => Some(match desc.spectral {
+            Some(spectral) if spectral_rows => MaterialModel::Spectral {
+                model: Box::new(Spectral::boxed(&set.brdf_tables(), &spectral, desc.options)),
+                spectral,
+                params: params[0],
+                options: desc.options,
+            },
+            _ => MaterialModel::Channels {
+                model: Box::new(Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options)),
+                params,
+                options: desc.options,
+            },
         }),
         _ => None,
     };

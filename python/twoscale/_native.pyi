@@ -7,7 +7,7 @@ conversion.
 """
 
 import os
-from typing import final
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +17,7 @@ __all__ = [
     "RGB_WAVELENGTHS",
     "OPTIONS",
     "BASES",
+    "RGB_MODES",
     "g1",
     "sigma_ratio",
     "conv",
@@ -33,6 +34,7 @@ __all__ = [
 RGB_WAVELENGTHS: list[float]
 OPTIONS: dict[str, tuple[str, ...]]
 BASES: tuple[str, ...]
+RGB_MODES: tuple[str, ...]
 
 @final
 class Material:
@@ -41,7 +43,7 @@ class Material:
         *,
         beta: float,
         p: float,
-        eta: list[tuple[float, float]],
+        eta: list[tuple[float, float]] | tuple[ArrayLike, ArrayLike, ArrayLike],
         sigma_s: float | None = None,
         b: float | None = None,
         c: float | None = None,
@@ -52,6 +54,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod
     def preset(
@@ -61,6 +64,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod
     def presets() -> list[str]: ...
@@ -73,11 +77,21 @@ class Material:
         self, wi: ArrayLike, wo: ArrayLike, lam: ArrayLike
     ) -> NDArray[np.float32]: ...
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float32]: ...
+    def pdf_spectral(
+        self, wi: ArrayLike, wo: ArrayLike, lam: ArrayLike
+    ) -> NDArray[np.float32]: ...
+    def sample_spectral(
+        self, wi: ArrayLike, u: ArrayLike, lam: ArrayLike
+    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]: ...
     def sample(
         self, wi: ArrayLike, u: ArrayLike
     ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...
     def eval_reference(self, wi: ArrayLike, wo: ArrayLike) -> NDArray[np.float64]: ...
     def bakes(self) -> list[dict[str, float | NDArray[np.float32] | NDArray[np.float64]]]: ...
+    def spectral_bakes(self) -> dict[str, Any]: ...
+    def with_layer(
+        self, *, albedo: float | None = None, lambertian: float | None = None
+    ) -> Material: ...
     @property
     def beta(self) -> float: ...
     @property
@@ -98,6 +112,8 @@ class Material:
     def lambertian(self) -> float: ...
     @property
     def options(self) -> dict[str, str]: ...
+    @property
+    def rgb_mode(self) -> str: ...
 
 def g1(
     p: NDArray[np.float64], a: NDArray[np.float64], *, reference: bool, clamp: bool = False
