@@ -19,8 +19,8 @@ use std::sync::Mutex;
 use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_sampler, random_direction};
 use twoscale::Complex;
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, Options, SigmaRelMode, Surface,
-    TwoScale,
+    BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, MultipleScattering, Options,
+    SigmaRelMode, Surface, TwoScale,
 };
 use twoscale::hp15::{Energy, Hp15, Hp15Params};
 
@@ -643,6 +643,7 @@ fn never_nan_over_dense_sweep() {
             sigma_rel: SigmaRelMode::Symmetrised,
             colour: ColourTerms::White,
             halo_weight: HaloWeight::Incident,
+            multiple_scattering: MultipleScattering::KullaConty,
         },
     ];
     let mut count = 0usize;

@@ -26,7 +26,7 @@ use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 use twoscale::brdf::{
     BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
-    Options, SigmaRelMode, Surface,
+    MultipleScattering, Options, SigmaRelMode, Surface,
 };
 use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
@@ -205,12 +205,14 @@ fn options(
     sigma_rel: Option<&str>,
     colour: Option<&str>,
     halo_weight: Option<&str>,
+    multiple_scattering: Option<&str>,
 ) -> PyResult<Options> {
     Ok(Options {
         masking: named(masking)?,
         sigma_rel: named(sigma_rel)?,
         colour: named(colour)?,
         halo_weight: named(halo_weight)?,
+        multiple_scattering: named(multiple_scattering)?,
     })
 }
 
@@ -243,7 +245,7 @@ type SampleArrays<'py> = (
 
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-/// halo_weight=None): the RGB two-scale model of one material, built once
+/// halo_weight=None, multiple_scattering=None): the RGB two-scale model of one material, built once
 /// (the runtime bakes its per-material tables) and evaluated over arrays of
 /// directions.
 ///
@@ -299,7 +301,7 @@ impl Material {
     #[new]
     #[pyo3(signature = (*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
         albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-        halo_weight=None))]
+        halo_weight=None, multiple_scattering=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         beta: f32,
@@ -315,6 +317,7 @@ impl Material {
         sigma_rel: Option<&str>,
         colour: Option<&str>,
         halo_weight: Option<&str>,
+        multiple_scattering: Option<&str>,
     ) -> PyResult<Self> {
         // The keywords are a material description's keys (`twoscale::desc`):
         // one reading, with its defaults and messages, for Python and TOML.
@@ -332,6 +335,7 @@ impl Material {
             sigma_rel,
             colour,
             halo_weight,
+            multiple_scattering,
         };
         let desc = keywords
             .material()
@@ -361,21 +365,23 @@ impl Material {
     }
 
     /// preset(name, *, masking=None, sigma_rel=None, colour=None,
-    /// halo_weight=None): the shipped preset `name` (`Material.presets()`
+    /// halo_weight=None, multiple_scattering=None): the shipped preset `name` (`Material.presets()`
     /// lists them) with the given options (names as in `OPTIONS`; None: the
     /// runtime's default).
     #[staticmethod]
-    #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None))]
+    #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None,
+        multiple_scattering=None))]
     fn preset(
         name: &str,
         masking: Option<&str>,
         sigma_rel: Option<&str>,
         colour: Option<&str>,
         halo_weight: Option<&str>,
+        multiple_scattering: Option<&str>,
     ) -> PyResult<Self> {
         let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
-        let options = options(masking, sigma_rel, colour, halo_weight)?;
+        let options = options(masking, sigma_rel, colour, halo_weight, multiple_scattering)?;
         Ok(Material::with_spectrum(
             spectral.paper_rgb(),
             options,
@@ -625,7 +631,7 @@ impl Material {
         self.material.layer.lambertian
     }
     /// The options as a dict of keyword names ("colour", "halo_weight",
-    /// "masking", "sigma_rel") to their values.
+    /// "masking", "multiple_scattering", "sigma_rel") to their values.
     #[getter]
     fn options(&self) -> BTreeMap<&'static str, &'static str> {
         let o = self.options;
@@ -634,6 +640,7 @@ impl Material {
             (SigmaRelMode::OPTION, o.sigma_rel.name()),
             (ColourTerms::OPTION, o.colour.name()),
             (HaloWeight::OPTION, o.halo_weight.name()),
+            (MultipleScattering::OPTION, o.multiple_scattering.name()),
         ])
     }
 
@@ -972,6 +979,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         (SigmaRelMode::OPTION, names::<SigmaRelMode>()),
         (ColourTerms::OPTION, names::<ColourTerms>()),
         (HaloWeight::OPTION, names::<HaloWeight>()),
+        (MultipleScattering::OPTION, names::<MultipleScattering>()),
     ]);
     let options = options
         .into_iter()

@@ -13,6 +13,17 @@
 //!           u = (b/λ) cos θd                                              (HP17 32-33, 40)
 //! ```
 //!
+//! With [`MultipleScattering::KullaConty`] a fourth term puts back the
+//! light that single scattering loses (docs/model.md §2.11):
+//!
+//! ```text
+//! ρ_ms    = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))
+//! F_ms    = F_avg² E_avg / (1 − F_avg (1 − E_avg)),   F_avg = 2 ∫ F(η, μ) μ dμ
+//! ```
+//!
+//! with E the directional albedo of the specular lobe for F = 1 (T6,
+//! [`AlbedoTable`]).
+//!
 //! `σrel = σrel(θi)` comes from T2 ([`SigmaRatioTable`]), D and G from the EPD
 //! distribution ([`Epd`], T1), `C` from any [`Convolution`] (the T3 tables, or
 //! an adapter), F and Q̄ from [`crate::fresnel`]. The constant of ρ_CTD makes
@@ -54,7 +65,7 @@ use crate::bake::{
 };
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::Epd;
-use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
+use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants, fresnel_average};
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
@@ -208,6 +219,21 @@ pub enum HaloWeight {
     Incident,
 }
 
+/// Whether the light that bounces more than once between microfacets is
+/// put back (docs/model.md §2.11).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MultipleScattering {
+    /// Single scattering only, as both papers (the default): rough and
+    /// heavy-tailed surfaces lose up to half of the light.
+    #[default]
+    None,
+    /// A Kulla–Conty energy-compensation lobe (a fourth, diffuse-like lobe,
+    /// [`Lobe::Multiple`]):
+    /// `ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))`, E from T6,
+    /// `F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))`.
+    KullaConty,
+}
+
 /// Model options; `Options::default()` is the paper's model.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Options {
@@ -219,6 +245,8 @@ pub struct Options {
     pub colour: ColourTerms,
     /// Which `A` weighs the halo.
     pub halo_weight: HaloWeight,
+    /// Energy compensation for multiple scattering.
+    pub multiple_scattering: MultipleScattering,
 }
 
 /// The tables the model reads. `convolution` is the source of C: the T3b
@@ -248,9 +276,12 @@ pub enum Lobe {
     Diffraction,
     /// `ρ_base + k_d/π`, cosine-weighted.
     Base,
+    /// `ρ_ms`, the energy compensation of [`MultipleScattering::KullaConty`],
+    /// cosine-weighted.
+    Multiple,
 }
 
-/// The three terms of ρ at one pair of directions (sr⁻¹).
+/// The terms of ρ at one pair of directions (sr⁻¹).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Lobes {
     /// `A_spec(θd) · ρ_CT`.
@@ -259,13 +290,18 @@ pub struct Lobes {
     pub diffraction: f32,
     /// `ρ_base + k_d/π`.
     pub base: f32,
+    /// `ρ_ms` (0 unless [`MultipleScattering::KullaConty`]).
+    pub multiple: f32,
 }
 
 impl Lobes {
-    /// `ρ`, the sum of the three terms.
+    /// `ρ`, the sum of the four terms.
     pub fn total(&self) -> f32 {
         finite_or_zero(
-            f64::from(self.specular) + f64::from(self.diffraction) + f64::from(self.base),
+            f64::from(self.specular)
+                + f64::from(self.diffraction)
+                + f64::from(self.base)
+                + f64::from(self.multiple),
         )
     }
 }
@@ -400,6 +436,10 @@ pub struct TwoScale<'a, B = ChannelBake> {
     /// `Re η` (the varnish index of the base layers).
     eta_re: f64,
     lambertian: f64,
+    /// `F_ms / (π (1 − E_avg))` of the compensation lobe (0 when off).
+    multiple_scale: f64,
+    /// `F_ms`, the compensation lobe's albedo over `1 − E(μi)` (0 when off).
+    multiple_colour: f64,
     options: Options,
     /// The per-material tables.
     bake: B,
@@ -591,6 +631,8 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             f_dr_int,
             eta_re: f64::from(eta.re),
             lambertian: unit(layer.lambertian),
+            multiple_scale: 0.0,
+            multiple_colour: 0.0,
             options,
             bake,
         }
@@ -620,6 +662,21 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
             None => false,
         };
+        (self.multiple_colour, self.multiple_scale) = match self.options.multiple_scattering {
+            MultipleScattering::None => (0.0, 0.0),
+            MultipleScattering::KullaConty => {
+                let column = tables
+                    .albedo
+                    .column(surface.beta, surface.p, self.options.masking);
+                let e_avg = bake.direction.set_albedo(|cos| column.albedo(cos));
+                let f_avg = if self.options.colour == ColourTerms::White {
+                    1.0
+                } else {
+                    fresnel_average(eta)
+                };
+                compensation(e_avg, f_avg)
+            }
+        };
         let weights = self
             .bake()
             .direction
@@ -647,7 +704,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     pub(crate) fn has_lobes(&self) -> (bool, bool) {
         let diffraction = self.surface.sigma_s > 0.0 && self.surface.b > 0.0;
         let base = self.base != BaseLayer::Conductor && !self.white();
-        (diffraction, base || self.lambertian > 0.0)
+        (
+            diffraction,
+            base || self.lambertian > 0.0 || self.multiple_scale > 0.0,
+        )
     }
 
     /// Hands the model's constants and bakes to `v` (names in the
@@ -821,7 +881,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         self.eval_lobes(i, o).total()
     }
 
-    /// The three terms of ρ(i, o) separately.
+    /// The four terms of ρ(i, o) separately.
     pub fn eval_lobes(&self, i: [f32; 3], o: [f32; 3]) -> Lobes {
         match self.pair(i, o) {
             Some(pair) => self.lobes(&pair),
@@ -901,10 +961,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             0.0
         };
 
+        // ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
+        let multiple = self.multiple_scale * at_i.lost() * at_o.lost();
+
         Lobes {
             specular: finite_or_zero(specular),
             diffraction: finite_or_zero(diffraction),
             base: finite_or_zero(self.base_value(&at_i, &at_o, cos_i, cos_o)),
+            multiple: finite_or_zero(multiple),
         }
     }
 
@@ -947,15 +1011,16 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         base + lambertian
     }
 
-    /// The lobe-selection probabilities `[specular, diffraction, base]` for
-    /// incidence `i` (sum 1; all 0 for `i` below the horizon):
+    /// The lobe-selection probabilities `[specular, diffraction, base,
+    /// multiple]` for incidence `i` (sum 1; all 0 for `i` below the horizon):
     ///
     /// ```text
     /// A_imp = exp(−(2π σs cos θi / λ)²)                              (HP17 48)
     /// E_s   = F(η, cos θi)         (1 with white colour terms)
     /// E_b   = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
     ///         (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
-    /// w     ∝ [A_imp E_s, (1 − A_imp) E_s, E_b]
+    /// E_ms  = F_ms (1 − E(μi)), the compensation lobe's albedo (0 when off)
+    /// w     ∝ [A_imp E_s, (1 − A_imp) E_s, E_b, E_ms]
     /// ```
     ///
     /// The surface lobes share F(θi) as the estimate of their energy and split
@@ -964,22 +1029,21 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// tabulated with the material (linear in `√cos θi` between 257 nodes):
     /// `sample` and `pdf` read the same table, so the weights add no error to
     /// the pdf.
-    pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
+    pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 4] {
         let Some(wi) = upper_unit(i) else {
-            return [0.0; 3];
+            return [0.0; 4];
         };
-        let w = self.weights(wi[2]);
-        [w[0] as f32, w[1] as f32, w[2] as f32]
+        self.weights(wi[2]).map(|w| w as f32)
     }
 
     /// The lobe weights at `cos θi`, from the direction bake's table of
     /// [`TwoScale::weights_at`].
-    fn weights(&self, cos_i: f64) -> [f64; 3] {
+    fn weights(&self, cos_i: f64) -> [f64; 4] {
         self.bake().direction.lobe_weights(cos_i as f32)
     }
 
     /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`.
-    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64) -> [f64; 3] {
+    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64) -> [f64; 4] {
         let t = 2.0 * PI * f64::from(self.surface.sigma_s) * cos_i / self.lambda;
         let a_imp = math::exp(-t * t);
         let e_s = self.fresnel_of(at_i);
@@ -995,12 +1059,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 BaseLayer::Subsurface { albedo } => into * f64::from(albedo),
             };
         }
-        let w = [a_imp * e_s, (1.0 - a_imp) * e_s, e_b];
-        let total = w[0] + w[1] + w[2];
+        // ∫ ρ_ms cos θo dωo = F_ms (1 − E(μi)): π (1 − E_avg) cancels.
+        let e_ms = self.multiple_colour * at_i.lost();
+        let w = [a_imp * e_s, (1.0 - a_imp) * e_s, e_b, e_ms];
+        let total = w[0] + w[1] + w[2] + w[3];
         if total > 0.0 && total.is_finite() {
             w.map(|x| x / total)
         } else {
-            [a_imp, 1.0 - a_imp, 0.0]
+            [a_imp, 1.0 - a_imp, 0.0, 0.0]
         }
     }
 
@@ -1034,10 +1100,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         if w[0] > 0.0 {
             total += w[0] * specular;
         }
-        for (k, lobe) in [(1, Lobe::Diffraction), (2, Lobe::Base)] {
-            if w[k] > 0.0 {
-                total += w[k] * self.lobe_pdf(lobe, geometry);
-            }
+        if w[1] > 0.0 {
+            total += w[1] * self.lobe_pdf(Lobe::Diffraction, geometry);
+        }
+        // The base and the compensation lobe share the cosine-weighted density.
+        let diffuse = w[2] + w[3];
+        if diffuse > 0.0 {
+            total += diffuse * self.lobe_pdf(Lobe::Base, geometry);
         }
         total
     }
@@ -1051,7 +1120,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
     ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`;
-    /// * base: `cos θo / π`.
+    /// * base and multiple: `cos θo / π`.
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
     pub fn pdf_lobe(&self, lobe: Lobe, i: [f32; 3], o: [f32; 3]) -> f32 {
@@ -1067,7 +1136,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         match lobe {
             Lobe::Specular => self.specular_pdf(geometry),
             Lobe::Diffraction => self.diffraction_pdf(wi, wo),
-            Lobe::Base => wo[2] / PI,
+            Lobe::Base | Lobe::Multiple => wo[2] / PI,
         }
     }
 
@@ -1129,7 +1198,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///   with `o_p = −i_p + λ f`; the arc that keeps `o_p` in the disc is
     ///   centred on `+i_p` as written here (at ψ = 0, `o_p` moves from the
     ///   mirror direction towards `i`'s side);
-    /// * base: cosine-weighted hemisphere.
+    /// * base and multiple: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
@@ -1165,7 +1234,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 }
                 [ox, oy, math::sqrt(z2)]
             }
-            Lobe::Base => {
+            Lobe::Base | Lobe::Multiple => {
                 let r = math::sqrt(u[0]);
                 let phi = 2.0 * PI * u[1];
                 [
@@ -1212,10 +1281,38 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 }
 
+/// `(F_ms, F_ms / (π (1 − E_avg)))` of the compensation lobe
+/// (docs/model.md §2.11) for the albedo average `E_avg` and the Fresnel
+/// average `F_avg`:
+///
+/// ```text
+/// F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))
+/// ```
+///
+/// (the light that leaves after k ≥ 2 bounces, `Σ F_avg^k E_avg (1 − E_avg)^(k−1)`,
+/// over its value at `F_avg = 1`, `1 − E_avg`). `(0, 0)` when
+/// `1 − E_avg ≤ 1e-6` (nothing to put back).
+fn compensation(e_avg: f64, f_avg: f64) -> (f64, f64) {
+    let lost = 1.0 - e_avg;
+    if !(lost > 1e-6) {
+        return (0.0, 0.0);
+    }
+    let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * lost);
+    if !f_ms.is_finite() {
+        return (0.0, 0.0);
+    }
+    (f_ms, f_ms / (PI * lost))
+}
+
 /// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
 /// past the last interval falls on the last lobe of positive weight.
-fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
-    const LOBES: [Lobe; 3] = [Lobe::Specular, Lobe::Diffraction, Lobe::Base];
+fn pick_lobe(pick: f64, w: [f64; 4]) -> Lobe {
+    const LOBES: [Lobe; 4] = [
+        Lobe::Specular,
+        Lobe::Diffraction,
+        Lobe::Base,
+        Lobe::Multiple,
+    ];
     let mut cumulative = 0.0;
     let mut last = Lobe::Specular;
     for (k, lobe) in LOBES.into_iter().enumerate() {
