@@ -519,6 +519,20 @@ struct Pair {
     across: f64,
 }
 
+/// What [`TwoScale::surface_terms`] computes at a pair.
+#[derive(Clone, Copy)]
+struct SurfaceTerms {
+    /// `A_spec(θd)`.
+    a_spec: f64,
+    /// `ρ_CT`.
+    rho_ct: f64,
+    /// `ρ_CTD`.
+    diffraction: f64,
+    /// The direction bake at `cos θi` and `cos θo`.
+    at_i: DirectionValues,
+    at_o: DirectionValues,
+}
+
 impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
@@ -668,7 +682,25 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
                 let column = tables
                     .albedo
                     .column(surface.beta, surface.p, self.options.masking);
-                let e_avg = bake.direction.set_albedo(|cos| column.albedo(cos));
+                // The halo's share of the white albedo (0 without diffraction).
+                let mut deficit = [0.0f64; DEFICIT_NODES];
+                if sigma_s > 0.0 && big_b > 0.0 {
+                    for (j, value) in deficit.iter_mut().enumerate() {
+                        let x = j as f64 / (DEFICIT_NODES - 1) as f64;
+                        *value = self.halo_deficit((x * x).max(DEFICIT_MIN_COS));
+                    }
+                }
+                let deficit_at = |cos: f64| {
+                    let t = math::sqrt(cos.max(0.0).min(1.0)) * (DEFICIT_NODES - 1) as f64;
+                    let k = (t as usize).min(DEFICIT_NODES - 2);
+                    let f = t - k as f64;
+                    deficit[k] + f * (deficit[k + 1] - deficit[k])
+                };
+                let e_avg = self
+                    .bake
+                    .borrow_mut()
+                    .direction
+                    .set_albedo(|cos| (f64::from(column.albedo(cos)) + deficit_at(cos)) as f32);
                 let f_avg = if self.options.colour == ColourTerms::White {
                     1.0
                 } else {
@@ -682,6 +714,69 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             .direction
             .lobe_weight_nodes(|at, cos| self.weights_at(at, cos));
         self.bake.borrow_mut().direction.set_lobe_weights(&weights);
+    }
+
+    /// The halo's change to the surface's white albedo at `cos θi`
+    /// (docs/model.md §2.11):
+    ///
+    /// ```text
+    /// Δ(μ) = ∫ [(A_spec(θd) − 1) ρ_CT + ρ_CTD]_{F = Q̄ = 1} cos θo dωo
+    /// ```
+    ///
+    /// so that `E(μ) + Δ(μ)` is the white albedo of the specular peak and
+    /// the halo together (E of T6). In polar coordinates `(α, φ)` around the
+    /// mirror direction, `α = e^t` from `10⁻³ w` to π (`w` the narrower of
+    /// the NDF's width β and the halo's `λ/2b`) by 4-point Gauss–Legendre on
+    /// [`DEFICIT_PANELS`] panels of t, φ by the trapezoid rule on
+    /// [`DEFICIT_AZIMUTHS`] points; both terms come from the same nodes.
+    fn halo_deficit(&self, cos_i: f64) -> f64 {
+        const GAUSS_4: [(f64, f64); 2] = [
+            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+        ];
+        let sin_i = math::sqrt((1.0 - cos_i * cos_i).max(0.0));
+        let i = [sin_i as f32, 0.0, cos_i as f32];
+        // The mirror direction r and two unit vectors orthogonal to it.
+        let r = [-sin_i, 0.0, cos_i];
+        let e1 = [cos_i, 0.0, sin_i];
+        let e2 = [0.0, 1.0, 0.0];
+        let halo_width = 0.5 * self.lambda / f64::from(self.surface.b).max(1e-6);
+        let width = f64::from(self.surface.beta)
+            .min(halo_width)
+            .max(1e-4)
+            .min(1.0);
+        let (t0, t1) = (math::ln(1e-3 * width), math::ln(PI));
+        let h = (t1 - t0) / DEFICIT_PANELS as f64;
+        let mut total = 0.0;
+        for k in 0..DEFICIT_PANELS {
+            let mid = t0 + (k as f64 + 0.5) * h;
+            for (x, weight) in GAUSS_4 {
+                for t in [mid - 0.5 * h * x, mid + 0.5 * h * x] {
+                    let alpha = math::exp(t);
+                    let (sa, ca) = (math::sin(alpha), math::cos(alpha));
+                    let mut ring = 0.0;
+                    for m in 0..DEFICIT_AZIMUTHS {
+                        let phi = 2.0 * PI * m as f64 / DEFICIT_AZIMUTHS as f64;
+                        let (sp, cp) = (math::sin(phi), math::cos(phi));
+                        let o = [0, 1, 2].map(|c| ca * r[c] + sa * (cp * e1[c] + sp * e2[c]));
+                        if !(o[2] > 0.0) {
+                            continue;
+                        }
+                        let Some(pair) = self.pair(i, to_f32(o)) else {
+                            continue;
+                        };
+                        let terms = self.surface_terms(&pair, true);
+                        let value = (terms.a_spec - 1.0) * terms.rho_ct + terms.diffraction;
+                        if value.is_finite() {
+                            ring += value * o[2];
+                        }
+                    }
+                    total +=
+                        0.5 * h * weight * ring * (2.0 * PI / DEFICIT_AZIMUTHS as f64) * sa * alpha;
+                }
+            }
+        }
+        total
     }
 
     /// The storage of the bakes, to rebuild another model in
@@ -891,6 +986,22 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// The terms of ρ at a pair (HP17 24-33).
     fn lobes(&self, pair: &Pair) -> Lobes {
+        let t = self.surface_terms(pair, self.white());
+        let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
+        // ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
+        let multiple = self.multiple_scale * t.at_i.lost() * t.at_o.lost();
+        Lobes {
+            specular: finite_or_zero(t.a_spec * t.rho_ct),
+            diffraction: finite_or_zero(t.diffraction),
+            base: finite_or_zero(self.base_value(&t.at_i, &t.at_o, cos_i, cos_o)),
+            multiple: finite_or_zero(multiple),
+        }
+    }
+
+    /// The surface lobes' factors at a pair (HP17 24-33), with white colour
+    /// terms (F = Q̄ = 1) when `white`.
+    #[inline(always)]
+    fn surface_terms(&self, pair: &Pair, white: bool) -> SurfaceTerms {
         let Pair {
             geometry:
                 Geometry {
@@ -925,12 +1036,16 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
         // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
         // D last: the other factors do not wait for its exponentials.
-        let rho_ct = self.fresnel_at(cells[2]) * g / (4.0 * cos_i * cos_o) * d;
-        let specular = a_spec * rho_ct;
+        let f = if white {
+            1.0
+        } else {
+            f64::from(self.bake().direction.fresnel_at(cells[2]))
+        };
+        let rho_ct = f * g / (4.0 * cos_i * cos_o) * d;
 
         // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
         let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && g > 0.0 {
-            let q = if self.white() {
+            let q = if white {
                 1.0
             } else {
                 match &self.q {
@@ -961,14 +1076,12 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             0.0
         };
 
-        // ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
-        let multiple = self.multiple_scale * at_i.lost() * at_o.lost();
-
-        Lobes {
-            specular: finite_or_zero(specular),
-            diffraction: finite_or_zero(diffraction),
-            base: finite_or_zero(self.base_value(&at_i, &at_o, cos_i, cos_o)),
-            multiple: finite_or_zero(multiple),
+        SurfaceTerms {
+            a_spec,
+            rho_ct,
+            diffraction,
+            at_i,
+            at_o,
         }
     }
 
@@ -1280,6 +1393,15 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some((self.sample_lobe(lobe, i, [u[1], u[2]])?, lobe))
     }
 }
+
+/// Nodes of [`TwoScale::halo_deficit`] over `√cos θi` (linear between).
+const DEFICIT_NODES: usize = 17;
+/// The smallest `cos θi` at which the deficit is computed (the first node's).
+const DEFICIT_MIN_COS: f64 = 1e-4;
+/// Panels of [`TwoScale::halo_deficit`]'s rule in `ln α`.
+const DEFICIT_PANELS: usize = 24;
+/// Azimuths of [`TwoScale::halo_deficit`]'s rule.
+const DEFICIT_AZIMUTHS: usize = 48;
 
 /// `(F_ms, F_ms / (π (1 − E_avg)))` of the compensation lobe
 /// (docs/model.md §2.11) for the albedo average `E_avg` and the Fresnel
