@@ -262,6 +262,8 @@ pub enum QueryError {
     MaterialUnsupported(Quantity),
     /// The material of `--material` is one the reference does not cover.
     Uncovered(brdf::Uncovered),
+    /// The reference's compensation lobe of the `--material` could not be built.
+    Reference(brdf::BrdfError),
     /// The quantity's tables lack one the model reads (a bug of `run`).
     MissingTables,
     /// The input has no header line.
@@ -301,6 +303,7 @@ impl fmt::Display for QueryError {
                 q.name()
             ),
             QueryError::Uncovered(e) => write!(f, "--material: {e}"),
+            QueryError::Reference(e) => write!(f, "--material: the reference failed: {e}"),
             QueryError::MissingTables => write!(f, "the table files were not opened"),
             QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
             QueryError::Read(e) => write!(f, "reading input: {e}"),
@@ -495,6 +498,9 @@ struct MaterialModel<'a> {
     model: Rgb<'a, Box<ChannelBake>>,
     params: [brdf::Params; 3],
     options: twoscale::brdf::Options,
+    /// The reference's energy-compensation lobe per channel, when the
+    /// material's options ask for it.
+    compensation: Option<[brdf::Compensation; 3]>,
 }
 
 impl MaterialModel<'_> {
@@ -508,9 +514,14 @@ impl MaterialModel<'_> {
         let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
         let f = |v: f64| v as f32;
         let value = self.model.eval(i.map(f), o.map(f))[ch];
-        let reference = brdf::two_scale(&self.params[ch], i, o, &self.options)
-            .map_err(|e| RowError::Reference(e.to_string()))?;
-        Ok(vec![short32(value), short(reference.total())])
+        let failed = |e: brdf::BrdfError| RowError::Reference(e.to_string());
+        let mut reference = brdf::two_scale(&self.params[ch], i, o, &self.options)
+            .map_err(failed)?
+            .total();
+        if let Some(lobes) = &self.compensation {
+            reference += lobes[ch].value(i, o).map_err(failed)?;
+        }
+        Ok(vec![short32(value), short(reference)])
     }
 }
 
@@ -544,7 +555,9 @@ pub fn run(
         Some(_) if quantity != Quantity::Brdf => {
             return Err(QueryError::MaterialUnsupported(quantity));
         }
-        Some(desc) => Some(brdf::Params::rgb(&desc.material).map_err(QueryError::Uncovered)?),
+        Some(desc) => Some(
+            brdf::Params::rgb_with(&desc.material, &desc.options).map_err(QueryError::Uncovered)?,
+        ),
         None => None,
     };
     let columns: &'static [&'static str] = match params {
@@ -591,11 +604,16 @@ pub fn run(
         None => None,
     };
     let material = match (&options.material, params, &set) {
-        (Some(desc), Some(params), Some(set)) => Some(MaterialModel {
-            model: Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options),
-            params,
-            options: desc.options,
-        }),
+        (Some(desc), Some(params), Some(set)) => {
+            let compensation =
+                brdf::Compensation::rgb(&params, &desc.options).map_err(QueryError::Reference)?;
+            Some(MaterialModel {
+                model: Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options),
+                params,
+                options: desc.options,
+                compensation,
+            })
+        }
         _ => None,
     };
 

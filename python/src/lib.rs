@@ -535,19 +535,27 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let params =
-            ref_brdf::Params::rgb(&self.material).map_err(|e| value_error(e.to_string()))?;
+        let options = self.options;
+        let params = ref_brdf::Params::rgb_with(&self.material, &options)
+            .map_err(|e| value_error(e.to_string()))?;
+        let compensation = py
+            .detach(|| ref_brdf::Compensation::rgb(&params, &options))
+            .map_err(|e| value_error(e.to_string()))?;
         let v = vectors([("wi", wi), ("wo", wo)])?;
         let [wi, wo] = &v.rows;
-        let options = self.options;
         let values = py.detach(|| {
             (0..v.len() * 3)
                 .into_par_iter()
                 .map(|j| {
                     let (k, ch) = (j / 3, j % 3);
                     let f64s = |v: [f32; 3]| v.map(f64::from);
-                    ref_brdf::two_scale(&params[ch], f64s(wi[k]), f64s(wo[k]), &options)
-                        .map(|v| v.total())
+                    let (i, o) = (f64s(wi[k]), f64s(wo[k]));
+                    let multiple = match &compensation {
+                        Some(lobes) => lobes[ch].value(i, o),
+                        None => Ok(0.0),
+                    };
+                    ref_brdf::two_scale(&params[ch], i, o, &options)
+                        .and_then(|v| Ok(v.total() + multiple?))
                         .map_err(|e| format!("row {k}: {e}"))
                 })
                 .collect::<Result<Vec<f64>, String>>()

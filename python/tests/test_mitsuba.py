@@ -121,6 +121,20 @@ def test_white_furnace(name, theta):
     assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
 
 
+def test_white_furnace_with_energy_compensation():
+    """A β = 0.8 conductor (σs = 0, reciprocal, so the render's integral over
+    the light's directions is the albedo) renders at 1 ± 0.005 with
+    ``multiple_scattering="kulla-conty"``; without, it is dark."""
+    kw = dict(beta=0.8, p=1.0, eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)], colour="white")
+    for options, lo, hi in [({}, 0.0, 0.95), ({"multiple_scattering": "kulla-conty"}, 0.995, 1.005)]:
+        material = twoscale.Material(**kw, **options)
+        pixels = furnace_render(tm.bsdf_dict(material), 45, seed=0)
+        mean = pixels.mean(axis=0)
+        standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
+        print(f"furnace β = 0.8 {options} θo=45: render {mean} ± {standard_error}")
+        assert np.all((mean > lo - 4 * standard_error) & (mean < hi + 4 * standard_error))
+
+
 def test_context_without_glossy_component_gives_zero():
     bsdf = mi.load_dict({"type": "twoscale", "material": "gold-rough"})
     si = make_si([[0.0, 0.0, 1.0]])

@@ -52,6 +52,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        multiple_scattering: str | None = None,
     ) -> Material: ...
     @staticmethod
     def preset(
@@ -61,6 +62,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        multiple_scattering: str | None = None,
     ) -> Material: ...
     @staticmethod
     def presets() -> list[str]: ...

@@ -554,6 +554,9 @@ class Model:
     channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
 
     def __init__(self, material: twoscale.Material):
+        if material.options.get("multiple_scattering", "none") != "none":
+            raise ValueError("twoscale.drjit_bsdf does not port multiple_scattering='kulla-conty' "
+                             "(the NumPy plugin twoscale.mitsuba does)")
         self.material = material
         self.channels = [_Channel(b) for b in material.bakes()]
         first = self.channels[0].s
