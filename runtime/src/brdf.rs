@@ -754,9 +754,12 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
                 for t in [mid - 0.5 * h * x, mid + 0.5 * h * x] {
                     let alpha = math::exp(t);
                     let (sa, ca) = (math::sin(alpha), math::cos(alpha));
+                    // The integrand is even in φ (i lies in the xz-plane): the
+                    // trapezoid rule over [0, π], ends halved, doubled.
+                    let half = DEFICIT_AZIMUTHS / 2;
                     let mut ring = 0.0;
-                    for m in 0..DEFICIT_AZIMUTHS {
-                        let phi = 2.0 * PI * m as f64 / DEFICIT_AZIMUTHS as f64;
+                    for m in 0..=half {
+                        let phi = PI * m as f64 / half as f64;
                         let (sp, cp) = (math::sin(phi), math::cos(phi));
                         let o = [0, 1, 2].map(|c| ca * r[c] + sa * (cp * e1[c] + sp * e2[c]));
                         if !(o[2] > 0.0) {
@@ -768,11 +771,11 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
                         let terms = self.surface_terms(&pair, true);
                         let value = (terms.a_spec - 1.0) * terms.rho_ct + terms.diffraction;
                         if value.is_finite() {
-                            ring += value * o[2];
+                            let end = if m == 0 || m == half { 0.5 } else { 1.0 };
+                            ring += end * value * o[2];
                         }
                     }
-                    total +=
-                        0.5 * h * weight * ring * (2.0 * PI / DEFICIT_AZIMUTHS as f64) * sa * alpha;
+                    total += 0.5 * h * weight * ring * (2.0 * PI / half as f64) * sa * alpha;
                 }
             }
         }
@@ -1399,9 +1402,9 @@ const DEFICIT_NODES: usize = 17;
 /// The smallest `cos θi` at which the deficit is computed (the first node's).
 const DEFICIT_MIN_COS: f64 = 1e-4;
 /// Panels of [`TwoScale::halo_deficit`]'s rule in `ln α`.
-const DEFICIT_PANELS: usize = 24;
+const DEFICIT_PANELS: usize = 16;
 /// Azimuths of [`TwoScale::halo_deficit`]'s rule.
-const DEFICIT_AZIMUTHS: usize = 48;
+const DEFICIT_AZIMUTHS: usize = 32;
 
 /// `(F_ms, F_ms / (π (1 − E_avg)))` of the compensation lobe
 /// (docs/model.md §2.11) for the albedo average `E_avg` and the Fresnel
