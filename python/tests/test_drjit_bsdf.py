@@ -101,6 +101,8 @@ MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
     ("gold-hp17-geometry", {"sigma_rel": "symmetrised"}),
     ("gold-hp17-geometry", {"halo_weight": "incident"}),
     ("white-plastic", {"colour": "white"}),
+    ("gold-rough", {"multiple_scattering": "kulla-conty"}),
+    ("white-plastic", {"multiple_scattering": "kulla-conty"}),
 ]
 
 
@@ -228,6 +230,7 @@ def xml(**props):
         ("white-plastic", dict(material="white-plastic"), 30.0),
         ("strong halo", dict(beta=0.1, p=1.0, sigma_s=0.1, b=3.0, c=1.6, eta=GOLD), 45.0),
         ("grazing", dict(material="gold-rough"), 85.0),
+        ("compensated", dict(material="gold-rough", multiple_scattering="kulla-conty"), 60.0),
     ],
 )
 def test_chi2(label, props, theta):

@@ -189,14 +189,14 @@ class _Channel:
 
     # -- the sampler's densities ---------------------------------------
     def lobe_weights(self, cos_i):
-        """`DirectionBake::lobe_weights`: `[specular, diffraction, base]`, sum 1 (f64)."""
+        """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
+        sum 1 (f64)."""
         i, frac = self.direction_cell(mi.Float(cos_i))
         w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
-             for k in range(3)]
-        total = w[0] + w[1] + w[2]
+             for k in range(4)]
+        total = w[0] + w[1] + w[2] + w[3]
         ok = total > 0.0
-        return [dr.select(ok, w[0] / total, 1.0), dr.select(ok, w[1] / total, 0.0),
-                dr.select(ok, w[2] / total, 0.0)]
+        return [dr.select(ok, w[0] / total, 1.0)] + [dr.select(ok, x / total, 0.0) for x in w[1:]]
 
     def diffraction_pdf(self, wi, wo):
         """`TwoScale::diffraction_pdf` (HP17 51-55), f64."""
@@ -498,14 +498,14 @@ class _Channel:
         return single + t * d["base_multi"] + lambertian
 
     def lobes(self, g, geo):
-        """`TwoScale::lobes`: (specular, diffraction, base) at a pair."""
+        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair."""
         s = self.s
         wi, wo = geo["wi"], geo["wo"]
         cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
         cell_i = self.direction_cell(mi.Float(cos_i))
         cell_o = self.direction_cell(mi.Float(cos_o))
-        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(7))]
-        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(7))]
+        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(8))]
+        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(8))]
         # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
         x = self.d["x_scale"] * cos_d * cos_d
         if s["sigma_s"] > 0.0:
@@ -546,7 +546,10 @@ class _Channel:
         else:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o)
-        return _finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base)
+        # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
+        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
+                _finite_or_zero(multiple))
 
 
 class Model:
@@ -554,9 +557,6 @@ class Model:
     channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
 
     def __init__(self, material: twoscale.Material):
-        if material.options.get("multiple_scattering", "none") != "none":
-            raise ValueError("twoscale.drjit_bsdf does not port multiple_scattering='kulla-conty' "
-                             "(the NumPy plugin twoscale.mitsuba does)")
         self.material = material
         self.channels = [_Channel(b) for b in material.bakes()]
         first = self.channels[0].s
@@ -614,9 +614,10 @@ class Model:
             g = g1_i * g1_o
         values = []
         for channel in self.channels:
-            spec, diff, base = channel.lobes(g, geo)
+            spec, diff, base, multiple = channel.lobes(g, geo)
             values.append(mi.Float(_finite_or_zero(
-                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base)))))
+                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base))
+                + mi.Float64(mi.Float(multiple)))))
         return dr.select(valid, mi.Color3f(*values), 0.0)
 
     def pdf(self, wi, wo):
@@ -632,7 +633,8 @@ class Model:
             value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
             if channel.diffraction:
                 value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
-            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            # The base and the compensation lobe share the cosine-weighted density.
+            value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
             total += mi.Float64(_finite_or_zero(mi.Float(value)))
         return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)
 
@@ -655,10 +657,10 @@ class Model:
         # The picked channel's lobe weights.
         weights = [ch.lobe_weights(wi.z) for ch in self.channels]
         w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
-             for n in range(3)]
+             for n in range(4)]
         # `pick_lobe`.
         cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
-        for n in range(3):
+        for n in range(4):
             positive = w[n] > 0.0
             cumulative += dr.select(positive, w[n], 0.0)
             last = dr.select(positive, n, last)
@@ -678,8 +680,8 @@ class Model:
         # Base: cosine-weighted.
         r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
         ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-        o = dr.select(lobe == 2, ob, o)
-        ok = dr.select(lobe == 2, True, ok)
+        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
+        ok = dr.select(lobe >= 2, True, ok)
         ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
         # `upper_unit(to_f32(o))`, back to f32.
         o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))

@@ -846,6 +846,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             ("f_dr_int", self.f_dr_int),
             ("eta_re", self.eta_re),
             ("lambertian", self.lambertian),
+            ("multiple_scale", self.multiple_scale),
             ("base", base),
             ("albedo", albedo),
             ("white", flag(self.white())),
