@@ -516,19 +516,12 @@ fn sampling_matches_pdf_with_the_lobe() {
             "χ² {name} θi = {deg}° {lobe:?} (weights {w:?}): p = {:.4}, ∫pdf = {:.6}, sampled {:.6}",
             check.chi.p_value, check.pdf_integral, check.success
         );
-        let se = (check.success * (1.0 - check.success) / n as f64).sqrt();
         assert!(
             check.chi.p_value >= alpha,
             "{name} {deg}°: p = {}",
             check.chi.p_value
         );
-        assert!(check.pdf_integral <= 1.0 + 1e-5);
-        assert!(
-            (check.pdf_integral - check.success).abs() <= 5.0 * se + 5e-5,
-            "{name} {deg}°: ∫pdf {} vs {}",
-            check.pdf_integral,
-            check.success
-        );
+        check.assert_pdf_is_the_success_rate(n, 5e-5, &format!("{name} {deg}°"));
     }
 }
 
