@@ -1,14 +1,18 @@
 """Render cost per sample of the ``twoscale`` BSDF against Mitsuba's
-``roughconductor`` (Beckmann), in ``llvm_ad_rgb`` and ``scalar_rgb``.
+``roughconductor`` (Beckmann), in ``llvm_ad_rgb`` and ``llvm_ad_spectral``.
 
-    python python/examples/benchmark_render.py [--size 64] [--spp 64]
+    python python/examples/benchmark_render.py [--size 64] [--spp 64] [--variant V] [--evaluated]
 
 Renders the sphere of the Beckmann-limit check (constant emitter and a
 directional light, path tracer of depth 2) with each BSDF, once to warm up
 (JIT compilation, plugin construction) and then ``--repeat`` times, and
 prints the process CPU time (user + system, all threads) per sample
 (pixels × spp) of the timed renders, and the ratio to ``roughconductor`` in
-the same variant, in the same run. Each variant runs in its own process.
+the same variant, in the same run. Each variant runs in its own process,
+in Mitsuba's default symbolic mode (loops and calls recorded once);
+``--evaluated`` switches symbolic loops and calls off in that process (the
+wavefront mode), for comparison. ``--variant scalar_rgb`` measures the
+scalar path.
 """
 
 import argparse
@@ -20,14 +24,22 @@ import time
 LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 
 
-def measure(variant, size, spp, repeat):
+def measure(variant, size, spp, repeat, evaluated):
+    import drjit as dr
     import mitsuba as mi
 
     mi.set_variant(variant)
+    if evaluated:
+        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
+        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
+    mode = "evaluated" if evaluated else "symbolic"
     import twoscale.mitsuba as tm
 
     tm.register()
     eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
+    if mi.is_spectral:
+        # an explicit material needs one index for every channel in spectral variants
+        eta, k = [0.584] * 3, [2.15] * 3
     bsdfs = {
         "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
         "twoscale Beckmann (p=1, σs=0)": {"type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
@@ -56,7 +68,7 @@ def measure(variant, size, spp, repeat):
         cost[name] = (time.process_time() - start) / (repeat * size * size * spp)
     base = cost["roughconductor beckmann"]
     for name, c in cost.items():
-        print(f"{variant:12s} {name:32s} {c * 1e9:10.1f} ns CPU/sample  ×{c / base:.1f}")
+        print(f"{variant:16s} {mode:9s} {name:32s} {c * 1e9:10.1f} ns CPU/sample  ×{c / base:.2f}")
 
 
 def main():
@@ -65,16 +77,18 @@ def main():
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--variant")
+    parser.add_argument("--evaluated", action="store_true")
     args = parser.parse_args()
     if args.variant:
-        measure(args.variant, args.size, args.spp, args.repeat)
+        measure(args.variant, args.size, args.spp, args.repeat, args.evaluated)
         return
     env = dict(os.environ)
     if os.path.exists(LLVM):
         env.setdefault("DRJIT_LIBLLVM_PATH", LLVM)
-    for variant in ("llvm_ad_rgb", "scalar_rgb"):
+    for variant in ("llvm_ad_rgb", "llvm_ad_spectral"):
         subprocess.run([sys.executable, __file__, "--variant", variant, "--size", str(args.size),
-                        "--spp", str(args.spp), "--repeat", str(args.repeat)], env=env, check=True)
+                        "--spp", str(args.spp), "--repeat", str(args.repeat)]
+                       + (["--evaluated"] if args.evaluated else []), env=env, check=True)
 
 
 if __name__ == "__main__":

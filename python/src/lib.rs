@@ -243,6 +243,9 @@ type SampleArrays<'py> = (
     Bound<'py, PyArrayDyn<f32>>,
 );
 
+/// `(wo, pdf)` of [`Material::sample_spectral`].
+type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArrayDyn<f32>>);
+
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
 /// halo_weight=None, multiple_scattering=None): the RGB two-scale model of one material, built once
@@ -273,6 +276,81 @@ struct Material {
 }
 
 impl Material {
+    /// The model at any wavelength of `spectral` (this material's index over
+    /// the spectrum), built by the first call.
+    fn spectral_model(
+        &self,
+        spectral: &SpectralMaterial<'static>,
+    ) -> &Spectral<'static, Box<ChannelBake>> {
+        self.spectral_model.get_or_init(|| {
+            Box::new(Spectral::boxed(
+                &TABLES.brdf_tables(),
+                spectral,
+                self.options,
+            ))
+        })
+    }
+
+    /// The rows of `arrays` (`(..., 3)`) and of `lam` (µm, `(...)`, as a
+    /// third array of rows `[λ, λ, λ]`) broadcast together, and the model at
+    /// any wavelength; `ValueError` (naming `method`) without an index over
+    /// the spectrum or for `lam` outside the models' range.
+    fn spectral_rows<'py>(
+        &self,
+        py: Python<'py>,
+        method: &str,
+        arrays: [(&str, &Bound<'py, PyAny>); 2],
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<(Vectors<3>, &Spectral<'static, Box<ChannelBake>>)> {
+        let Some(spectral) = &self.spectral else {
+            return Err(value_error(format!(
+                "{method} needs an index over the spectrum: a preset, or one (n, k) for every channel"
+            )));
+        };
+        // lam as a (..., 3) array, to broadcast with the directions.
+        let np = PyModule::import(py, "numpy")?;
+        let lam = np.call_method1("asarray", (lam, "float64")).map_err(|_| {
+            value_error(format!(
+                "lam must be an array of numbers (µm), got {}",
+                describe(lam)
+            ))
+        })?;
+        let lam3 = np.call_method1(
+            "repeat",
+            (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
+        )?;
+        let [a, b] = arrays;
+        let v = vectors([a, b, ("lam", &lam3)])?;
+        let (lo, hi) = (
+            SPECTRAL_WAVELENGTHS[0],
+            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+        );
+        if let Some(k) = v.rows[2].iter().position(|l| !(l[0] >= lo && l[0] <= hi)) {
+            return Err(value_error(format!(
+                "lam must be in [{lo}, {hi}] µm, got {} at row {k}",
+                v.rows[2][k][0]
+            )));
+        }
+        Ok((v, self.spectral_model(spectral)))
+    }
+
+    /// `f(model, wi, wo, λ)` on every row of `wi`, `wo` and `lam` broadcast
+    /// together ([`Material::spectral_rows`]), as a float32 array.
+    fn spectral_pairs<'py>(
+        &self,
+        py: Python<'py>,
+        method: &str,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+        f: impl Fn(&Spectral<'static, Box<ChannelBake>>, [f32; 3], [f32; 3], f32) -> f32 + Sync,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        let (v, model) = self.spectral_rows(py, method, [("wi", wi), ("wo", wo)], lam)?;
+        let [wi, wo, lam] = &v.rows;
+        let values = py.detach(|| rows(v.len(), |k| f(model, wi[k], wo[k], lam[k][0])));
+        Ok(shaped(py, &v.shape, values))
+    }
+
     /// The model of `material`, its bakes allocated zeroed on the heap and
     /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
     /// is enough (`tests/test_small_stack.py`).
@@ -431,44 +509,46 @@ impl Material {
         wo: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let Some(spectral) = &self.spectral else {
-            return Err(value_error(
-                "eval_spectral needs an index over the spectrum: a preset, or one (n, k) for every channel",
-            ));
-        };
-        // lam as a (..., 3) array, to broadcast with the directions.
-        let np = PyModule::import(py, "numpy")?;
-        let lam = np.call_method1("asarray", (lam, "float64")).map_err(|_| {
-            value_error(format!(
-                "lam must be an array of numbers (µm), got {}",
-                describe(lam)
-            ))
-        })?;
-        let lam3 = np.call_method1(
-            "repeat",
-            (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
-        )?;
-        let v = vectors([("wi", wi), ("wo", wo), ("lam", &lam3)])?;
-        let [wi, wo, lam] = &v.rows;
-        let (lo, hi) = (
-            SPECTRAL_WAVELENGTHS[0],
-            SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
-        );
-        if let Some(k) = lam.iter().position(|l| !(l[0] >= lo && l[0] <= hi)) {
-            return Err(value_error(format!(
-                "lam must be in [{lo}, {hi}] µm, got {} at row {k}",
-                lam[k][0]
-            )));
-        }
-        let model = self.spectral_model.get_or_init(|| {
-            Box::new(Spectral::boxed(
-                &TABLES.brdf_tables(),
-                spectral,
-                self.options,
-            ))
+        self.spectral_pairs(py, "eval_spectral", wi, wo, lam, Spectral::eval)
+    }
+
+    /// pdf_spectral(wi, wo, lam): the density (sr⁻¹) of `sample_spectral(wi,
+    /// ·, lam)` at `wo`: the sampler of the model at any wavelength nearest
+    /// `lam` (`Spectral::pdf`). Arguments and errors as `eval_spectral`'s.
+    fn pdf_spectral<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+        self.spectral_pairs(py, "pdf_spectral", wi, wo, lam, Spectral::pdf)
+    }
+
+    /// sample_spectral(wi, u, lam): `(wo, pdf)`, a direction drawn for the
+    /// wavelength `lam` (µm) from three uniforms `u` (`Spectral::sample`: the
+    /// sampler of the model nearest `lam`) and its density; `(0, 0, 0)` and 0
+    /// where none is drawn. Arguments and errors as `eval_spectral`'s.
+    fn sample_spectral<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+        lam: &Bound<'py, PyAny>,
+    ) -> PyResult<SpectralSampleArrays<'py>> {
+        let (v, model) = self.spectral_rows(py, "sample_spectral", [("wi", wi), ("u", u)], lam)?;
+        let [wi, u, lam] = &v.rows;
+        let samples = py.detach(|| {
+            rows(v.len(), |k| match model.sample(wi[k], u[k], lam[k][0]) {
+                Some(s) => (s.o, s.pdf),
+                None => ([0.0; 3], 0.0),
+            })
         });
-        let values = py.detach(|| rows(v.len(), |k| model.eval(wi[k], wo[k], lam[k][0])));
-        Ok(shaped(py, &v.shape, values))
+        let (dirs, pdf): (Vec<_>, Vec<_>) = samples.into_iter().unzip();
+        Ok((
+            shaped_vectors(py, &v.shape, dirs),
+            shaped(py, &v.shape, pdf),
+        ))
     }
 
     /// pdf(wi, wo): the solid-angle density (sr⁻¹) of `sample(wi, ·)` at
@@ -575,18 +655,56 @@ impl Material {
         self.model
             .channels
             .iter()
-            .map(|channel| {
-                let mut visitor = DictVisitor {
-                    dict: PyDict::new(py),
-                    error: None,
-                };
-                channel.visit_bakes(&mut visitor);
-                match visitor.error {
-                    Some(e) => Err(e),
-                    None => Ok(visitor.dict),
-                }
-            })
+            .map(|channel| bake_dict(py, |v| channel.visit_bakes(v)))
             .collect()
+    }
+
+    /// spectral_bakes(): the constants and bakes of the model at any
+    /// wavelength (`eval_spectral`'s), for ports of it
+    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 11 models', µm),
+    /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, and
+    /// `models`, a list of 11 dicts as `bakes()` gives them (not a stable
+    /// interface). Raises `ValueError` as `eval_spectral` does for a
+    /// material without an index over the spectrum.
+    fn spectral_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let Some(spectral) = &self.spectral else {
+            return Err(value_error(
+                "spectral_bakes needs an index over the spectrum: a preset, or one (n, k) for every channel",
+            ));
+        };
+        let model = self.spectral_model(spectral);
+        let dict = bake_dict(py, |v| model.visit_index(v))?;
+        let models = model
+            .nodes()
+            .iter()
+            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
+            .collect::<PyResult<Vec<_>>>()?;
+        dict.set_item("models", models)?;
+        Ok(dict)
+    }
+
+    /// with_layer(*, albedo=None, lambertian=None): this material with the
+    /// base layer's albedo and/or the Lambertian k_d replaced (the same
+    /// geometry, index, spectrum and options), rebuilt and re-baked; refused
+    /// as the constructor refuses them (`ValueError`). For the Mitsuba
+    /// plugin's `parameters_changed`.
+    #[pyo3(signature = (*, albedo=None, lambertian=None))]
+    fn with_layer(&self, albedo: Option<f32>, lambertian: Option<f32>) -> PyResult<Self> {
+        let mut layer = self.material.layer;
+        if let Some(albedo) = albedo {
+            layer.base = validate::base_layer(layer.base.kind(), Some(albedo))
+                .map_err(|e| value_error(e.to_string()))?;
+        }
+        if let Some(lambertian) = lambertian {
+            layer.lambertian = lambertian;
+        }
+        layer.validate().map_err(invalid)?;
+        let material = twoscale::brdf::Material {
+            layer,
+            ..self.material
+        };
+        let spectral = self.spectral.map(|s| SpectralMaterial { layer, ..s });
+        Ok(Material::with_spectrum(material, self.options, spectral))
     }
 
     /// β, the EPD's roughness (slope scale), dimensionless.
@@ -680,6 +798,22 @@ fn columns<const K: usize>(
         same_rows((names[0], n), (name, view.len()))?;
     }
     Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// The dict that `visit` fills through a [`DictVisitor`].
+fn bake_dict<'py>(
+    py: Python<'py>,
+    visit: impl FnOnce(&mut dyn BakeVisitor),
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut visitor = DictVisitor {
+        dict: PyDict::new(py),
+        error: None,
+    };
+    visit(&mut visitor);
+    match visitor.error {
+        Some(e) => Err(e),
+        None => Ok(visitor.dict),
+    }
 }
 
 /// Collects `TwoScale::visit_bakes` into a dict (the first error is kept).

@@ -1,5 +1,5 @@
-"""Render checks shared by the Mitsuba plugins' tests (test_mitsuba.py,
-test_drjit_bsdf.py): the white furnace (a material's albedo by quadrature
+"""Render checks of the Mitsuba plugin's tests (test_drjit_bsdf.py,
+test_drjit_spectral.py): the χ² test, the white furnace (a material's albedo by quadrature
 over the runtime's eval, and a render that estimates it in every pixel) and
 the Beckmann limit against Mitsuba's roughconductor."""
 
@@ -10,6 +10,19 @@ import numpy as np
 def direction(theta_deg):
     t = np.radians(theta_deg)
     return [float(np.sin(t)), 0.0, float(np.cos(t))]
+
+
+def chi2(sample, pdf):
+    """Mitsuba's χ² test (spherical domain, 3 uniforms) of `sample` against
+    `pdf`, with ires=16: the tester integrates the pdf over each cell with
+    16×16 points; its default, 4, under-resolves lobes of β ≈ 0.06
+    (docs/python.md). Returns the test, run."""
+    test = mi.chi2.ChiSquareTest(
+        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
+        sample_dim=3, ires=16,
+    )
+    test.passed = test.run(quiet=True)
+    return test
 
 
 def furnace_albedo(material, theta_deg, k=1500):

@@ -1,6 +1,9 @@
-"""The Mitsuba 3 plugin, checked with Mitsuba's own tools (llvm_ad_rgb):
-the χ² test of its sampler, the Beckmann limit against `roughconductor`,
-a white furnace, and the consistency of eval, pdf, sample and eval_pdf."""
+"""The Mitsuba 3 plugin ``twoscale`` (the Dr.Jit BSDF, llvm_ad_rgb, Mitsuba's
+default symbolic mode): its interface (register, material files, context
+masks), the direction convention, the consistency of eval, pdf, sample and
+eval_pdf, and its agreement with the NumPy round trip (numpy_oracle.py).
+The χ² tests, the white furnace and the Beckmann limit are in
+test_drjit_bsdf.py."""
 
 import os
 
@@ -16,48 +19,16 @@ import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
-from render_checks import beckmann_limit, direction, furnace_albedo, furnace_render  # noqa: E402,E501
+import numpy_oracle  # noqa: E402
 
 mi.set_variant("llvm_ad_rgb")
 tm.register()
+numpy_oracle.register()
 
 GOLD = "0.163 3.56, 0.584 2.15, 1.403 1.925"
 
 
-def xml(**props):
-    """Plugin properties as the XML the χ² adapter expects."""
-    out = []
-    for key, value in props.items():
-        kind = "float" if isinstance(value, float) else "string"
-        out.append(f'<{kind} name="{key}" value="{value}"/>')
-    return "".join(out)
-
-
 STRONG_HALO = dict(beta=0.1, p=1.0, sigma_s=0.1, b=3.0, c=1.6, eta=GOLD)
-CHI2_CASES = [
-    ("gold-hp17-geometry, 40°", dict(material="gold-hp17-geometry"), 40),
-    ("gold-rough, 30°", dict(material="gold-rough"), 30),
-    ("gold-rough, grazing 85°", dict(material="gold-rough"), 85),
-    ("white-plastic, 50°", dict(material="white-plastic"), 50),
-    ("marble, 10°", dict(material="marble"), 10),
-    ("strong halo, 20°", STRONG_HALO, 20),
-    ("strong halo, grazing 80°", STRONG_HALO, 80),
-]
-
-
-@pytest.mark.parametrize("label,props,theta", CHI2_CASES, ids=[c[0] for c in CHI2_CASES])
-def test_chi2(label, props, theta, record_property):
-    sample, pdf = mi.chi2.BSDFAdapter("twoscale", xml(**props), wi=direction(theta))
-    # ires=16: the tester integrates the pdf over each cell with 16×16 points;
-    # its default (4) under-resolves lobes of β ≈ 0.06 (docs/python.md).
-    test = mi.chi2.ChiSquareTest(
-        domain=mi.chi2.SphericalDomain(), sample_func=sample, pdf_func=pdf,
-        sample_dim=3, ires=16,
-    )
-    passed = test.run(quiet=True)
-    record_property("p_value", test.p_value)
-    print(f"chi2 {label}: p = {test.p_value:.4f}")
-    assert passed, test.messages
 
 
 def make_si(wi):
@@ -93,46 +64,42 @@ def test_eval_pdf_sample_consistent_and_directions():
     np.testing.assert_allclose(np.asarray(pdf2)[ok], pdf[ok], rtol=1e-5)
     np.testing.assert_allclose(np.asarray(weight).T[ok], value[ok] / pdf[ok, None], rtol=1e-4)
     expected = material.eval(wo[ok], cam[ok]) * wo[ok, 2:3]
-    np.testing.assert_allclose(value[ok], expected, rtol=1e-6)
+    # the plugin's agreement with the runtime (issue 25: 2e-4; test_drjit_bsdf.py)
+    np.testing.assert_allclose(value[ok], expected, rtol=2e-4)
     swapped = material.eval(cam[ok], wo[ok]) * wo[ok, 2:3]
     # the swap differs by far more than the tolerance above
     assert (np.abs(swapped - expected) / expected).max() > 1e-2
 
 
-@pytest.mark.parametrize("alpha", [0.1, 0.3])
-def test_beckmann_limit(alpha, record_property):
-    diff, noise, bias = beckmann_limit(alpha)
-    print(f"Beckmann limit α={alpha}: mean|Δ| = {diff:.5f}, noise = {noise:.5f}, "
-          f"ratio = {diff / noise:.3f}, mean bias = {bias:+.4%}")
-    record_property("ratio", diff / noise)
-    assert diff / noise < 1.1
-    assert abs(bias) < 0.01
-
-
-@pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
-def test_white_furnace(name, theta):
-    material = twoscale.Material.preset(name, colour="white")
-    expected = furnace_albedo(material, theta)
-    pixels = furnace_render(tm.bsdf_dict(material), theta, seed=0)
-    mean = pixels.mean(axis=0)
-    standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
-    print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
-    # the channels differ through λ (σrel and the halo), not through F
-    assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
-
-
-def test_white_furnace_with_energy_compensation():
-    """A β = 0.8 conductor (σs = 0, reciprocal, so the render's integral over
-    the light's directions is the albedo) renders at 1 ± 0.005 with
-    ``multiple_scattering="kulla-conty"``; without, it is dark."""
-    kw = dict(beta=0.8, p=1.0, eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)], colour="white")
-    for options, lo, hi in [({}, 0.0, 0.95), ({"multiple_scattering": "kulla-conty"}, 0.995, 1.005)]:
-        material = twoscale.Material(**kw, **options)
-        pixels = furnace_render(tm.bsdf_dict(material), 45, seed=0)
-        mean = pixels.mean(axis=0)
-        standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
-        print(f"furnace β = 0.8 {options} θo=45: render {mean} ± {standard_error}")
-        assert np.all((mean > lo - 4 * standard_error) & (mean < hi + 4 * standard_error))
+def test_agrees_with_the_numpy_oracle():
+    """The plugin and the NumPy round trip (Material's eval, pdf and sample
+    called on the wavefront) agree: eval and pdf within 2e-4 relative where
+    above 1e-6 of the peak, sampled directions within 1e-4, on 2000
+    camera directions per material, with symbolic mode on."""
+    assert dr.flag(dr.JitFlag.SymbolicLoops) and dr.flag(dr.JitFlag.SymbolicCalls)
+    rng = np.random.default_rng(8)
+    n = 2000
+    cam = rng.normal(size=(n, 3))
+    cam[:, 2] = np.abs(cam[:, 2])
+    cam /= np.linalg.norm(cam, axis=1, keepdims=True)
+    si, ctx = make_si(cam), mi.BSDFContext()
+    u1 = mi.Float(rng.random(n, dtype=np.float32))
+    u2 = mi.Point2f(rng.random((2, n), dtype=np.float32))
+    for props in (dict(material="gold-hp17-geometry"), dict(material="marble"), STRONG_HALO):
+        plugin = mi.load_dict({"type": tm.NAME, **props})
+        oracle = mi.load_dict({"type": numpy_oracle.NAME, **props})
+        bs, _ = plugin.sample(ctx, si, u1, u2)
+        bs_ref, _ = oracle.sample(ctx, si, u1, u2)
+        ok = np.asarray(bs_ref.pdf) > 0
+        assert np.array_equal(np.asarray(bs.pdf) > 0, ok)
+        assert np.abs(np.asarray(bs.wo) - np.asarray(bs_ref.wo))[:, ok].max() <= 1e-4
+        light = mi.Vector3f(bs_ref.wo)
+        for got, ref in zip(plugin.eval_pdf(ctx, si, light), oracle.eval_pdf(ctx, si, light)):
+            got, ref = np.asarray(got).reshape(-1, n).T, np.asarray(ref).reshape(-1, n).T
+            peak = ref.max(axis=0)
+            big = ref > 1e-6 * peak
+            assert np.all(np.abs(got - ref)[big] <= 2e-4 * ref[big]), props
+            assert np.all(np.abs(got - ref)[~big] <= 1e-6 * peak.max()), props
 
 
 def test_context_without_glossy_component_gives_zero():

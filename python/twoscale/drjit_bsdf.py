@@ -1,4 +1,6 @@
-"""A Mitsuba 3 BSDF ``twoscale_drjit`` written in Dr.Jit (issue 25, first steps).
+"""The Mitsuba 3 BSDF ``twoscale`` in Dr.Jit (issue 25), registered by
+:func:`twoscale.mitsuba.register` (parameters and direction convention
+there).
 
 The per-material bakes come from the Rust runtime (:meth:`twoscale.Material.bakes`,
 the only place where the tables are interpreted); they are uploaded once per
@@ -10,24 +12,42 @@ own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
 ``ln C`` grid), written as gathers rather than ``dr.Texture`` fetches because
 the bakes' node axes and cubic weights are not a texture's.
 
-**What is ported.** :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
+**What is ported.** RGB variants: :meth:`Model.eval` (``Rgb::eval``, three RGB channels),
 :meth:`Model.pdf` (``Rgb::pdf``: the visible-slope tables, the diffraction
 law, the cosine lobe, the baked lobe weights, averaged over the channels) and
 :meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
 loop, the diffraction and cosine lobes). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
-its density and weight ``eval / pdf``. Not yet: gradients (``traverse``
-exposes nothing), spectral variants. Particle tracing is not supported (as
-in ``twoscale.mitsuba``).
+its density and weight ``eval / pdf``. Particle tracing is not supported.
+Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
+:meth:`twoscale.Material.spectral_bakes`: the 11 models' bakes, interpolated
+in λ, with F(θd) at each of the path's four wavelengths in closed form;
+``pdf`` and ``sample`` those of the model nearest the hero wavelength).
 
-**Direction convention** (as ``twoscale.mitsuba``): ``eval(si, wo) =
+**Gradients.** The bakes are fixed per material (the runtime interprets the
+tables; a lookup's node positions have no useful derivative), so
+``traverse`` exposes only the parameters that enter *after* the lookups, in
+closed form (:attr:`Model.params`, ``mi.ParamFlags.Differentiable``):
+
+- ``lambertian``: k_d, the term ``k_d/π`` (every material);
+- ``albedo``: the base layer's α (plastic: ``T α/(π n²(1 − α F_dr))``;
+  subsurface: HP17 42-47), for a plastic or subsurface base with physical
+  colour;
+- ``halo_factor``: a factor on the diffraction lobe ρ_CTD (default 1; not
+  a runtime parameter: at other values the plugin is no longer
+  ``Material.eval``), for materials with σs > 0.
+
+β, p, σs, b, c and η enter the bakes (C, G1, F, the sampler's tables) and
+are not exposed. ``parameters_changed`` re-bakes the material at the new
+k_d or albedo (``Material.with_layer``: they also set the sampler's lobe
+weights), so the primal value stays the runtime's; the derivative is that
+of the closed form, with the sampler held fixed (its density is not
+differentiated).
+
+**Direction convention** (``twoscale.mitsuba``): ``eval(si, wo) =
 ρ(wi=wo, wo=si.wi) · cos θ(wo)``, the light's direction being the model's
 incident one.
-
-Register with :func:`register` after ``mi.set_variant(...)``; the plugin takes
-the parameters of ``twoscale.mitsuba`` (``material``, ``filename`` or explicit
-ones).
 """
 
 import math
@@ -38,9 +58,6 @@ import numpy as np
 
 import twoscale
 from twoscale.mitsuba import _material
-
-#: Plugin name.
-NAME = "twoscale_drjit"
 
 # The constants of `math::log2_axis` (runtime/src/math.rs), in f32.
 _LOG2_E = np.float32(math.log2(math.e))
@@ -69,6 +86,11 @@ def _lerp_gather(table, width, column, i, frac):
     a = dr.gather(mi.Float, table, i * width + column)
     b = dr.gather(mi.Float, table, (i + 1) * width + column)
     return dr.fma(frac, b - a, a)
+
+
+def _gather4(table, k):
+    """Floats `4k … 4k + 3` of `table`, one packet gather."""
+    return dr.gather(mi.Vector4f, table, k)
 
 
 def _catmull_rom_weights(t):
@@ -123,22 +145,21 @@ class _Channel:
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
         s["visible_r_max"] = self.r_max
-        # Constants of the base layer (`TwoScale::base_value`).
+        # Constants of the base layer (`TwoScale::base_value`; the albedo
+        # and k_d are the plugin's parameters, `Model.params`).
         n = max(abs(s["eta_re"]), 1e-3)
-        f_dr, alpha = s["f_dr_int"], s["albedo"]
-        s["base_lambertian"] = s["lambertian"] / math.pi
+        f_dr = s["f_dr_int"]
         s["base_inv_n_sq"] = 1.0 / (n * n)
-        if s["base"] == 1.0:
-            s["base_plastic"] = alpha / (math.pi * n * n * (1.0 - alpha * f_dr))
-        a_f = (1.0 - f_dr) / (1.0 + f_dr)
-        root = math.sqrt(max(3.0 * (1.0 - alpha), 0.0))
-        s["base_single"] = alpha / (4.0 * math.pi)
-        s["base_multi"] = (alpha / (2.0 * math.pi) * math.exp(-root)
-                           * (1.0 + math.exp(-4.0 / 3.0 * a_f * root)))
+        s["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
         self.f, self.d = _Opaque(s, mi.Float), _Opaque(s, mi.Float64)
+        # ln C as overlapping packets: packet j holds nodes j … j + 3 of the
+        # flattened grid (so that a Catmull–Rom row is one packet gather).
+        ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()
+        ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
+        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
-            raise ValueError("twoscale_drjit: this material's C is not baked (source other than T3b)")
+            raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
 
     # -- the 1-D bakes -------------------------------------------------
     def direction_cell(self, cos):
@@ -146,8 +167,17 @@ class _Channel:
         return _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
 
     def direction(self, cell, columns):
+        """The direction bake's `columns` at `cell`, linear between its rows
+        (`DirectionBake::at_cell`), read as packets of four columns."""
         i, frac = cell
-        return [_lerp_gather(self.t["direction_rows"], 8, k, i, frac) for k in columns]
+        out = []
+        for half in sorted({k // 4 for k in columns}):
+            a = _gather4(self.t["direction_rows"], 2 * i + half)
+            b = _gather4(self.t["direction_rows"], 2 * i + 2 + half)
+            out += [(k, dr.fma(frac, b[k % 4] - a[k % 4], a[k % 4]))
+                    for k in columns if k // 4 == half]
+        values = dict(out)
+        return [values[k] for k in columns]
 
     def g1(self, r, z):
         """`MaskingBake::g1`."""
@@ -179,10 +209,11 @@ class _Channel:
         wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
         ln_c = mi.Float(0.0)
         for a in range(4):
-            row = (ju + a) * n_s + ks
+            # The four nodes (ks … ks + 3) of row ju + a in one packet.
+            quad = _gather4(self.conv_quads, (ju + a) * n_s + ks)
             inner = mi.Float(0.0)
             for b in range(4):
-                inner += ws[b] * dr.gather(mi.Float, self.t["conv_ln_c"], row + b)
+                inner += ws[b] * quad[b]
             ln_c += wu[a] * inner
         value = dr.exp(ln_c)
         return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
@@ -481,24 +512,36 @@ class _Channel:
              + pp_re * pp_re + pp_im * pp_im)
         return 0.5 * self.d["q_e_norm_sqr"] * q * inv_s_sq
 
-    def base_value(self, f_i, f_o, cos_i, cos_o):
-        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47)."""
+    def base_value(self, f_i, f_o, cos_i, cos_o, params):
+        """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47), with the
+        albedo α and k_d of `params` (differentiable: closed forms after
+        the lookups). Plastic: `T α / (π n² (1 − α F_dr))`; subsurface:
+        `T α/(4π (cos θi' + cos θo')) + T α/(2π) e^−r (1 + e^−(4/3) A r)`,
+        `r = √(3(1 − α))`, `T = (1 − F(θi))(1 − F(θo))`."""
         s, d = self.s, self.d
-        lambertian = d["base_lambertian"]
+        lambertian = mi.Float64(params["lambertian"]) * (1.0 / math.pi)
         if s["white"] != 0.0 or s["base"] == 0.0:
-            return mi.Float64(lambertian)
+            return lambertian
+        alpha = mi.Float64(params["albedo"])
         t = (1.0 - f_i) * (1.0 - f_o)
         if s["base"] == 1.0:
-            return t * d["base_plastic"] + lambertian
+            plastic = alpha * d["base_inv_n_sq"] / (math.pi * (1.0 - alpha * d["f_dr_int"]))
+            return t * plastic + lambertian
 
         def refracted(cos):
             return dr.sqrt(dr.maximum(1.0 - (1.0 - cos * cos) * d["base_inv_n_sq"], 0.0))
 
-        single = t * d["base_single"] / dr.maximum(refracted(cos_i) + refracted(cos_o), 1e-12)
-        return single + t * d["base_multi"] + lambertian
+        root = dr.sqrt(dr.maximum(3.0 * (1.0 - alpha), 0.0))
+        multi = alpha / (2.0 * math.pi) * dr.exp(-root) * (
+            1.0 + dr.exp(-4.0 / 3.0 * d["base_a_f"] * root))
+        single = t * (alpha / (4.0 * math.pi)) / dr.maximum(
+            refracted(cos_i) + refracted(cos_o), 1e-12)
+        return single + t * multi + lambertian
 
-    def lobes(self, g, geo):
-        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair."""
+    def lobes(self, g, geo, params):
+        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair,
+        the diffraction lobe times `params["halo_factor"]` and the base
+        layer's with `params`' albedo and k_d (:meth:`base_value`)."""
         s = self.s
         wi, wo = geo["wi"], geo["wo"]
         cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
@@ -542,23 +585,41 @@ class _Channel:
             c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
                                 mi.Float(self.d["big_b"] * cos_d))
             c_value = mi.Float64(dr.maximum(c_value, 0.0))
-            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0)
+            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0) * mi.Float64(
+                params["halo_factor"])
         else:
             diffraction = mi.Float64(0.0)
-        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o)
+        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
         multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
 
+def default_params(material: twoscale.Material):
+    """The differentiable parameters of :class:`Model` at `material`'s
+    values (``mi.Float`` kernel inputs): ``lambertian`` (k_d), ``albedo``
+    (the base layer's; 0 for a conductor) and ``halo_factor`` (1)."""
+    return {
+        "lambertian": dr.opaque(mi.Float, material.lambertian),
+        "albedo": dr.opaque(mi.Float, material.albedo or 0.0),
+        "halo_factor": dr.opaque(mi.Float, 1.0),
+    }
+
+
 class Model:
     """The RGB model of a :class:`twoscale.Material` in Dr.Jit: its three
-    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``."""
+    channels' bakes uploaded once; :meth:`eval` is ``Material.eval``.
 
-    def __init__(self, material: twoscale.Material):
+    `params` (:func:`default_params`) hold the parameters that enter after
+    the lookups (k_d, the base albedo, a factor on the diffraction lobe), as
+    Dr.Jit variables that may carry gradients; at the material's values and
+    a factor of 1, :meth:`eval` is the runtime's."""
+
+    def __init__(self, material: twoscale.Material, params=None, bakes=None):
         self.material = material
-        self.channels = [_Channel(b) for b in material.bakes()]
+        self.params = default_params(material) if params is None else params
+        self.channels = [_Channel(b) for b in (material.bakes() if bakes is None else bakes)]
         first = self.channels[0].s
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
@@ -595,11 +656,8 @@ class Model:
             "across": -(wi.x * wo.y - wi.y * wo.x),
         }
 
-    def eval(self, wi, wo):
-        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
-        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
-        below the horizon."""
-        valid, geo = self.geometry(wi, wo)
+    def masking(self, geo):
+        """G at a pair (`TwoScale::with_masking`), f64."""
         wi, wo = geo["wi"], geo["wo"]
         ch = self.channels[0]
 
@@ -612,9 +670,17 @@ class Model:
             g = 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0)
         else:
             g = g1_i * g1_o
+        return g
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
+        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
+        below the horizon."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
         values = []
         for channel in self.channels:
-            spec, diff, base, multiple = channel.lobes(g, geo)
+            spec, diff, base, multiple = channel.lobes(g, geo, self.params)
             values.append(mi.Float(_finite_or_zero(
                 mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base))
                 + mi.Float64(mi.Float(multiple)))))
@@ -689,15 +755,254 @@ class Model:
         return o, ok
 
 
-def _bsdf_class():
-    """The BSDF class for the current variant (``mi.BSDF`` is per variant)."""
+def _fresnel(n, k, cos):
+    """`fresnel::fresnel`: F of the index `n + ik` (f32) at `cos θ` (f32),
+    unpolarised (HP17 3-4), computed in f64 as the runtime; 0 for η² = 1."""
+    n = dr.minimum(dr.abs(mi.Float64(n)), 1e9)
+    k = dr.minimum(dr.abs(mi.Float64(k)), 1e9)
+    n = dr.select(n * n + k * k < 1e-20, 1e-10, n)
+    e_re, e_im = (n - 1.0) * (n + 1.0) - k * k, 2.0 * n * k
+    cos = dr.clip(mi.Float64(cos), 0.0, 1.0)
+    # c = √(η² − 1 + cos²θ), the runtime's principal root (`C64::sqrt`).
+    x, y = e_re + cos * cos, e_im
+    r = dr.sqrt(x * x + y * y)
+    t = dr.sqrt(0.5 * (r + dr.abs(x)))
+    t_safe = dr.select(t > 0.0, t, 1.0)
+    c_re = dr.select(x >= 0.0, t, dr.abs(y) / (2.0 * t_safe))
+    c_im = dr.select(x >= 0.0, y / (2.0 * t_safe), dr.select(y < 0.0, -t, t))
 
-    class TwoScaleDrJitBSDF(mi.BSDF):
+    def ratio(a_re, a_im):
+        """|a − c|² / |a + c|²."""
+        return (((a_re - c_re) ** 2 + (a_im - c_im) ** 2)
+                / ((a_re + c_re) ** 2 + (a_im + c_im) ** 2))
+
+    f = 0.5 * (ratio(cos, 0.0) + ratio((n * n - k * k) * cos, e_im * cos))
+    f = dr.select((e_re == 0.0) & (e_im == 0.0), 0.0, f)
+    return dr.clip(mi.Float(f), 0.0, 1.0)
+
+
+class SpectralModel(Model):
+    """The model at any wavelength of a :class:`twoscale.Material`
+    (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 11
+    models of ``Material.spectral_bakes()`` sharing the surface, their
+    surface lobes divided by F(θd) and interpolated linearly in λ, times
+    F(θd) at λ in closed form (η linear between 5 nm nodes); the base lobes
+    interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
+    the nearest model (``Spectral::pdf``, ``Spectral::sample``)."""
+
+    def __init__(self, material: twoscale.Material, params=None):
+        spectral = material.spectral_bakes()
+        super().__init__(material, params, spectral["models"])
+        self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
+        self.node_table = mi.Float(spectral["wavelengths"])
+        self.eta = mi.Float(np.ascontiguousarray(spectral["eta"]).ravel())
+        self.eta_nodes = spectral["eta"].shape[0]
+        self.eta_first = float(np.float32(spectral["eta_first"]))
+        self.eta_step = float(np.float32(spectral["eta_step"]))
+        self.white = spectral["white"] != 0.0
+
+    def clamped(self, lam):
+        """λ (µm, f32) clamped to the models' range (NaN → the first)."""
+        return dr.select(lam > self.nodes[0], dr.minimum(lam, self.nodes[-1]), self.nodes[0])
+
+    def cell(self, lam):
+        """`spectral::cell`: the model `k` and fraction `f` of the clamped λ."""
+        k = mi.UInt32(0)
+        for node in self.nodes[1:-1]:
+            k += dr.select(lam > node, 1, 0)
+        a = dr.gather(mi.Float, self.node_table, k)
+        b = dr.gather(mi.Float, self.node_table, k + 1)
+        f = (lam - a) / (b - a)
+        return k, dr.select(f > 0.0, dr.minimum(f, 1.0), 0.0)
+
+    def eta_at(self, lam):
+        """`Spectral::eta_at`: η at λ (f32), linear between the 5 nm nodes."""
+        t = (lam - self.eta_first) / self.eta_step
+        j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), self.eta_nodes - 2)
+        f = dr.clip(t - mi.Float(j), 0.0, 1.0)
+
+        def at(col):
+            a = dr.gather(mi.Float, self.eta, 2 * j + col)
+            b = dr.gather(mi.Float, self.eta, 2 * j + 2 + col)
+            return a + f * (b - a)
+
+        return at(0), at(1)
+
+    def eval_spectral(self, wi, wo, lams):
+        """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
+        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``)."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
+        cos_d = mi.Float(geo["cos_d"])
+        surface, base, total, fresnel = [], [], [], []
+        for channel in self.channels:
+            spec, diff, b, mult = channel.lobes(g, geo, self.params)
+            spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
+            surface.append(spec + diff)
+            base.append(b + mult)  # the base and the compensation lobe: linear in λ
+            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult))))
+            fresnel.append(mi.Float64(1.0) if self.white else mi.Float64(
+                channel.direction(channel.direction_cell(cos_d), [6])[0]))
+        out = []
+        for lam in lams:
+            lam = self.clamped(mi.Float(lam))
+            k, f = self.cell(lam)
+
+            def at(values, m):
+                return sum(dr.select(m == j, v, 0.0) for j, v in enumerate(values))
+
+            fa, fb = at(fresnel, k), at(fresnel, k + 1)
+            f = mi.Float64(f)
+            plain = (1.0 - f) * at(total, k) + f * at(total, k + 1)
+            fl = mi.Float64(_fresnel(*self.eta_at(lam), cos_d))
+            fa_safe = dr.select(fa > 0.0, fa, 1.0)
+            fb_safe = dr.select(fb > 0.0, fb, 1.0)
+            coloured = (fl * ((1.0 - f) * at(surface, k) / fa_safe
+                              + f * at(surface, k + 1) / fb_safe)
+                        + (1.0 - f) * at(base, k) + f * at(base, k + 1))
+            use_plain = (fa <= 0.0) | (fb <= 0.0) if not self.white else True
+            value = dr.select(use_plain, plain, coloured)
+            out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
+        return out
+
+    def nearest(self, lam):
+        """`Spectral::nearest`: the index of the model nearest λ."""
+        k, f = self.cell(self.clamped(mi.Float(lam)))
+        return dr.select(f < 0.5, k, k + 1)
+
+    def pdf_spectral(self, wi, wo, lam):
+        """`Spectral::pdf`: `TwoScale::pdf` of the model nearest λ."""
+        valid, geo = self.geometry(wi, wo)
+        wi, wo = geo["wi"], geo["wo"]
+        nearest = self.nearest(lam)
+        specular = self.channels[0].visible_pdf(wi, wo)
+        base = wo.z / math.pi
+        total = mi.Float64(0.0)
+        for m, channel in enumerate(self.channels):
+            w = channel.lobe_weights(wi.z)
+            value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
+            if channel.diffraction:
+                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo), 0.0)
+            value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
+            total = dr.select(nearest == m, value, total)
+        return dr.select(valid, _finite_or_zero(mi.Float(total)), 0.0)
+
+    def sample_spectral(self, wi, u, lam):
+        """`Spectral::sample`'s direction: `TwoScale::sample_direction` of
+        the model nearest λ (the lobe picked with `u[0]`, its direction
+        from `u[1], u[2]`). Returns the direction and whether one was drawn."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        wi_f = mi.Vector3f(wi)
+        valid = dr.all(dr.isfinite(wi_f))
+        wi = dr.normalize(mi.Vector3d(wi_f))
+        valid &= wi.z > 0.0
+        nearest = self.nearest(lam)
+        pick = mi.Float64(dr.clip(u.x, 0.0, below_one))
+        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
+        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        w = [mi.Float64(0.0)] * 4
+        for m, channel in enumerate(self.channels):
+            wm = channel.lobe_weights(wi.z)
+            w = [dr.select(nearest == m, wm[n], w[n]) for n in range(4)]
+        # `pick_lobe`.
+        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+        for n in range(4):
+            positive = w[n] > 0.0
+            cumulative += dr.select(positive, w[n], 0.0)
+            last = dr.select(positive, n, last)
+            chosen = dr.select((chosen < 0) & positive & (pick < cumulative), n, chosen)
+        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
+        m_, ok = self.channels[0].visible_sample(wi, u1, u2)
+        o = 2.0 * dr.dot(wi, m_) * m_ - wi
+        for m, channel in enumerate(self.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & (nearest == m)
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
+        ok = dr.select(lobe >= 2, True, ok)
+        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
+        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
+        return o, ok
+
+
+def _scalar_bsdf_class():
+    """The BSDF in scalar RGB variants: one direction per call, handed to
+    the runtime (:class:`twoscale.Material`) directly; Dr.Jit's scalar
+    variants have no arrays to gather from. No differentiable parameters."""
+
+    def vector(v):
+        return np.array([v[0], v[1], v[2]], dtype=np.float32)
+
+    class TwoScaleScalarBSDF(mi.BSDF):
+        """The two-scale BRDF, scalar RGB variants (front side, glossy)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            if not mi.is_rgb:
+                raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
+                                   "(scalar_rgb is; spectral variants: llvm_ad_spectral)")
+            self.material = _material(props)
+            self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            self.m_components = [self.m_flags]
+
+        def _on(self, ctx, active):
+            return bool(active) and ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
+
+        def _eval(self, si, wo):
+            value = self.material.eval(vector(wo), vector(si.wi)) * max(float(wo[2]), 0.0)
+            return mi.Color3f(*(float(x) for x in value))
+
+        def _pdf(self, si, wo):
+            return float(self.material.pdf(vector(si.wi), vector(wo)))
+
+        def eval(self, ctx, si, wo, active=True):
+            return self._eval(si, wo) if self._on(ctx, active) else mi.Color3f(0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            return self._pdf(si, wo) if self._on(ctx, active) else 0.0
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            u = np.array([sample1, sample2[0], sample2[1]], dtype=np.float32)
+            wo, pdf, _ = self.material.sample(vector(si.wi), u)
+            bs = mi.BSDFSample3f()
+            bs.wo = mi.Vector3f(*(float(x) for x in wo))
+            bs.pdf = float(pdf) if self._on(ctx, active) else 0.0
+            bs.eta = 1.0
+            bs.sampled_type = +mi.BSDFFlags.GlossyReflection
+            bs.sampled_component = 0
+            if not bs.pdf > 0.0:
+                return bs, mi.Color3f(0.0)
+            return bs, self._eval(si, bs.wo) / bs.pdf
+
+        def to_string(self):
+            return f"TwoScaleBSDF[{self.material!r}]"
+
+    return TwoScaleScalarBSDF
+
+
+def bsdf_class():
+    """The BSDF class for the current variant (``mi.BSDF`` is per variant),
+    registered as ``twoscale`` by :func:`twoscale.mitsuba.register`."""
+    if mi.variant().startswith("scalar"):
+        return _scalar_bsdf_class()
+
+    class TwoScaleBSDF(mi.BSDF):
         """The two-scale BRDF in Dr.Jit (front side only, glossy reflection)."""
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            self.model = Model(_material(props))
+            if mi.is_polarized or not (mi.is_rgb or mi.is_spectral):
+                raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
+                                   "(rgb and unpolarised spectral variants are)")
+            self.model = (SpectralModel if mi.is_spectral else Model)(_material(props))
             self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             self.m_components = [self.m_flags]
 
@@ -705,29 +1010,47 @@ def _bsdf_class():
         def _active(ctx, active):
             return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
 
+        @staticmethod
+        def _lams(si):
+            """The path's wavelengths in µm (Mitsuba's are in nm)."""
+            return [si.wavelengths[j] * 1e-3 for j in range(len(si.wavelengths))]
+
         def _eval(self, si, wo):
-            """ρ(wi=wo, wo=si.wi) · cos θ(wo)."""
-            return self.model.eval(wo, si.wi) * dr.maximum(wo.z, 0.0)
+            """ρ(wi=wo, wo=si.wi) · cos θ(wo): RGB, or at the path's wavelengths."""
+            if mi.is_spectral:
+                value = mi.Spectrum(*self.model.eval_spectral(wo, si.wi, self._lams(si)))
+            else:
+                value = self.model.eval(wo, si.wi)
+            return value * dr.maximum(wo.z, 0.0)
+
+        def _pdf(self, si, wo):
+            """The density of `sample` (at the hero wavelength, spectral)."""
+            if mi.is_spectral:
+                return self.model.pdf_spectral(si.wi, wo, self._lams(si)[0])
+            return self.model.pdf(si.wi, wo)
 
         def eval(self, ctx, si, wo, active=True):
             return dr.select(self._active(ctx, active), self._eval(si, wo), 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
-            return dr.select(self._active(ctx, active), self.model.pdf(si.wi, wo), 0.0)
+            return dr.select(self._active(ctx, active), self._pdf(si, wo), 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             active = self._active(ctx, active)
             return (dr.select(active, self._eval(si, wo), 0.0),
-                    dr.select(active, self.model.pdf(si.wi, wo), 0.0))
+                    dr.select(active, self._pdf(si, wo), 0.0))
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             # The light direction from the runtime's sampler given the camera
             # direction (as twoscale.mitsuba), its density and eval / pdf.
             u = mi.Vector3f(sample1, sample2.x, sample2.y)
-            wo, ok = self.model.sample_direction(si.wi, u)
+            if mi.is_spectral:
+                wo, ok = self.model.sample_spectral(si.wi, u, self._lams(si)[0])
+            else:
+                wo, ok = self.model.sample_direction(si.wi, u)
             bs = mi.BSDFSample3f()
             bs.wo = wo
-            bs.pdf = dr.select(ok, self.model.pdf(si.wi, wo), 0.0)
+            bs.pdf = dr.select(ok, self._pdf(si, wo), 0.0)
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)
@@ -735,20 +1058,36 @@ def _bsdf_class():
             weight = self._eval(si, wo) / dr.select(active, bs.pdf, 1.0)
             return bs, dr.select(active, weight, 0.0)
 
+        def _exposed(self):
+            """The keys of `Model.params` this material has (module doc)."""
+            m = self.model.material
+            keys = ["lambertian"]
+            if m.base != "conductor" and m.options.get("colour") != "white":
+                keys.append("albedo")
+            if self.model.channels_have_diffraction:
+                keys.append("halo_factor")
+            return keys
+
         def traverse(self, callback):
-            # No parameter is differentiable yet (issue 25 item 3).
-            pass
+            for key in self._exposed():
+                callback.put(key, self.model.params[key], mi.ParamFlags.Differentiable)
+
+        def parameters_changed(self, keys):
+            # k_d and the albedo also set the sampler's baked lobe weights:
+            # re-bake the material at their (detached) values; the params
+            # (changed in place by mi.SceneParameters) stay the model's.
+            m, params = self.model.material, self.model.params
+            changed = {}
+            for key in ("albedo", "lambertian"):
+                if key in keys:
+                    value = float(dr.detach(params[key])[0] if dr.is_array_v(params[key])
+                                  else params[key])
+                    if value != float(getattr(m, key) or 0.0):
+                        changed[key] = value
+            if changed:
+                self.model = type(self.model)(m.with_layer(**changed), params)
 
         def to_string(self):
-            return f"TwoScaleDrJitBSDF[{self.model.material!r}]"
+            return f"TwoScaleBSDF[{self.model.material!r}]"
 
-    return TwoScaleDrJitBSDF
-
-
-def register() -> None:
-    """register(): registers the ``twoscale_drjit`` BSDF with the current Mitsuba
-    variant. No Dr.Jit flag is changed."""
-    if not mi.variant():
-        raise RuntimeError("call mi.set_variant(...) before twoscale.drjit_bsdf.register()")
-    cls = _bsdf_class()
-    mi.register_bsdf(NAME, lambda props: cls(props))
+    return TwoScaleBSDF

@@ -55,15 +55,22 @@ So ``eval``, ``pdf``, ``sample`` and ``eval_pdf`` are mutually consistent
 (the χ² test checks ``sample`` against ``pdf``; the tests check the weight is
 ``eval / pdf`` and that ``eval_pdf`` returns both).
 
-**Variants.** In JIT variants (``llvm_ad_rgb``) each call converts a whole
-wavefront to NumPy and back, which needs symbolic loops and calls switched
-off: :func:`register` does that. ``scalar_rgb`` also works (one direction per
-call, so every call pays Python's overhead).
+**Implementation and variants.** The BSDF is written in Dr.Jit
+(:mod:`twoscale.drjit_bsdf`: the runtime bakes each material, the plugin
+mirrors its ``eval``, ``pdf`` and ``sample`` with Dr.Jit operations), so it
+runs in Mitsuba's default symbolic mode and :func:`register` changes no
+Dr.Jit flag. Run in ``scalar_rgb``, ``llvm_ad_rgb`` and ``llvm_ad_spectral``
+(four wavelengths per path, the runtime's model at any wavelength);
+``cuda_ad_*`` run the same code but have not been run (no GPU here);
+polarised and monochrome variants are refused.
+
+**Differentiable parameters** (``mi.traverse``): ``lambertian``, ``albedo``
+(plastic and subsurface bases) and ``halo_factor`` (a factor on the
+diffraction lobe, default 1, materials with σs > 0); see
+:mod:`twoscale.drjit_bsdf` for why only these.
 """
 
-import drjit as dr
 import mitsuba as mi
-import numpy as np
 
 import twoscale
 
@@ -124,104 +131,12 @@ def _material(props):
     return twoscale.Material(**keywords, **options)
 
 
-def _rows(*vectors):
-    """Mitsuba 3-vectors (scalar or wavefronts, of width 1 or N) as (N, 3)
-    float32 arrays."""
-    arrays = [np.asarray(v, dtype=np.float32).reshape(3, -1).T for v in vectors]
-    n = max(len(a) for a in arrays)
-    return [np.ascontiguousarray(np.broadcast_to(a, (n, 3))) for a in arrays]
-
-
-def _scalar_variant():
-    return mi.variant().startswith("scalar")
-
-
-def _vector(rows):
-    if _scalar_variant():
-        return mi.Vector3f(*(float(x) for x in rows[0]))
-    return mi.Vector3f(np.ascontiguousarray(rows.T))
-
-
-def _color(rows):
-    if _scalar_variant():
-        return mi.Color3f(*(float(x) for x in rows[0]))
-    return mi.Color3f(np.ascontiguousarray(rows.T))
-
-
-def _float(values):
-    if _scalar_variant():
-        return mi.Float(float(values[0]))
-    return mi.Float(np.ascontiguousarray(values))
-
-
-def _bsdf_class():
-    """The BSDF class for the current variant (``mi.BSDF`` is per variant)."""
-
-    class TwoScaleBSDF(mi.BSDF):
-        """The two-scale BRDF (front side only, glossy reflection)."""
-
-        def __init__(self, props):
-            mi.BSDF.__init__(self, props)
-            self.material = _material(props)
-            self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
-            self.m_components = [self.m_flags]
-
-        def _eval_rows(self, camera, light):
-            """ρ(wi=light, wo=camera) · cos θ(light), (N, 3)."""
-            value = self.material.eval(light, camera)
-            return value * np.maximum(light[:, 2:3], 0.0)
-
-        @staticmethod
-        def _active(ctx, active):
-            """``active`` where the context asks for the glossy component."""
-            return mi.Bool(active) & ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0)
-
-        def sample(self, ctx, si, sample1, sample2, active=True):
-            u1 = np.asarray(sample1, dtype=np.float32).reshape(1, -1)
-            u2 = np.asarray(sample2, dtype=np.float32).reshape(2, -1)
-            camera, u = _rows(si.wi, np.concatenate(np.broadcast_arrays(u1, u2[:1], u2[1:])))
-            light, pdf, _ = self.material.sample(camera, u)
-            ok = pdf > 0
-            weight = np.zeros_like(light)
-            weight[ok] = self._eval_rows(camera[ok], light[ok]) / pdf[ok, None]
-            bs = mi.BSDFSample3f()
-            bs.wo = _vector(light)
-            bs.pdf = _float(pdf)
-            bs.eta = 1.0
-            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
-            bs.sampled_component = mi.UInt32(0)
-            active = self._active(ctx, active) & (bs.pdf > 0)
-            return bs, dr.select(active, _color(weight), 0.0)
-
-        def eval(self, ctx, si, wo, active=True):
-            value = _color(self._eval_rows(*_rows(si.wi, wo)))
-            return dr.select(self._active(ctx, active), value, 0.0)
-
-        def pdf(self, ctx, si, wo, active=True):
-            pdf = _float(self.material.pdf(*_rows(si.wi, wo)))
-            return dr.select(self._active(ctx, active), pdf, 0.0)
-
-        def eval_pdf(self, ctx, si, wo, active=True):
-            camera, light = _rows(si.wi, wo)
-            value = _color(self._eval_rows(camera, light))
-            pdf = _float(self.material.pdf(camera, light))
-            active = self._active(ctx, active)
-            return dr.select(active, value, 0.0), dr.select(active, pdf, 0.0)
-
-        def to_string(self):
-            return f"TwoScaleBSDF[{self.material!r}]"
-
-    return TwoScaleBSDF
-
-
 def register() -> None:
-    """register(): registers the ``twoscale`` BSDF with the current Mitsuba variant; in
-    JIT variants, switches symbolic loops and calls off (the BSDF runs on
-    NumPy arrays, so Mitsuba must hand it evaluated wavefronts)."""
+    """register(): registers the ``twoscale`` BSDF (:mod:`twoscale.drjit_bsdf`)
+    with the current Mitsuba variant. No Dr.Jit flag is changed."""
     if not mi.variant():
         raise RuntimeError("call mi.set_variant(...) before twoscale.mitsuba.register()")
-    if not _scalar_variant():
-        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
-        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
-    cls = _bsdf_class()
+    from twoscale import drjit_bsdf
+
+    cls = drjit_bsdf.bsdf_class()
     mi.register_bsdf(NAME, lambda props: cls(props))

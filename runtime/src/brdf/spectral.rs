@@ -13,7 +13,9 @@
 //! are those of the model nearest λ.
 
 use super::integrated::models_at;
-use super::{ChannelBake, ColourTerms, Lobes, Options, Sample, Tables, TwoScale, finite_or_zero};
+use super::{
+    BakeVisitor, ChannelBake, ColourTerms, Lobes, Options, Sample, Tables, TwoScale, finite_or_zero,
+};
 use crate::fresnel::{Complex, fresnel};
 use crate::math;
 use crate::optical::SpectralMaterial;
@@ -90,6 +92,24 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     /// The one-wavelength models, at [`SPECTRAL_WAVELENGTHS`].
     pub fn nodes(&self) -> &[TwoScale<'_, B>; SPECTRAL_COUNT] {
         &self.nodes
+    }
+
+    /// Hands the spectral constants to `v` for ports of [`Spectral::eval`]
+    /// (the Python package's `Material.spectral_bakes()`): `wavelengths`
+    /// ([`SPECTRAL_WAVELENGTHS`], µm), `eta` (`[ETA_NODES, 2]`: n, k every
+    /// `eta_step` µm from `eta_first`) and `white`. Each model's bakes are
+    /// its node's [`TwoScale::visit_bakes`].
+    #[doc(hidden)]
+    pub fn visit_index(&self, v: &mut dyn BakeVisitor) {
+        v.array("wavelengths", &[SPECTRAL_COUNT], &SPECTRAL_WAVELENGTHS);
+        let mut eta = [0.0f32; 2 * ETA_NODES];
+        for (pair, e) in eta.chunks_exact_mut(2).zip(&self.eta) {
+            pair.copy_from_slice(&[e.re, e.im]);
+        }
+        v.array("eta", &[ETA_NODES, 2], &eta);
+        v.scalar("eta_first", f64::from(ETA_FIRST));
+        v.scalar("eta_step", f64::from(ETA_STEP));
+        v.scalar("white", if self.white { 1.0 } else { 0.0 });
     }
 
     /// λ clamped to [0.36, 0.83] µm (NaN → 0.36).
