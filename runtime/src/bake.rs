@@ -113,8 +113,8 @@ pub trait BakeVisitor {
 /// One direction's quantities at one wavelength (module documentation).
 #[derive(Clone, Debug, FromZeros)]
 pub(crate) struct DirectionBake {
-    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E]` per node: what `eval`
-    /// reads, in one row (`1 − E(μ)` of T6 for the compensation lobe, 0
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E_s]` per node: what `eval`
+    /// reads, in one row (`1 − E_s(μ)`, the white albedo the compensation lobe puts back, 0
     /// when it is off).
     rows: [[f32; ROW]; MU_NODES],
     /// `[w_spec, w_diff, w_base, w_ms]` per node: what the sampler and `pdf` read.
@@ -144,7 +144,7 @@ impl DirectionCell {
 /// Interpolated [`DirectionBake`] row at one `cos θ`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirectionValues {
-    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E]`.
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E_s]`.
     pub v: [f32; ROW],
 }
 
@@ -168,7 +168,7 @@ impl DirectionValues {
         f64::from(self.v[5])
     }
 
-    /// `1 − E(μ)`, the light single scattering loses (0 unless the
+    /// `1 − E_s(μ)`, the light single scattering loses (0 unless the
     /// compensation lobe is on).
     #[inline]
     pub fn lost(&self) -> f64 {
@@ -184,7 +184,7 @@ impl DirectionBake {
     /// Tabulates in place F and Q̄'s factors of `eta` (when `q` is given) and
     /// σrel/σs of the spectrum `(B, c)` from T2; the lobe weights are
     /// cleared (set them with [`DirectionBake::set_lobe_weights`]), and so is
-    /// `1 − E` (set it with [`DirectionBake::set_albedo`]).
+    /// `1 − E_s` (set it with [`DirectionBake::set_albedo`]).
     pub fn init(
         &mut self,
         eta: Complex,
@@ -227,11 +227,11 @@ impl DirectionBake {
         bake
     }
 
-    /// Stores `1 − E(μ)` at the nodes from `albedo(μ)` (clamped to
+    /// Stores `1 − E_s(μ)` at the nodes from `albedo(μ)` (clamped to
     /// [0, 1]) and returns `E_avg = 2 ∫₀¹ E μ dμ` of the stored values as
     /// `eval` interpolates them (linear in `√μ`,
     /// [`crate::albedo::cosine_weighted_mean`]), so that the compensation lobe
-    /// `∝ (1 − E(μi)) (1 − E(μo)) / (1 − E_avg)` integrates exactly.
+    /// `∝ (1 − E_s(μi)) (1 − E_s(μo)) / (1 − E_avg)` integrates exactly.
     pub fn set_albedo(&mut self, albedo: impl Fn(f64) -> f32) -> f64 {
         for (k, row) in self.rows.iter_mut().enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;

@@ -17,12 +17,12 @@
 //! light that single scattering loses (docs/model.md §2.11):
 //!
 //! ```text
-//! ρ_ms    = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))
+//! ρ_ms    = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))
 //! F_ms    = F_avg² E_avg / (1 − F_avg (1 − E_avg)),   F_avg = 2 ∫ F(η, μ) μ dμ
 //! ```
 //!
-//! with E the directional albedo of the specular lobe for F = 1 (T6,
-//! [`AlbedoTable`]).
+//! with E_s the white albedo (F = Q̄ = 1) of the specular peak and the halo:
+//! T6's E ([`AlbedoTable`]) plus the halo's deficit, computed per material.
 //!
 //! `σrel = σrel(θi)` comes from T2 ([`SigmaRatioTable`]), D and G from the EPD
 //! distribution ([`Epd`], T1), `C` from any [`Convolution`] (the T3 tables, or
@@ -229,8 +229,9 @@ pub enum MultipleScattering {
     None,
     /// A Kulla–Conty energy-compensation lobe (a fourth, diffuse-like lobe,
     /// [`Lobe::Multiple`]):
-    /// `ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))`, E from T6,
-    /// `F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))`.
+    /// `ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))`, `E_s`
+    /// the white albedo of the specular peak and the halo (T6's E plus the
+    /// halo's deficit), `F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))`.
     KullaConty,
 }
 
@@ -438,7 +439,7 @@ pub struct TwoScale<'a, B = ChannelBake> {
     lambertian: f64,
     /// `F_ms / (π (1 − E_avg))` of the compensation lobe (0 when off).
     multiple_scale: f64,
-    /// `F_ms`, the compensation lobe's albedo over `1 − E(μi)` (0 when off).
+    /// `F_ms`, the compensation lobe's albedo over `1 − E_s(μi)` (0 when off).
     multiple_colour: f64,
     options: Options,
     /// The per-material tables.
@@ -992,7 +993,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     fn lobes(&self, pair: &Pair) -> Lobes {
         let t = self.surface_terms(pair, self.white());
         let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
-        // ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
+        // ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
         let multiple = self.multiple_scale * t.at_i.lost() * t.at_o.lost();
         Lobes {
             specular: finite_or_zero(t.a_spec * t.rho_ct),
@@ -1136,7 +1137,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// E_s   = F(η, cos θi)         (1 with white colour terms)
     /// E_b   = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
     ///         (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
-    /// E_ms  = F_ms (1 − E(μi)), the compensation lobe's albedo (0 when off)
+    /// E_ms  = F_ms (1 − E_s(μi)), the compensation lobe's albedo (0 when off)
     /// w     ∝ [A_imp E_s, (1 − A_imp) E_s, E_b, E_ms]
     /// ```
     ///
@@ -1176,7 +1177,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 BaseLayer::Subsurface { albedo } => into * f64::from(albedo),
             };
         }
-        // ∫ ρ_ms cos θo dωo = F_ms (1 − E(μi)): π (1 − E_avg) cancels.
+        // ∫ ρ_ms cos θo dωo = F_ms (1 − E_s(μi)): π (1 − E_avg) cancels.
         let e_ms = self.multiple_colour * at_i.lost();
         let w = [a_imp * e_s, (1.0 - a_imp) * e_s, e_b, e_ms];
         let total = w[0] + w[1] + w[2] + w[3];
