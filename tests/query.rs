@@ -6,13 +6,19 @@ use generator::reference::epd;
 use generator::rng::SplitMix64;
 use generator::table_source::TableSource;
 
-fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
+/// The answer, output and errors of query `quantity` over `input` with the
+/// committed tables.
+fn run_with(
+    quantity: &str,
+    options: &query::Options,
+    input: &str,
+) -> (Result<query::Summary, query::QueryError>, String, String) {
     let mut out = Vec::new();
     let mut err = Vec::new();
     let result = query::run(
-        "g1",
+        quantity,
         &TableSource::Dir(suite::tables_dir()),
-        &query::Options::default(),
+        options,
         input.as_bytes(),
         &mut out,
         &mut err,
@@ -22,6 +28,22 @@ fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, Strin
         String::from_utf8(out).unwrap(),
         String::from_utf8(err).unwrap(),
     )
+}
+
+/// The f64 reference's ρ of `params` at the pair `(i, o)`.
+fn reference_total(
+    params: &generator::reference::brdf::Params,
+    i: [f32; 3],
+    o: [f32; 3],
+    options: &twoscale::brdf::Options,
+) -> f64 {
+    generator::reference::brdf::two_scale(params, i.map(f64::from), o.map(f64::from), options)
+        .unwrap()
+        .total()
+}
+
+fn run(input: &str) -> (Result<query::Summary, query::QueryError>, String, String) {
+    run_with("g1", &query::Options::default(), input)
 }
 
 #[test]
@@ -167,28 +189,13 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
     use twoscale::desc::MaterialDesc;
     let text = "[material]\nbeta = 0.2\np = 1.3\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n\
                 sigma_s = 0.03\nb = 2.0\nc = 2.5\nsigma_rel = \"symmetrised\"\n";
-    let desc = MaterialDesc::from_toml_str(text).unwrap();
+    let owned = MaterialDesc::from_toml_str(text).unwrap();
+    let desc = owned.get();
     let options = query::Options {
-        material: Some(desc),
+        material: Some(owned.clone()),
         ..query::Options::default()
     };
-    let source = TableSource::Dir(suite::tables_dir());
-    let run = |quantity: &str, options: &query::Options, input: &str| {
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let result = query::run(
-            quantity,
-            &source,
-            options,
-            input.as_bytes(),
-            &mut out,
-            &mut err,
-        );
-        (
-            result,
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-        )
-    };
+    let run = run_with;
     let pairs = [
         ([0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
         ([0.1, 0.2, 0.97], [-0.3, -0.1, 0.95]),
@@ -226,14 +233,7 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
         let table: f32 = fields[7].parse().unwrap();
         assert_eq!(table.to_bits(), model.eval(i, o)[ch].to_bits(), "{row}");
         let reference: f64 = fields[8].parse().unwrap();
-        let want = generator::reference::brdf::two_scale(
-            &params[ch],
-            i.map(f64::from),
-            o.map(f64::from),
-            &desc.options,
-        )
-        .unwrap()
-        .total();
+        let want = reference_total(&params[ch], i, o, &desc.options);
         assert_eq!(reference, want, "{row}");
     }
     let (result, ..) = run("g1", &options, "p,a\n1,1\n");
@@ -254,7 +254,7 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
     let message = result.unwrap_err().to_string();
     let uncovered = "--material: the f64 reference covers conductors without a Lambertian \
                      term, and their energy compensation (multiple_scattering) without \
-                     diffraction (sigma_s = 0)";
+                     diffraction (sigma_s = 0) at the paper's wavelengths";
     assert_eq!(message, uncovered);
     // The energy compensation of a surface with diffraction is refused too.
     let halo =
@@ -316,4 +316,99 @@ fn brdf_of_a_compensated_material() {
         );
     }
     eprintln!("compensated material: max relative |table − reference| = {worst:.2e}");
+    // Rows over the spectrum: the reference's lobe is per channel, so refused.
+    let one_index = "[material]\nbeta = 0.6\np = 0.6\neta = [[0.2, 3.0], [0.2, 3.0], [0.2, 3.0]]\n\
+                     multiple_scattering = \"kulla-conty\"\n";
+    let options = query::Options {
+        material: Some(MaterialDesc::from_toml_str(one_index).unwrap()),
+        ..query::Options::default()
+    };
+    let (result, ..) = run_with("brdf", &options, "lambda,ix,iy,iz,ox,oy,oz\n");
+    assert!(
+        matches!(result, Err(query::QueryError::Uncovered(_))),
+        "{result:?}"
+    );
+}
+
+/// `query brdf --material FILE` with a `lambda` column: `table` is the
+/// spectral model (`brdf::Spectral`) of the file's index at that
+/// wavelength, bit for bit, and `reference` the f64 reference at λ with the
+/// index interpolated there; λ outside [0.36, 0.83] µm is a bad row, and a
+/// material without a spectrum, or with `rgb_mode = "integrated"` and
+/// `channel` rows, is refused before any row.
+#[test]
+fn brdf_with_a_lambda_column_is_the_spectral_model() {
+    use twoscale::desc::MaterialDesc;
+    let text = "[material]\nbeta = 0.2\np = 1.3\n\
+                eta = { lambda = [0.4, 0.5, 0.7], n = [1.4, 0.8, 0.2], k = [1.9, 2.2, 4.0] }\n\
+                sigma_s = 0.03\nb = 2.0\nc = 2.5\nrgb_mode = \"integrated\"\n";
+    let owned = MaterialDesc::from_toml_str(text).unwrap();
+    let desc = owned.get();
+    let spectral = desc.spectral.unwrap();
+    let run = |material: MaterialDesc<'_>, input: &str| {
+        let options = query::Options {
+            material: Some(material.to_owned_desc()),
+            ..query::Options::default()
+        };
+        run_with("brdf", &options, input)
+    };
+    let rows = [
+        (0.45f32, [0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
+        (0.62, [0.1, 0.2, 0.97], [-0.3, -0.1, 0.95]),
+        (0.38, [0.8, 0.0, 0.6], [-0.7, 0.3, 0.648]),
+    ];
+    let mut input = String::from("lambda,ix,iy,iz,ox,oy,oz\n");
+    for (lambda, i, o) in rows {
+        let v: Vec<String> = i
+            .iter()
+            .chain(&o)
+            .map(|x| f64::from(*x).to_string())
+            .collect();
+        input.push_str(&format!("{},{}\n", f64::from(lambda), v.join(",")));
+    }
+    input.push_str("0.9,0,0,1,0,0,1\n");
+    let (result, out, err) = run(desc, &input);
+    assert_eq!(
+        result.unwrap(),
+        query::Summary {
+            answered: 3,
+            bad: 1
+        }
+    );
+    assert!(
+        err.contains("line 5: lambda = 0.9: must be in [0.36, 0.83]"),
+        "{err}"
+    );
+    let set = twoscale::TableSet::open(suite::tables_dir()).unwrap();
+    let tables = set.set().brdf_tables();
+    let model = twoscale::brdf::Spectral::boxed(&tables, &spectral, desc.options);
+    let params = generator::reference::brdf::Params::rgb(&desc.material).unwrap()[0];
+    for (row, (lambda, i, o)) in out.lines().skip(1).zip(rows) {
+        let fields: Vec<&str> = row.split(',').collect();
+        let table: f32 = fields[7].parse().unwrap();
+        assert_eq!(table.to_bits(), model.eval(i, o, lambda).to_bits(), "{row}");
+        let eta = spectral.eta.at(lambda);
+        let at = generator::reference::brdf::Params {
+            n: eta.re.into(),
+            k: eta.im.into(),
+            lambda: lambda.into(),
+            ..params
+        };
+        let reference: f64 = fields[8].parse().unwrap();
+        let want = reference_total(&at, i, o, &desc.options);
+        assert_eq!(reference, want, "{row}");
+        // The model is within 3% of the reference at this λ.
+        assert!((f64::from(table) / want - 1.0).abs() < 0.03, "{row}");
+    }
+    let (result, ..) = run(desc, "channel,ix,iy,iz,ox,oy,oz\n");
+    assert!(matches!(
+        result,
+        Err(query::QueryError::IntegratedUnsupported)
+    ));
+    let rgb = MaterialDesc::from_toml_str(
+        "[material]\nbeta = 0.2\np = 1\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n",
+    )
+    .unwrap();
+    let (result, ..) = run(rgb.get(), "lambda,ix,iy,iz,ox,oy,oz\n");
+    assert!(matches!(result, Err(query::QueryError::NoSpectrum)));
 }

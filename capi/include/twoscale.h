@@ -149,7 +149,21 @@
 #define TS_MULTIPLE_KULLA_CONTY 1
 
 /**
- * An RGB material built from a `ts_tables`. Opaque; about 136 KB, on the heap.
+ * `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
+ * (`ts_rgb_wavelengths`) as red, green, blue (the default).
+ */
+#define TS_RGB_MODE_PAPER_WAVELENGTHS 0
+
+/**
+ * `ts_material_desc.rgb_mode`: linear sRGB by integration over the
+ * spectrum (docs/model.md §2.12); needs `eta_rows`, or one index for
+ * every channel.
+ */
+#define TS_RGB_MODE_INTEGRATED 1
+
+/**
+ * An RGB material built from a `ts_tables`. Opaque; about 136 KB (360 KB
+ * with `TS_RGB_MODE_INTEGRATED`), on the heap.
  */
 typedef struct ts_material ts_material;
 
@@ -256,13 +270,26 @@ typedef struct {
   float lambertian;
   /**
    * Real part n of the index per channel, at the wavelengths of
-   * `ts_rgb_wavelengths`.
+   * `ts_rgb_wavelengths` (not read when `eta_rows` is given).
    */
   float eta_re[3];
   /**
-   * Imaginary part k of the index per channel.
+   * Imaginary part k of the index per channel (not read when `eta_rows`
+   * is given).
    */
   float eta_im[3];
+  /**
+   * The index over the spectrum, or NULL: `eta_row_count` rows of three
+   * floats `(λ µm, n, k)`, λ increasing (linear in 1/λ between rows,
+   * held beyond the ends). `ts_material_new` copies them. The channels'
+   * index is then the spectrum at `ts_rgb_wavelengths`. Presets
+   * (`ts_material_desc_preset`) point to their measured rows.
+   */
+  const float *eta_rows;
+  /**
+   * Number of rows of `eta_rows` (0 when it is NULL).
+   */
+  uintptr_t eta_row_count;
   /**
    * `TS_MASKING_*`.
    */
@@ -283,6 +310,10 @@ typedef struct {
    * `TS_MULTIPLE_*`.
    */
   int32_t multiple_scattering;
+  /**
+   * `TS_RGB_MODE_*`.
+   */
+  int32_t rgb_mode;
 } ts_material_desc;
 
 /**
@@ -390,7 +421,8 @@ int ts_rgb_wavelengths(float *out);
 /**
  * Fills `out` with preset `name`'s parameters and the default options, and
  * `out->size` with `sizeof(ts_material_desc)` (a starting point for
- * `ts_material_new`).
+ * `ts_material_new`); `out->eta_rows` points to the preset's measured
+ * index (static storage).
  *
  * # Safety
  *
@@ -406,8 +438,10 @@ int ts_material_desc_preset(const char *name,
  * optionally `sigma_s`, `b`, `c`, `base`, `albedo`, `lambertian`,
  * `masking`, `sigma_rel`, `colour`, `halo_weight`) and an optional
  * `[metrics]` table, not read (what `python -m twoscale.fit` writes;
- * docs/fitting.md). `TS_ERR_PARSE`: not TOML, or an unknown, missing or
- * mistyped key; `TS_ERR_INVALID`: a value outside its domain. The message
+ * docs/fitting.md; also `rgb_mode`). `TS_ERR_PARSE`: not TOML, or an
+ * unknown, missing or mistyped key; `TS_ERR_INVALID`: a value outside its
+ * domain, or `eta = { lambda, n, k }` (a spectrum: its rows would not
+ * outlive the call; give them in `eta_rows` instead). The message
  * is the one Rust and Python give for the same text. `out` is left
  * unchanged on failure.
  *

@@ -21,14 +21,15 @@ use std::sync::{Arc, OnceLock};
 
 use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material,
-    MultipleScattering, Options, RGB_WAVELENGTHS, Rgb, SigmaRelMode, Surface,
+    MultipleScattering, Options, RGB_WAVELENGTHS, RgbMode, RgbModel, SigmaRelMode, Surface,
 };
 use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
-use twoscale::optical::SpectralMaterial;
+use twoscale::optical::{Ior, OwnedSpectralMaterial, Tabulated};
 use twoscale::table_set::TABLES;
+use twoscale::validate::Refused;
 use twoscale::validate::{self, Domain, Invalid};
 use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
 
@@ -81,20 +82,28 @@ pub const TS_MULTIPLE_NONE: i32 = 0;
 /// `ts_material_desc.multiple_scattering`: the Kulla–Conty energy-compensation
 /// lobe (docs/model.md §2.11).
 pub const TS_MULTIPLE_KULLA_CONTY: i32 = 1;
+/// `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
+/// (`ts_rgb_wavelengths`) as red, green, blue (the default).
+pub const TS_RGB_MODE_PAPER_WAVELENGTHS: i32 = 0;
+/// `ts_material_desc.rgb_mode`: linear sRGB by integration over the
+/// spectrum (docs/model.md §2.12); needs `eta_rows`, or one index for
+/// every channel.
+pub const TS_RGB_MODE_INTEGRATED: i32 = 1;
 
 /// A validated set of the four tables (T1, T2, T3, T5). Opaque.
 pub struct ts_tables {
     inner: Arc<OwnedTableSet>,
 }
 
-/// An RGB material built from a `ts_tables`. Opaque; about 136 KB, on the heap.
+/// An RGB material built from a `ts_tables`. Opaque; about 136 KB (360 KB
+/// with `TS_RGB_MODE_INTEGRATED`), on the heap.
 pub struct ts_material {
     /// Borrows `_tables` (declared after it, so dropped before it); its
     /// bakes are allocated zeroed on the heap and filled in place.
-    rgb: Rgb<'static, Box<ChannelBake>>,
-    /// The index over the spectrum (a preset's measured one, or the one
-    /// index of a description that gives the same for every channel).
-    spectral: Option<SpectralMaterial<'static>>,
+    rgb: RgbModel<'static, Box<ChannelBake>>,
+    /// The index over the spectrum (`eta_rows`, a preset's measured one, or
+    /// the one index of a description that gives the same for every channel).
+    spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first
     /// `ts_eval_spectral`; borrows `_tables` as `rgb` does.
     spectral_model: OnceLock<Spectral<'static, Box<ChannelBake>>>,
@@ -160,10 +169,19 @@ pub struct ts_material_desc {
     /// Lambertian reflectance `k_d` in [0, 1] (adds `k_d/π`; 0 for none).
     pub lambertian: f32,
     /// Real part n of the index per channel, at the wavelengths of
-    /// `ts_rgb_wavelengths`.
+    /// `ts_rgb_wavelengths` (not read when `eta_rows` is given).
     pub eta_re: [f32; 3],
-    /// Imaginary part k of the index per channel.
+    /// Imaginary part k of the index per channel (not read when `eta_rows`
+    /// is given).
     pub eta_im: [f32; 3],
+    /// The index over the spectrum, or NULL: `eta_row_count` rows of three
+    /// floats `(λ µm, n, k)`, λ increasing (linear in 1/λ between rows,
+    /// held beyond the ends). `ts_material_new` copies them. The channels'
+    /// index is then the spectrum at `ts_rgb_wavelengths`. Presets
+    /// (`ts_material_desc_preset`) point to their measured rows.
+    pub eta_rows: *const f32,
+    /// Number of rows of `eta_rows` (0 when it is NULL).
+    pub eta_row_count: usize,
     /// `TS_MASKING_*`.
     pub masking: i32,
     /// `TS_SIGMA_REL_*`.
@@ -174,6 +192,8 @@ pub struct ts_material_desc {
     pub halo_weight: i32,
     /// `TS_MULTIPLE_*`.
     pub multiple_scattering: i32,
+    /// `TS_RGB_MODE_*`.
+    pub rgb_mode: i32,
 }
 
 impl Default for ts_material_desc {
@@ -191,11 +211,14 @@ impl Default for ts_material_desc {
             lambertian: 0.0,
             eta_re: [0.0; 3],
             eta_im: [0.0; 3],
+            eta_rows: std::ptr::null(),
+            eta_row_count: 0,
             masking: TS_MASKING_SEPARABLE,
             sigma_rel: TS_SIGMA_REL_INCIDENT,
             colour: TS_COLOUR_PHYSICAL,
             halo_weight: TS_HALO_PRINTED,
             multiple_scattering: TS_MULTIPLE_NONE,
+            rgb_mode: TS_RGB_MODE_PAPER_WAVELENGTHS,
         }
     }
 }
@@ -384,6 +407,10 @@ fn invalid(error: Invalid) -> Fail {
         "eta[0].k" => "eta_im[0]",
         "eta[1].k" => "eta_im[1]",
         "eta[2].k" => "eta_im[2]",
+        "rows" => "eta_row_count",
+        "lambda" => "eta_rows[].lambda",
+        "n" => "eta_rows[].n",
+        "k" => "eta_rows[].k",
         name => name,
     };
     Fail::new(
@@ -416,11 +443,24 @@ fn constant<T: Copy>(field: &str, value: i32, choices: &[(&str, i32, T)]) -> Res
     ))
 }
 
+/// A refused description as `TS_ERR_INVALID`, naming the field.
+fn refused(error: Refused<'_>) -> Fail {
+    match error {
+        Refused::Invalid(e) => invalid(e),
+        e => Fail::new(TS_ERR_INVALID, format!("ts_material_desc: {e}")),
+    }
+}
+
 impl ts_material_desc {
-    /// The runtime's material and options: unknown enumeration values and
-    /// what `Material::validate` rejects (non-finite numbers among them) are
-    /// `TS_ERR_INVALID`, naming the field.
-    fn to_model(self) -> Result<(Material, Options), Fail> {
+    /// The runtime's material description: unknown enumeration values and
+    /// what `Material::validate` or `SpectralMaterial::validate` rejects
+    /// (non-finite numbers among them) are `TS_ERR_INVALID`, naming the
+    /// field.
+    ///
+    /// # Safety
+    ///
+    /// `eta_rows` is NULL or holds `3 eta_row_count` floats, valid for `'a`.
+    unsafe fn to_model<'a>(self) -> Result<MaterialDesc<'a>, Fail> {
         let albedo = self.base_albedo;
         let base = constant(
             "base",
@@ -535,12 +575,70 @@ impl ts_material_desc {
             )
             .map_err(invalid)?;
         }
-        material.validate().map_err(invalid)?;
-        Ok((material, options))
+        let rgb_mode = constant(
+            "rgb_mode",
+            self.rgb_mode,
+            &[
+                (
+                    "TS_RGB_MODE_PAPER_WAVELENGTHS",
+                    TS_RGB_MODE_PAPER_WAVELENGTHS,
+                    RgbMode::PaperWavelengths,
+                ),
+                (
+                    "TS_RGB_MODE_INTEGRATED",
+                    TS_RGB_MODE_INTEGRATED,
+                    RgbMode::Integrated,
+                ),
+            ],
+        )?;
+        if self.eta_rows.is_null() {
+            if self.eta_row_count != 0 {
+                return Err(Fail::new(
+                    TS_ERR_INVALID,
+                    format!(
+                        "ts_material_desc.eta_row_count = {} with eta_rows NULL: must be 0",
+                        self.eta_row_count
+                    ),
+                ));
+            }
+            return MaterialDesc::rgb(material, options, rgb_mode).map_err(refused);
+        }
+        if !self.eta_rows.is_aligned() {
+            return Err(Fail::new(
+                TS_ERR_MISALIGNED,
+                "ts_material_desc.eta_rows is misaligned",
+            ));
+        }
+        if self.eta_row_count > isize::MAX as usize / size_of::<[f32; 3]>() {
+            return Err(Fail::new(
+                TS_ERR_INVALID,
+                format!(
+                    "ts_material_desc.eta_row_count = {} overflows",
+                    self.eta_row_count
+                ),
+            ));
+        }
+        // SAFETY: non-null, aligned, and by the caller's contract `3 count`
+        // readable floats; `[f32; 3]` has the alignment of `f32`.
+        let rows: &'a [[f32; 3]] = unsafe {
+            std::slice::from_raw_parts(self.eta_rows.cast::<[f32; 3]>(), self.eta_row_count)
+        };
+        let eta = Ior::Tabulated(Tabulated::new(rows).map_err(invalid)?);
+        let spectral = twoscale::optical::SpectralMaterial {
+            layer: material.layer,
+            eta,
+        };
+        MaterialDesc::spectral(spectral, options, rgb_mode).map_err(refused)
     }
 
-    /// The description of `material` with `options`.
-    fn from_model(material: &Material, options: Options) -> ts_material_desc {
+    /// The description of `desc`; its rows (if a spectrum is tabulated)
+    /// must outlive the description: the presets' static ones.
+    fn from_model(desc: &MaterialDesc<'static>) -> ts_material_desc {
+        let (material, options) = (&desc.material, desc.options);
+        let (eta_rows, eta_row_count) = match desc.spectral.map(|s| s.eta) {
+            Some(Ior::Tabulated(t)) => (t.rows().as_ptr().cast::<f32>(), t.rows().len()),
+            _ => (std::ptr::null(), 0),
+        };
         let (base, base_albedo) = match material.layer.base {
             BaseLayer::Conductor => (TS_BASE_CONDUCTOR, 0.0),
             BaseLayer::Plastic { albedo } => (TS_BASE_PLASTIC, albedo),
@@ -559,6 +657,8 @@ impl ts_material_desc {
             lambertian: material.layer.lambertian,
             eta_re: material.eta_rgb.map(|eta| eta.re),
             eta_im: material.eta_rgb.map(|eta| eta.im),
+            eta_rows,
+            eta_row_count,
             masking: match options.masking {
                 Masking::Separable => TS_MASKING_SEPARABLE,
                 Masking::HeightCorrelated => TS_MASKING_HEIGHT_CORRELATED,
@@ -579,6 +679,10 @@ impl ts_material_desc {
                 MultipleScattering::None => TS_MULTIPLE_NONE,
                 MultipleScattering::KullaConty => TS_MULTIPLE_KULLA_CONTY,
             },
+            rgb_mode: match desc.rgb_mode {
+                RgbMode::PaperWavelengths => TS_RGB_MODE_PAPER_WAVELENGTHS,
+                RgbMode::Integrated => TS_RGB_MODE_INTEGRATED,
+            },
         }
     }
 }
@@ -589,31 +693,23 @@ fn new_tables(tables: OwnedTableSet) -> Box<ts_tables> {
     })
 }
 
-/// Builds the material handle of `material` from the set behind `t`.
-fn new_material(t: &ts_tables, material: &Material, options: Options) -> Box<ts_material> {
-    let spectral = SpectralMaterial::with_one_index(material);
-    new_material_with(t, material, options, spectral)
-}
-
-fn new_material_with(
-    t: &ts_tables,
-    material: &Material,
-    options: Options,
-    spectral: Option<SpectralMaterial<'static>>,
-) -> Box<ts_material> {
-    let rgb = Rgb::boxed(&t.inner.set().brdf_tables(), material, options);
+/// Builds the material handle of `desc` from the set behind `t`.
+fn new_material(t: &ts_tables, desc: &MaterialDesc<'_>) -> Box<ts_material> {
+    let rgb = RgbModel::boxed(&t.inner.set().brdf_tables(), desc);
     // SAFETY: `rgb` borrows only the `TableSet` inside the `Arc` allocation
     // (which never moves) and, through it, the table storage it owns. The
     // handle keeps a clone of that `Arc` in `_tables`, dropped after `rgb`
     // (field order), so the borrow never dangles.
     let rgb = unsafe {
-        std::mem::transmute::<Rgb<'_, Box<ChannelBake>>, Rgb<'static, Box<ChannelBake>>>(rgb)
+        std::mem::transmute::<RgbModel<'_, Box<ChannelBake>>, RgbModel<'static, Box<ChannelBake>>>(
+            rgb,
+        )
     };
     Box::new(ts_material {
         rgb,
-        spectral,
+        spectral: desc.spectral.as_ref().map(OwnedSpectralMaterial::new),
         spectral_model: OnceLock::new(),
-        options,
+        options: desc.options,
         _tables: Arc::clone(&t.inner),
     })
 }
@@ -780,7 +876,8 @@ pub unsafe extern "C" fn ts_rgb_wavelengths(out: *mut f32) -> c_int {
 
 /// Fills `out` with preset `name`'s parameters and the default options, and
 /// `out->size` with `sizeof(ts_material_desc)` (a starting point for
-/// `ts_material_new`).
+/// `ts_material_new`); `out->eta_rows` points to the preset's measured
+/// index (static storage).
 ///
 /// # Safety
 ///
@@ -792,16 +889,34 @@ pub unsafe extern "C" fn ts_material_desc_preset(
 ) -> c_int {
     status(|| {
         let name = utf8(name, "name")?;
-        let material = twoscale::materials::preset(name).ok_or_else(|| {
-            Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name })
-        })?;
-        let desc = MaterialDesc {
-            material,
-            options: Options::default(),
-        };
+        let desc = preset_desc(name)?;
         // SAFETY: forwarded caller contract.
         unsafe { write_desc(out, &desc) }
     })
+}
+
+/// Preset `name` over the spectrum with the default options.
+fn preset_desc(name: &str) -> Result<MaterialDesc<'static>, Fail> {
+    let spectral = twoscale::materials::spectral(name)
+        .ok_or_else(|| Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name }))?;
+    MaterialDesc::spectral(spectral, Options::default(), RgbMode::default()).map_err(refused)
+}
+
+/// The description of a material file: refused when it gives a tabulated
+/// spectrum, whose rows a `ts_material_desc` cannot own.
+fn file_desc(desc: &twoscale::desc::OwnedMaterialDesc) -> Result<MaterialDesc<'static>, Fail> {
+    let desc = desc.get();
+    match desc.spectral.map(|s| s.eta) {
+        Some(Ior::Tabulated(_)) => Err(Fail::new(
+            TS_ERR_INVALID,
+            "a material file with eta = { lambda, n, k } does not fit in a ts_material_desc \
+             (it would not own the rows): set eta_rows and eta_row_count yourself",
+        )),
+        _ => Ok(MaterialDesc {
+            spectral: None,
+            ..desc
+        }),
+    }
 }
 
 /// Writes `desc` to `out` (checked: not NULL, aligned).
@@ -809,12 +924,12 @@ pub unsafe extern "C" fn ts_material_desc_preset(
 /// # Safety
 ///
 /// `out` is NULL or writable.
-unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc) -> Result<(), Fail> {
+unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc<'static>) -> Result<(), Fail> {
     non_null(out, "out")?;
     if !out.is_aligned() {
         return Err(Fail::new(TS_ERR_MISALIGNED, "out is misaligned"));
     }
-    let desc = ts_material_desc::from_model(&desc.material, desc.options);
+    let desc = ts_material_desc::from_model(desc);
     // SAFETY: non-null, aligned, writable by the caller's contract.
     unsafe { out.write(desc) };
     Ok(())
@@ -826,8 +941,10 @@ unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc) -> Result<
 /// optionally `sigma_s`, `b`, `c`, `base`, `albedo`, `lambertian`,
 /// `masking`, `sigma_rel`, `colour`, `halo_weight`) and an optional
 /// `[metrics]` table, not read (what `python -m twoscale.fit` writes;
-/// docs/fitting.md). `TS_ERR_PARSE`: not TOML, or an unknown, missing or
-/// mistyped key; `TS_ERR_INVALID`: a value outside its domain. The message
+/// docs/fitting.md; also `rgb_mode`). `TS_ERR_PARSE`: not TOML, or an
+/// unknown, missing or mistyped key; `TS_ERR_INVALID`: a value outside its
+/// domain, or `eta = { lambda, n, k }` (a spectrum: its rows would not
+/// outlive the call; give them in `eta_rows` instead). The message
 /// is the one Rust and Python give for the same text. `out` is left
 /// unchanged on failure.
 ///
@@ -841,7 +958,7 @@ pub unsafe extern "C" fn ts_material_desc_from_toml(
 ) -> c_int {
     status(|| {
         let text = utf8(toml, "toml")?;
-        let desc = MaterialDesc::from_toml_str(text)?;
+        let desc = file_desc(&MaterialDesc::from_toml_str(text)?)?;
         // SAFETY: forwarded caller contract.
         unsafe { write_desc(out, &desc) }
     })
@@ -861,7 +978,7 @@ pub unsafe extern "C" fn ts_material_desc_from_toml_file(
     status(|| {
         // SAFETY: forwarded caller contract.
         let path = unsafe { self::path(path, "path")? };
-        let desc = MaterialDesc::from_toml_file(path)?;
+        let desc = file_desc(&MaterialDesc::from_toml_file(path)?)?;
         // SAFETY: forwarded caller contract.
         unsafe { write_desc(out, &desc) }
     })
@@ -881,17 +998,10 @@ pub unsafe extern "C" fn ts_material_preset(
     handle(|| {
         non_null(t, "the tables")?;
         let name = utf8(name, "name")?;
-        let spectral = twoscale::materials::spectral(name).ok_or_else(|| {
-            Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name })
-        })?;
+        let desc = preset_desc(name)?;
         // SAFETY: non-null, a live handle by the caller's contract.
         let t = unsafe { &*t };
-        Ok(new_material_with(
-            t,
-            &spectral.paper_rgb(),
-            Options::default(),
-            Some(spectral),
-        ))
+        Ok(new_material(t, &desc))
     })
 }
 
@@ -931,13 +1041,15 @@ pub unsafe extern "C" fn ts_material_new(
             ));
         }
         // SAFETY: as above, and `size` says the caller's struct is this
-        // layout; every field is a plain number, so any bit pattern is a
-        // valid value.
+        // layout; every field is a plain number or a raw pointer, so any bit
+        // pattern is a valid value.
         let desc = unsafe { desc.read() };
-        let (material, options) = desc.to_model()?;
+        // SAFETY: the caller's contract: `eta_rows` NULL or readable rows,
+        // used only within this call (`new_material` copies them).
+        let desc = unsafe { desc.to_model()? };
         // SAFETY: non-null, a live handle by the caller's contract.
         let t = unsafe { &*t };
-        Ok(new_material(t, &material, options))
+        Ok(new_material(t, &desc))
     })
 }
 
@@ -1022,11 +1134,11 @@ pub unsafe extern "C" fn ts_eval_spectral(
         let Some(spectral) = &m.spectral else {
             return Err(Fail::new(
                 TS_ERR_INVALID,
-                "ts_eval_spectral needs an index over the spectrum: a preset, or one (n, k) for every channel",
+                "ts_eval_spectral needs an index over the spectrum: a preset, eta_rows, or one (n, k) for every channel",
             ));
         };
         let model = m.spectral_model.get_or_init(|| {
-            let model = Spectral::boxed(&m._tables.set().brdf_tables(), spectral, m.options);
+            let model = Spectral::boxed(&m._tables.set().brdf_tables(), &spectral.get(), m.options);
             // SAFETY: as in `new_material_with`: the model borrows only the
             // `TableSet` inside the `Arc` the handle keeps (`_tables`,
             // declared after `spectral_model`, so dropped after it).
@@ -1241,9 +1353,20 @@ mod tests {
         assert_eq!(all_options.len(), 32);
         for (name, material) in PRESETS {
             for options in &all_options {
-                let desc = ts_material_desc::from_model(&material, *options);
-                let (back, back_options) = desc.to_model().ok().expect(name);
-                assert_eq!((back, back_options), (material, *options), "{name}");
+                for rgb_mode in [RgbMode::PaperWavelengths, RgbMode::Integrated] {
+                    let want = MaterialDesc {
+                        options: *options,
+                        rgb_mode,
+                        ..preset_desc(name).ok().expect(name)
+                    };
+                    let desc = ts_material_desc::from_model(&want);
+                    let constant = matches!(want.spectral.map(|s| s.eta), Some(Ior::Constant(_)));
+                    assert_eq!(desc.eta_rows.is_null(), constant, "{name}");
+                    // SAFETY: the preset's static rows.
+                    let back = unsafe { desc.to_model() }.ok().expect(name);
+                    assert_eq!(back, want, "{name}");
+                    assert_eq!(back.material, material, "{name}");
+                }
             }
         }
         // Zeroed enumeration fields are the defaults; zeroed numbers are not
@@ -1255,10 +1378,15 @@ mod tests {
             eta_re: [1.5; 3],
             ..ts_material_desc::default()
         };
-        let (material, options) = zero.to_model().ok().expect("zeroed enumerations");
-        assert_eq!(options, Options::default());
-        assert_eq!(material.layer.base, BaseLayer::Conductor);
-        let Err(Fail(code, message)) = ts_material_desc::default().to_model() else {
+        // SAFETY: no rows.
+        let desc = unsafe { zero.to_model() }
+            .ok()
+            .expect("zeroed enumerations");
+        assert_eq!(desc.options, Options::default());
+        assert_eq!(desc.rgb_mode, RgbMode::PaperWavelengths);
+        assert_eq!(desc.material.layer.base, BaseLayer::Conductor);
+        // SAFETY: no rows.
+        let Err(Fail(code, message)) = (unsafe { ts_material_desc::default().to_model() }) else {
             panic!("β = 0 accepted");
         };
         assert_eq!(code, TS_ERR_INVALID);
@@ -1273,9 +1401,10 @@ mod tests {
     #[test]
     fn out_of_domain_descriptions_are_rejected() {
         let gold = twoscale::materials::preset("gold-rough").expect("preset");
-        let base = ts_material_desc::from_model(&gold, Options::default());
+        let gold = MaterialDesc::rgb(gold, Options::default(), RgbMode::default()).expect("valid");
+        let base = ts_material_desc::from_model(&gold);
         type Edit = fn(&mut ts_material_desc);
-        let cases: [(Edit, &str); 9] = [
+        let cases: [(Edit, &str); 14] = [
             (
                 |d| d.beta = -0.1,
                 "ts_material_desc.beta = -0.1: must be in",
@@ -1306,12 +1435,40 @@ mod tests {
                 "ts_material_desc.eta_re[2] = NaN",
             ),
             (|d| d.lambertian = 2.0, "ts_material_desc.lambertian = 2"),
+            (
+                |d| d.rgb_mode = TS_RGB_MODE_INTEGRATED,
+                "ts_material_desc: rgb_mode 'integrated' needs an index over the spectrum",
+            ),
+            (
+                |d| d.rgb_mode = 7,
+                "ts_material_desc.rgb_mode = 7 is not one of",
+            ),
+            (
+                |d| d.eta_row_count = 2,
+                "ts_material_desc.eta_row_count = 2 with eta_rows NULL",
+            ),
+            (
+                |d| {
+                    d.eta_rows = DECREASING.as_ptr().cast();
+                    d.eta_row_count = 2;
+                },
+                "ts_material_desc.eta_rows[].lambda = 0.4: must be finite and > 0.5",
+            ),
+            (
+                |d| {
+                    d.eta_rows = DECREASING.as_ptr().cast();
+                    d.eta_row_count = 0;
+                },
+                "ts_material_desc.eta_row_count = 0: must be",
+            ),
         ];
+        static DECREASING: [[f32; 3]; 2] = [[0.5, 1.0, 2.0], [0.4, 1.0, 2.0]];
         assert_eq!(base.base, TS_BASE_CONDUCTOR);
         for (edit, want) in cases {
             let mut desc = base;
             edit(&mut desc);
-            match desc.to_model() {
+            // SAFETY: NULL or static rows.
+            match unsafe { desc.to_model() } {
                 Err(Fail(code, message)) => {
                     assert_eq!(code, TS_ERR_INVALID, "{message}");
                     assert!(message.starts_with(want), "{message} (want {want})");
@@ -1334,7 +1491,8 @@ mod tests {
         let status = unsafe { ts_material_desc_from_toml(c_text.as_ptr(), &mut out) };
         assert_eq!(status, TS_OK);
         let want = MaterialDesc::from_toml_str(text).expect("valid");
-        assert_eq!(out.to_model().ok(), Some((want.material, want.options)));
+        // SAFETY: no rows.
+        assert_eq!(unsafe { out.to_model() }.ok(), Some(want.get()));
         let eta = "eta = [[1, 0], [1, 0], [1, 0]]";
         let cases = [
             (

@@ -210,7 +210,10 @@ enum Command {
         /// `[material]` table, what `python -m twoscale.fit` writes; a
         /// conductor without a Lambertian term, as the reference covers):
         /// the rows then give `channel,ix,iy,iz,ox,oy,oz` (channel 0, 1, 2:
-        /// red, green, blue) and `table` is the RGB model's channel.
+        /// red, green, blue) and `table` is the RGB model's channel, or
+        /// `lambda,ix,iy,iz,ox,oy,oz` (λ in [0.36, 0.83] µm) and `table` is
+        /// the spectral model at λ (for a material over the spectrum:
+        /// `eta = { lambda, n, k }`, or one (n, k) for every channel).
         #[arg(long, value_name = "FILE")]
         material: Option<PathBuf>,
     },

@@ -34,7 +34,7 @@ use std::fmt;
 use std::path::Path;
 use twoscale::Complex;
 use twoscale::brdf::{Layer, Options};
-use twoscale::desc::KeywordTable;
+use twoscale::desc::{EtaTable, KeywordTable};
 
 use crate::sh::BandFilter;
 
@@ -250,17 +250,18 @@ fn keywords(
     let err = |m: &dyn fmt::Display| MaterialsError(format!("material '{name}': {m}"));
     let keywords: KeywordTable = table.try_into().map_err(|e| err(&e))?;
     let (layer, options) = keywords.keywords().layer(channels).map_err(|e| err(&e))?;
-    if options != Options::default() {
+    if options != Options::default() || keywords.rgb_mode.is_some() {
         return Err(err(
             &"T4 projects the model with the default options: remove masking, sigma_rel, \
-              colour and halo_weight",
+              colour, halo_weight and rgb_mode",
         ));
     }
-    let eta = keywords
-        .eta
-        .iter()
-        .map(|&[n, k]| Complex::new(n, k))
-        .collect();
+    // `layer` refused a spectrum: T4 takes one index per wavelength of the file.
+    let pairs: &[[f32; 2]] = match &keywords.eta {
+        EtaTable::Channels(pairs) => pairs,
+        EtaTable::Spectrum(_) => &[],
+    };
+    let eta = pairs.iter().map(|&[n, k]| Complex::new(n, k)).collect();
     Ok((layer, eta))
 }
 
@@ -350,6 +351,7 @@ lambertian = 0.1
 "#;
         let file = format!("[material]\n{table}\n[metrics]\nrmse = [0.1, 0.1, 0.1]\n");
         let desc = twoscale::desc::MaterialDesc::from_toml_str(&file).unwrap();
+        let desc = desc.get();
         let entry =
             format!("wavelengths = [0.645, 0.526, 0.444]\n[[material]]\nname = \"fit\"\n{table}");
         let m = Materials::parse(&entry).unwrap();

@@ -25,7 +25,9 @@ use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::{ConvTable, FormatError, SigmaRatioTable, SmithG1Table, TableId};
+use twoscale::brdf::{IntegratedRgb, Options, Spectral, Tables};
+use twoscale::optical::SpectralMaterial;
+use twoscale::{ConvTable, FormatError, Rgb, SigmaRatioTable, SmithG1Table, TableId};
 
 /// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
 pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -159,59 +161,61 @@ fn outgoing_angles(theta_i: f64) -> Vec<f64> {
     v
 }
 
-/// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
-/// with the tables of `source` to `path`.
-pub fn lobes(
-    material: &Material,
-    channel: usize,
-    lambda: f64,
-    source: &TableSource,
-    path: &Path,
-) -> Result<(), PlotError> {
-    let inputs = source.model_inputs()?;
-    let parsed = inputs.parse()?;
-    let tables = parsed.brdf_tables();
-    let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
-    // Per incidence: θo and the terms at each.
-    let curves: Vec<(f64, Vec<f64>, Vec<[f64; 4]>)> = INCIDENCES
+/// One curve of a lobe picture: its legend label, colour and line width.
+struct Curve {
+    label: String,
+    color: RGBColor,
+    width: u32,
+}
+
+/// Per incidence of [`INCIDENCES`]: θi, the outgoing angles in the plane of
+/// incidence and `values(i, o)` at each.
+type PlaneCurves<const K: usize> = Vec<(f64, Vec<f64>, Vec<[f64; K]>)>;
+
+/// `values(i, o)` in the plane of incidence, per incidence of [`INCIDENCES`].
+fn plane_curves<const K: usize>(values: impl Fn([f32; 3], [f32; 3]) -> [f64; K]) -> PlaneCurves<K> {
+    INCIDENCES
         .iter()
         .map(|&theta_i| {
             let ti = theta_i.to_radians();
             let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
             let thetas = outgoing_angles(theta_i);
-            let values = thetas
+            let v = thetas
                 .iter()
                 .map(|&t| {
                     let to = t.to_radians();
-                    let lobes = brdf.eval_lobes(i, [to.sin() as f32, 0.0, to.cos() as f32]);
-                    TERMS.map(|term| f64::from((term.pick)(&lobes)))
+                    values(i, [to.sin() as f32, 0.0, to.cos() as f32])
                 })
                 .collect();
-            (theta_i, thetas, values)
+            (theta_i, thetas, v)
         })
-        .collect();
+        .collect()
+}
+
+/// Draws `curves` (one panel per incidence, log scale over six decades
+/// below the peak) titled `title` to `path`; `name` is the material's, for
+/// the error of an all-zero BRDF.
+fn draw_plane_curves<const K: usize>(
+    path: &Path,
+    title: &str,
+    name: &str,
+    curves: &PlaneCurves<K>,
+    series: &[Curve; K],
+) -> Result<(), PlotError> {
     let peak = curves
         .iter()
-        .flat_map(|(_, _, v)| v.iter().map(|t| t[0]))
+        .flat_map(|(_, _, v)| v.iter().flatten().copied())
         .fold(0.0f64, f64::max);
     if !(peak > 0.0 && peak.is_finite()) {
-        return Err(PlotError::ZeroBrdf(material.name.clone()));
+        return Err(PlotError::ZeroBrdf(name.to_string()));
     }
     let hi = 10f64.powf(peak.log10().ceil() + 0.3);
     let lo = hi * 1e-6;
 
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_error)?;
-    let root = root
-        .titled(
-            &format!(
-                "{}: ρ in the plane of incidence, λ = {lambda} µm (log scale)",
-                material.name
-            ),
-            (FONT, 20),
-        )
-        .map_err(draw_error)?;
-    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(&curves) {
+    let root = root.titled(title, (FONT, 20)).map_err(draw_error)?;
+    for (panel, (theta_i, thetas, values)) in root.split_evenly((2, 2)).iter().zip(curves) {
         let mut chart = ChartBuilder::on(panel)
             .caption(format!("θi = {theta_i}°"), (FONT, 15))
             .margin(6)
@@ -230,25 +234,17 @@ pub fn lobes(
             .axis_desc_style((FONT, 12))
             .draw()
             .map_err(draw_error)?;
-        for (k, term) in TERMS.iter().enumerate() {
-            // Runs above the plot's floor (a log axis has no 0).
-            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-            for (&t, v) in thetas.iter().zip(values) {
-                if v[k] > lo {
-                    runs.last_mut().expect("one run").push((t, v[k]));
-                } else if !runs.last().expect("one run").is_empty() {
-                    runs.push(Vec::new());
-                }
-            }
-            let style = ShapeStyle::from(&term.color).stroke_width(if k == 0 { 2 } else { 1 });
-            if runs.iter().all(Vec::is_empty) {
+        for (k, curve) in series.iter().enumerate() {
+            let runs = runs_above(thetas.iter().zip(values).map(|(&t, v)| (t, v[k])), lo);
+            let style = ShapeStyle::from(&curve.color).stroke_width(curve.width);
+            if runs.is_empty() {
                 // Listed all the same: absent (a conductor has no base), or
                 // below the plot.
                 let largest = values.iter().map(|v| v[k]).fold(0.0f64, f64::max);
                 let label = if largest > 0.0 {
-                    format!("{}: all < {lo:.0e}", term.name)
+                    format!("{}: all < {lo:.0e}", curve.label)
                 } else {
-                    format!("{}: none", term.name)
+                    format!("{}: none", curve.label)
                 };
                 chart
                     .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
@@ -257,28 +253,235 @@ pub fn lobes(
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
                 continue;
             }
-            for (r, run) in runs.into_iter().filter(|r| !r.is_empty()).enumerate() {
-                let series = chart
+            for (r, run) in runs.into_iter().enumerate() {
+                let drawn = chart
                     .draw_series(LineSeries::new(run, style))
                     .map_err(draw_error)?;
                 if r == 0 {
-                    series
-                        .label(term.name)
+                    drawn
+                        .label(curve.label.as_str())
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 11))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_error)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 11)?;
     }
     root.present().map_err(draw_error)
 }
+
+/// Draws the legend of `chart`'s labelled series at `position`, text of `size`.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+    size: u32,
+) -> Result<(), PlotError> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_error)
+}
+
+/// Draws the lobes of `material` at `channel` (wavelength `lambda`, µm)
+/// with the tables of `source` to `path`.
+pub fn lobes(
+    material: &Material,
+    channel: usize,
+    lambda: f64,
+    source: &TableSource,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let inputs = source.model_inputs()?;
+    let parsed = inputs.parse()?;
+    let tables = parsed.brdf_tables();
+    let brdf = two_scale_brdf(material, channel, lambda, &tables).0;
+    let curves = plane_curves(|i, o| {
+        let lobes = brdf.eval_lobes(i, o);
+        TERMS.map(|term| f64::from((term.pick)(&lobes)))
+    });
+    let series = TERMS.each_ref().map(|term| Curve {
+        label: term.name.to_string(),
+        color: term.color,
+        width: if term.name == TERMS[0].name { 2 } else { 1 },
+    });
+    let title = format!(
+        "{}: ρ in the plane of incidence, λ = {lambda} µm (log scale)",
+        material.name
+    );
+    draw_plane_curves(path, &title, &material.name, &curves, &series)
+}
+
+/// The runs of `points` above `lo` (a log axis has no 0): one polyline per
+/// run, none when no point is above.
+fn runs_above(points: impl Iterator<Item = (f64, f64)>, lo: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for (t, v) in points {
+        if v > lo {
+            runs.last_mut().expect("one run").push((t, v));
+        } else if !runs.last().expect("one run").is_empty() {
+            runs.push(Vec::new());
+        }
+    }
+    runs.retain(|r| !r.is_empty());
+    runs
+}
+
+/// The wavelengths (µm) of [`spectral_lobes`] and a colour for each.
+const SPECTRAL_LINES: [(f32, RGBColor); 5] = [
+    (0.40, RGBColor(118, 0, 196)),
+    (0.50, RGBColor(0, 160, 170)),
+    (0.60, RGBColor(230, 130, 0)),
+    (0.70, RGBColor(200, 0, 0)),
+    (0.80, RGBColor(100, 0, 0)),
+];
+
+/// Draws ρ of preset `name` over the spectrum (`material`) in the plane of
+/// incidence at 0.4, 0.5, 0.6, 0.7 and 0.8 µm, one panel per incidence,
+/// through `brdf::Spectral` (HP17 Fig. 15: the halo widens with λ) with
+/// `tables`, to `path`.
+pub fn spectral_lobes(
+    name: &str,
+    material: &SpectralMaterial<'_>,
+    tables: &Tables<'_>,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let model = Spectral::boxed(tables, material, Options::default());
+    let curves =
+        plane_curves(|i, o| SPECTRAL_LINES.map(|(lambda, _)| f64::from(model.eval(i, o, lambda))));
+    let series = SPECTRAL_LINES.map(|(lambda, color)| Curve {
+        label: format!("λ = {lambda} µm"),
+        color,
+        width: 1,
+    });
+    let title = format!("{name}: ρ in the plane of incidence at five wavelengths (log scale)");
+    draw_plane_curves(path, &title, name, &curves, &series)
+}
+
+/// The incidence (°) of [`rgb_comparison`].
+const COMPARISON_INCIDENCE: f64 = 45.0;
+
+/// Draws preset `name`'s RGB in the plane of incidence at θi = 45°,
+/// integrated over the spectrum (`brdf::IntegratedRgb`, solid) against the
+/// paper's three wavelengths (`brdf::Rgb`, dashed): ρ per channel (linear
+/// scale, around the mirror direction) and each channel over red (the
+/// colour), with `tables`, to `path`.
+pub fn rgb_comparison(
+    name: &str,
+    material: &SpectralMaterial<'_>,
+    tables: &Tables<'_>,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let options = Options::default();
+    let paper = Rgb::boxed(tables, &material.paper_rgb(), options);
+    let integrated = IntegratedRgb::boxed(tables, material, options);
+    let ti = COMPARISON_INCIDENCE.to_radians();
+    let i = [-ti.sin() as f32, 0.0, ti.cos() as f32];
+    let thetas: Vec<f64> = (0..=600)
+        .map(|k| COMPARISON_INCIDENCE - 30.0 + 0.1 * f64::from(k))
+        .filter(|t| t.abs() <= 89.5)
+        .collect();
+    let values: Vec<([f64; 3], [f64; 3])> = thetas
+        .iter()
+        .map(|&t| {
+            let to = t.to_radians();
+            let o = [to.sin() as f32, 0.0, to.cos() as f32];
+            (
+                integrated.eval(i, o).map(f64::from),
+                paper.eval(i, o).map(f64::from),
+            )
+        })
+        .collect();
+    let peak = values
+        .iter()
+        .flat_map(|(a, b)| a.iter().chain(b))
+        .copied()
+        .fold(0.0f64, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return Err(PlotError::ZeroBrdf(name.to_string()));
+    }
+    let channels = [
+        ("R", RGBColor(200, 30, 30)),
+        ("G", RGBColor(30, 150, 30)),
+        ("B", RGBColor(30, 60, 200)),
+    ];
+    let x_range = (thetas[0], thetas[thetas.len() - 1]);
+    let root = BitMapBackend::new(path, (SIZE.0, SIZE.1 / 2 + 40)).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let root = root
+        .titled(
+            &format!(
+                "{name}, θi = {COMPARISON_INCIDENCE}°: RGB integrated over the spectrum (solid) \
+                 vs at 0.645, 0.526, 0.444 µm (dashed)"
+            ),
+            (FONT, 15),
+        )
+        .map_err(draw_error)?;
+    let panels = root.split_evenly((1, 2));
+    // Left: ρ per channel; right: each channel over red.
+    for (p, panel) in panels.iter().enumerate() {
+        let y_max = if p == 0 { peak * 1.05 } else { 1.2 };
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(32)
+            .y_label_area_size(52)
+            .build_cartesian_2d(x_range.0..x_range.1, 0f64..y_max)
+            .map_err(draw_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("θo (°), in the plane of incidence")
+            .y_desc(if p == 0 {
+                "ρ (sr⁻¹)"
+            } else {
+                "ρ_c / ρ_R"
+            })
+            .x_labels(7)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .label_style((FONT, 11))
+            .axis_desc_style((FONT, 12))
+            .draw()
+            .map_err(draw_error)?;
+        for (c, &(label, color)) in channels.iter().enumerate() {
+            if p == 1 && c == 0 {
+                continue;
+            }
+            // Where red is above 1e-3 of the peak (the ratio is colour there).
+            let pick = |v: &[f64; 3]| if p == 0 { v[c] } else { v[c] / v[0] };
+            let shown = |v: &[f64; 3]| p == 0 || v[0] > 1e-3 * peak;
+            let solid: Vec<(f64, f64)> = thetas
+                .iter()
+                .zip(&values)
+                .filter(|(_, (a, _))| shown(a))
+                .map(|(&t, (a, _))| (t, pick(a)))
+                .collect();
+            let dashed: Vec<(f64, f64)> = thetas
+                .iter()
+                .zip(&values)
+                .filter(|(_, (_, b))| shown(b))
+                .map(|(&t, (_, b))| (t, pick(b)))
+                .collect();
+            let style = ShapeStyle::from(&color).stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(solid, style))
+                .map_err(draw_error)?
+                .label(format!("{label} integrated"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            let thin = ShapeStyle::from(&color).stroke_width(1);
+            chart
+                .draw_series(DashedLineSeries::new(dashed, 6, 4, thin))
+                .map_err(draw_error)?
+                .label(format!("{label} three wavelengths"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], thin));
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperRight, 10)?;
+    }
+    root.present().map_err(draw_error)
+}
+
+/// The metal of the README's comparison picture ([`rgb_comparison`]).
+pub const COMPARISON_PRESET: &str = "gold-hp17-geometry";
 
 /// Errors at points of a 2-D view of a table's domain: `(x, y, error)` in
 /// plot coordinates.
@@ -565,9 +768,11 @@ pub struct PlotArgs {
     pub font: PathBuf,
 }
 
-/// `generator plot`: the lobes of each material (`lobes-<name>.png`) and
-/// the error maps (`error-t1.png`, `error-t2.png`, `error-t3.png`) in
-/// `args.out`.
+/// `generator plot`: the lobes of each material (`lobes-<name>.png`), of
+/// each preset over the spectrum (`spectral-<name>.png`), the README's
+/// comparison of integrated and three-wavelength RGB
+/// (`rgb-integration-gold-hp17-geometry.png`) and the error maps
+/// (`error-t1.png`, `error-t2.png`, `error-t3.png`) in `args.out`.
 pub fn run(args: &PlotArgs) -> Result<(), Error> {
     load_font(&args.font)?;
     let materials = &args.materials;
@@ -589,6 +794,9 @@ pub fn run(args: &PlotArgs) -> Result<(), Error> {
     // The green channel (as T4's band-limit study).
     let channel = 1;
     let lambda = materials.wavelengths[channel];
+    let inputs = args.tables.model_inputs().map_err(PlotError::from)?;
+    let parsed = inputs.parse().map_err(PlotError::from)?;
+    let tables = parsed.brdf_tables();
     for material in &materials.materials {
         if !args.only.is_empty() && !args.only.contains(&material.name) {
             continue;
@@ -596,6 +804,18 @@ pub fn run(args: &PlotArgs) -> Result<(), Error> {
         let path = out.join(format!("lobes-{}.png", material.name));
         lobes(material, channel, lambda, &args.tables, &path)?;
         eprintln!("wrote {}", path.display());
+        // A preset (same name and layer) has its index over the spectrum.
+        let preset = twoscale::materials::spectral(&material.name);
+        if let Some(spectral) = preset.filter(|s| s.layer == material.layer) {
+            let path = out.join(format!("spectral-{}.png", material.name));
+            spectral_lobes(&material.name, &spectral, &tables, &path)?;
+            eprintln!("wrote {}", path.display());
+            if material.name == COMPARISON_PRESET {
+                let path = out.join(format!("rgb-integration-{}.png", material.name));
+                rgb_comparison(&material.name, &spectral, &tables, &path)?;
+                eprintln!("wrote {}", path.display());
+            }
+        }
     }
     if args.errors {
         let (source, points, seed) = (&args.tables, args.points, args.seed);

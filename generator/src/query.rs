@@ -11,8 +11,9 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use twoscale::brdf::ChannelBake;
-use twoscale::desc::MaterialDesc;
+use twoscale::brdf::{ChannelBake, MultipleScattering, RgbMode, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::desc::OwnedMaterialDesc;
+use twoscale::optical::SpectralMaterial;
 use twoscale::{
     AlbedoTable, ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table,
     TableId, TableSet,
@@ -264,6 +265,11 @@ pub enum QueryError {
     Uncovered(brdf::Uncovered),
     /// The reference's compensation lobe of the `--material` could not be built.
     Reference(brdf::BrdfError),
+    /// `--material` with `rgb_mode = "integrated"` and a `channel` column:
+    /// the reference gives the paper's three wavelengths only.
+    IntegratedUnsupported,
+    /// A `lambda` column for a material without an index over the spectrum.
+    NoSpectrum,
     /// The quantity's tables lack one the model reads (a bug of `run`).
     MissingTables,
     /// The input has no header line.
@@ -304,6 +310,19 @@ impl fmt::Display for QueryError {
             ),
             QueryError::Uncovered(e) => write!(f, "--material: {e}"),
             QueryError::Reference(e) => write!(f, "--material: the reference failed: {e}"),
+            QueryError::IntegratedUnsupported => write!(
+                f,
+                "--material: rows of {} compare with the reference at the paper's wavelengths; \
+                 rgb_mode 'integrated' has none (give rows of {})",
+                MATERIAL_COLUMNS.join(","),
+                SPECTRAL_COLUMNS.join(",")
+            ),
+            QueryError::NoSpectrum => write!(
+                f,
+                "--material: rows of {} need an index over the spectrum: \
+                 eta = {{ lambda, n, k }}, or one (n, k) for every channel",
+                SPECTRAL_COLUMNS.join(",")
+            ),
             QueryError::MissingTables => write!(f, "the table files were not opened"),
             QueryError::EmptyInput => write!(f, "empty input: expected a CSV header line"),
             QueryError::Read(e) => write!(f, "reading input: {e}"),
@@ -477,51 +496,111 @@ impl std::error::Error for RowError {}
 
 /// How `run` treats rows outside a table's domain, and the material of a
 /// `brdf` query.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Options {
     /// Answer them at the clamped point (as the renderer-facing lookups
     /// do) and add the column `in_domain`, instead of reporting them.
     pub clamp: bool,
     /// `brdf` of this material (a material file, `--material FILE`): the
     /// rows give [`MATERIAL_COLUMNS`], `table` is the channel of the RGB
-    /// model (`twoscale::Rgb`, as the C API and Python build it).
-    pub material: Option<MaterialDesc>,
+    /// model (`twoscale::Rgb`, as the C API and Python build it), or
+    /// [`SPECTRAL_COLUMNS`] (a `lambda` column and no `channel`), `table`
+    /// is the model at that wavelength (`twoscale::brdf::Spectral`).
+    pub material: Option<OwnedMaterialDesc>,
 }
 
 /// The input columns of `brdf` with a material: the channel (0, 1, 2: red,
 /// green, blue at `RGB_WAVELENGTHS`) and the two directions.
 pub const MATERIAL_COLUMNS: [&str; 7] = ["channel", "ix", "iy", "iz", "ox", "oy", "oz"];
 
-/// The RGB model of a `brdf --material` query and the reference's
-/// parameters of each channel.
-struct MaterialModel<'a> {
-    model: Rgb<'a, Box<ChannelBake>>,
-    params: [brdf::Params; 3],
-    options: twoscale::brdf::Options,
-    /// The reference's energy-compensation lobe per channel, when the
-    /// material's options ask for it.
-    compensation: Option<[brdf::Compensation; 3]>,
+/// The input columns of `brdf` with a material over the spectrum: the
+/// wavelength (µm, in [0.36, 0.83]) and the two directions.
+pub const SPECTRAL_COLUMNS: [&str; 7] = ["lambda", "ix", "iy", "iz", "ox", "oy", "oz"];
+
+/// The model of a `brdf --material` query, and the reference's parameters.
+enum MaterialModel<'a> {
+    /// Rows of [`MATERIAL_COLUMNS`]: the RGB model, and the reference's
+    /// parameters of each channel.
+    Channels {
+        model: Box<Rgb<'a, Box<ChannelBake>>>,
+        params: [brdf::Params; 3],
+        options: twoscale::brdf::Options,
+        /// The reference's energy-compensation lobe per channel, when the
+        /// material's options ask for it.
+        compensation: Option<Box<[brdf::Compensation; 3]>>,
+    },
+    /// Rows of [`SPECTRAL_COLUMNS`]: the spectral model, and the reference's
+    /// parameters with `n`, `k`, `λ` set per row from the material's index.
+    Spectral {
+        model: Box<Spectral<'a, Box<ChannelBake>>>,
+        spectral: SpectralMaterial<'a>,
+        params: brdf::Params,
+        options: twoscale::brdf::Options,
+    },
 }
 
 impl MaterialModel<'_> {
-    /// `table` and `reference` of a row of [`MATERIAL_COLUMNS`].
+    /// `table` and `reference` of a row of [`MATERIAL_COLUMNS`] or
+    /// [`SPECTRAL_COLUMNS`].
     fn evaluate(&self, x: &[f64]) -> Result<Vec<String>, RowError> {
-        let channel = x[0];
-        let ch = [0.0, 1.0, 2.0]
-            .iter()
-            .position(|&c| c == channel)
-            .ok_or(RowError::Channel(channel))?;
         let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
         let f = |v: f64| v as f32;
-        let value = self.model.eval(i.map(f), o.map(f))[ch];
-        let failed = |e: brdf::BrdfError| RowError::Reference(e.to_string());
-        let mut reference = brdf::two_scale(&self.params[ch], i, o, &self.options)
-            .map_err(failed)?
-            .total();
-        if let Some(lobes) = &self.compensation {
-            reference += lobes[ch].value(i, o).map_err(failed)?;
-        }
-        Ok(vec![short32(value), short(reference)])
+        let (value, params, options, multiple) = match self {
+            MaterialModel::Channels {
+                model,
+                params,
+                options,
+                compensation,
+            } => {
+                let channel = x[0];
+                let ch = [0.0, 1.0, 2.0]
+                    .iter()
+                    .position(|&c| c == channel)
+                    .ok_or(RowError::Channel(channel))?;
+                let multiple = match compensation {
+                    Some(lobes) => lobes[ch]
+                        .value(i, o)
+                        .map_err(|e| RowError::Reference(e.to_string()))?,
+                    None => 0.0,
+                };
+                (
+                    model.eval(i.map(f), o.map(f))[ch],
+                    params[ch],
+                    options,
+                    multiple,
+                )
+            }
+            MaterialModel::Spectral {
+                model,
+                spectral,
+                params,
+                options,
+            } => {
+                let lambda = f(x[0]);
+                let (lo, hi) = (
+                    SPECTRAL_WAVELENGTHS[0],
+                    SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
+                );
+                validate::check(
+                    "lambda",
+                    validate::widen(lambda),
+                    validate::Domain::Closed(validate::widen(lo), validate::widen(hi)),
+                    "µm, the spectral model's range",
+                )
+                .map_err(RowError::Invalid)?;
+                let eta = spectral.eta.at(lambda);
+                let params = brdf::Params {
+                    n: eta.re.into(),
+                    k: eta.im.into(),
+                    lambda: lambda.into(),
+                    ..*params
+                };
+                (model.eval(i.map(f), o.map(f), lambda), params, options, 0.0)
+            }
+        };
+        let reference = brdf::two_scale(&params, i, o, options)
+            .map_err(|e| RowError::Reference(e.to_string()))?;
+        Ok(vec![short32(value), short(reference.total() + multiple)])
     }
 }
 
@@ -555,14 +634,12 @@ pub fn run(
         Some(_) if quantity != Quantity::Brdf => {
             return Err(QueryError::MaterialUnsupported(quantity));
         }
-        Some(desc) => Some(
-            brdf::Params::rgb_with(&desc.material, &desc.options).map_err(QueryError::Uncovered)?,
-        ),
+        Some(desc) => Some((
+            desc.get(),
+            brdf::Params::rgb_with(&desc.get().material, &desc.get().options)
+                .map_err(QueryError::Uncovered)?,
+        )),
         None => None,
-    };
-    let columns: &'static [&'static str] = match params {
-        Some(_) => &MATERIAL_COLUMNS,
-        None => quantity.columns(),
     };
     let mut lines = input.lines().enumerate();
     let header = loop {
@@ -577,6 +654,30 @@ pub fn run(
         }
     };
     let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    // With a material, a `lambda` column and no `channel` asks for the spectral model.
+    let spectral_rows = params.is_some()
+        && names.iter().any(|n| n == "lambda")
+        && !names.iter().any(|n| n == "channel");
+    let columns: &'static [&'static str] = match params {
+        Some(_) if spectral_rows => &SPECTRAL_COLUMNS,
+        Some(_) => &MATERIAL_COLUMNS,
+        None => quantity.columns(),
+    };
+    match &params {
+        Some((desc, _)) if spectral_rows && desc.spectral.is_none() => {
+            return Err(QueryError::NoSpectrum);
+        }
+        Some((desc, _)) if !spectral_rows && desc.rgb_mode == RgbMode::Integrated => {
+            return Err(QueryError::IntegratedUnsupported);
+        }
+        // The reference's compensation lobe is built per channel, not per row's λ.
+        Some((desc, _))
+            if spectral_rows && desc.options.multiple_scattering != MultipleScattering::None =>
+        {
+            return Err(QueryError::Uncovered(brdf::Uncovered));
+        }
+        _ => {}
+    }
     let positions = columns
         .iter()
         .map(|&column| {
@@ -603,17 +704,23 @@ pub fn run(
         Some(_) => Some(views.set().map_err(|_| QueryError::MissingTables)?),
         None => None,
     };
-    let material = match (&options.material, params, &set) {
-        (Some(desc), Some(params), Some(set)) => {
-            let compensation =
-                brdf::Compensation::rgb(&params, &desc.options).map_err(QueryError::Reference)?;
-            Some(MaterialModel {
-                model: Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options),
+    let material = match (params, &set) {
+        (Some((desc, params)), Some(set)) => Some(match desc.spectral {
+            Some(spectral) if spectral_rows => MaterialModel::Spectral {
+                model: Box::new(Spectral::boxed(&set.brdf_tables(), &spectral, desc.options)),
+                spectral,
+                params: params[0],
+                options: desc.options,
+            },
+            _ => MaterialModel::Channels {
+                model: Box::new(Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options)),
                 params,
                 options: desc.options,
-                compensation,
-            })
-        }
+                compensation: brdf::Compensation::rgb(&params, &desc.options)
+                    .map_err(QueryError::Reference)?
+                    .map(Box::new),
+            },
+        }),
         _ => None,
     };
 

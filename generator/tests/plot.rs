@@ -1,5 +1,6 @@
-//! `generator plot` runs: one material's lobes into a temporary directory
-//! give a PNG of the documented size.
+//! `generator plot` runs: one material's lobes (and, for a preset, its
+//! lobes at five wavelengths) into a temporary directory give PNGs of the
+//! documented size.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -14,20 +15,29 @@ fn plot_writes_the_lobes_of_one_material() {
         .status()
         .expect("generator runs");
     assert!(status.success(), "generator plot failed: {status}");
-    let written: Vec<PathBuf> = std::fs::read_dir(&out)
+    let mut written: Vec<PathBuf> = std::fs::read_dir(&out)
         .expect("output directory")
         .map(|e| e.expect("entry").path())
         .collect();
-    assert_eq!(written, vec![out.join("lobes-gold-rough.png")]);
-    let png = std::fs::read(&written[0]).expect("readable PNG");
-    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "not a PNG");
-    // IHDR: width and height, big-endian, at bytes 16..24.
-    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
-    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
-    assert_eq!((width, height), (800, 540));
-    // Curves and text, not a blank canvas: a blank 800×540 PNG compresses
-    // to a few kB.
-    assert!(png.len() > 20_000, "{} bytes", png.len());
+    written.sort();
+    assert_eq!(
+        written,
+        vec![
+            out.join("lobes-gold-rough.png"),
+            out.join("spectral-gold-rough.png")
+        ]
+    );
+    for path in &written {
+        let png = std::fs::read(path).expect("readable PNG");
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "not a PNG");
+        // IHDR: width and height, big-endian, at bytes 16..24.
+        let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
+        let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
+        assert_eq!((width, height), (800, 540));
+        // Curves and text, not a blank canvas: a blank 800×540 PNG
+        // compresses to a few kB.
+        assert!(png.len() > 20_000, "{} bytes", png.len());
+    }
     std::fs::remove_dir_all(&out).expect("clean up");
 }
 
@@ -69,7 +79,8 @@ fn the_committed_lobes_are_what_plot_draws() {
         .map(|e| e.expect("entry").path())
         .collect();
     drawn.sort();
-    assert_eq!(drawn.len(), twoscale::materials::PRESETS.len());
+    // Per preset its lobes and its lobes at five wavelengths; gold's two RGBs.
+    assert_eq!(drawn.len(), 2 * twoscale::materials::PRESETS.len() + 1);
     for path in &drawn {
         let name = path.file_name().expect("file name");
         let committed = std::fs::read(docs.join(name)).expect("committed picture");

@@ -28,11 +28,11 @@ use twoscale::brdf::{
     BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
     MultipleScattering, Options, SigmaRelMode, Surface,
 };
-use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
-use twoscale::desc::{DescError, DescErrorKind, Keywords, MaterialDesc};
-use twoscale::optical::SpectralMaterial;
+use twoscale::brdf::{RgbMode, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::desc::{self, DescError, DescErrorKind, Eta, Keywords, MaterialDesc};
+use twoscale::optical::{OwnedSpectralMaterial, SpectralMaterial};
 use twoscale::validate::{self, Invalid, Named};
-use twoscale::{Bxdf, Complex, Convolution, Rgb, TableSet, TwoScale};
+use twoscale::{Bxdf, Complex, Convolution, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
 use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
 
@@ -248,14 +248,20 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-/// halo_weight=None, multiple_scattering=None): the RGB two-scale model of one material, built once
+/// halo_weight=None, multiple_scattering=None, rgb_mode=None): the RGB two-scale model of one material, built once
 /// (the runtime bakes its per-material tables) and evaluated over arrays of
 /// directions.
 ///
 /// `beta`, `p`: the EPD's roughness and shape; `sigma_s`, `b` (µm), `c`: the
 /// nanoscale roughness's RMS height, lateral scale and exponent; `eta`: three
 /// (n, k) pairs, red, green, blue at `RGB_WAVELENGTHS` (0.645, 0.526,
-/// 0.444 µm); `base`: one of `BASES`; `albedo`: the base layer's, in [0, 1]
+/// 0.444 µm), or the index over the spectrum `(lam, n, k)`, three 1-D arrays
+/// of one length (λ in µm, increasing; linear in 1/λ between rows; three
+/// arrays of two values are read as (n, k) pairs); `rgb_mode`: one of
+/// `RGB_MODES`, "paper-wavelengths" (the default: ρ at `RGB_WAVELENGTHS`) or
+/// "integrated" (the integral over the spectrum, docs/model.md §2.12; needs
+/// a spectrum, or one (n, k) for every channel); `base`: one of `BASES`;
+/// `albedo`: the base layer's, in [0, 1]
 /// (plastic or subsurface only); `lambertian`: the weight k_d in [0, 1] of a
 /// Lambertian term. A keyword left out (None) takes the runtime's default:
 /// sigma_s = 0 (no diffraction), b = 1 µm, c = 2, base "conductor",
@@ -265,27 +271,42 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 /// domain raise `ValueError` with the runtime's message.
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
-    model: Box<Rgb<'static, Box<ChannelBake>>>,
+    model: Box<RgbModel<'static, Box<ChannelBake>>>,
     material: twoscale::brdf::Material,
     options: Options,
-    /// The index over the spectrum: a preset's measured one, or the one
-    /// index of a material that gives the same (n, k) for every channel.
-    spectral: Option<SpectralMaterial<'static>>,
+    rgb_mode: RgbMode,
+    /// The index over the spectrum (`MaterialDesc::spectral`): given, a
+    /// preset's measured one, or the one index of every channel.
+    spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first `eval_spectral`.
     spectral_model: OnceLock<Box<Spectral<'static, Box<ChannelBake>>>>,
 }
 
 impl Material {
+    /// The model of `desc`, its bakes allocated zeroed on the heap and
+    /// filled in place (`RgbModel::boxed`): built on any thread, 64 KiB of
+    /// stack is enough (`tests/test_small_stack.py`).
+    fn build(desc: &MaterialDesc<'_>) -> Self {
+        Material {
+            model: Box::new(RgbModel::boxed(&TABLES.brdf_tables(), desc)),
+            material: desc.material,
+            options: desc.options,
+            rgb_mode: desc.rgb_mode,
+            spectral: desc.spectral.as_ref().map(OwnedSpectralMaterial::new),
+            spectral_model: OnceLock::new(),
+        }
+    }
+
     /// The model at any wavelength of `spectral` (this material's index over
     /// the spectrum), built by the first call.
     fn spectral_model(
         &self,
-        spectral: &SpectralMaterial<'static>,
+        spectral: &OwnedSpectralMaterial,
     ) -> &Spectral<'static, Box<ChannelBake>> {
         self.spectral_model.get_or_init(|| {
             Box::new(Spectral::boxed(
                 &TABLES.brdf_tables(),
-                spectral,
+                &spectral.get(),
                 self.options,
             ))
         })
@@ -304,7 +325,7 @@ impl Material {
     ) -> PyResult<(Vectors<3>, &Spectral<'static, Box<ChannelBake>>)> {
         let Some(spectral) = &self.spectral else {
             return Err(value_error(format!(
-                "{method} needs an index over the spectrum: a preset, or one (n, k) for every channel"
+                "{method} needs an index over the spectrum: a preset, eta=(lam, n, k), or one (n, k) for every channel"
             )));
         };
         // lam as a (..., 3) array, to broadcast with the directions.
@@ -350,26 +371,39 @@ impl Material {
         let values = py.detach(|| rows(v.len(), |k| f(model, wi[k], wo[k], lam[k][0])));
         Ok(shaped(py, &v.shape, values))
     }
+}
 
-    /// The model of `material`, its bakes allocated zeroed on the heap and
-    /// filled in place (`Rgb::boxed`): built on any thread, 64 KiB of stack
-    /// is enough (`tests/test_small_stack.py`).
-    fn build(material: twoscale::brdf::Material, options: Options) -> Self {
-        let spectral = SpectralMaterial::with_one_index(&material);
-        Material::with_spectrum(material, options, spectral)
+/// `Material(eta=…)`: three (n, k) pairs, or `(lam, n, k)` arrays as rows.
+enum EtaArgument {
+    Channels(Vec<[f32; 2]>),
+    Spectrum(Vec<[f32; 3]>),
+}
+
+impl EtaArgument {
+    fn read(eta: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if let Ok(pairs) = eta.extract::<Vec<[f32; 2]>>() {
+            return Ok(EtaArgument::Channels(pairs));
+        }
+        // Any sequence of three 1-D sequences: a tuple, a list, a (3, N) array.
+        let arrays = eta
+            .extract::<Vec<Vec<f32>>>()
+            .ok()
+            .filter(|a| a.len() == 3)
+            .ok_or_else(|| {
+                value_error(format!(
+                    "eta must be three (n, k) pairs or (lam, n, k), three 1-D arrays, got {}",
+                    describe(eta)
+                ))
+            })?;
+        desc::spectrum_rows(&arrays[0], &arrays[1], &arrays[2])
+            .map(EtaArgument::Spectrum)
+            .map_err(|e| value_error(e.to_string()))
     }
 
-    fn with_spectrum(
-        material: twoscale::brdf::Material,
-        options: Options,
-        spectral: Option<SpectralMaterial<'static>>,
-    ) -> Self {
-        Material {
-            model: Box::new(Rgb::boxed(&TABLES.brdf_tables(), &material, options)),
-            material,
-            options,
-            spectral,
-            spectral_model: OnceLock::new(),
+    fn eta(&self) -> Eta<'_> {
+        match self {
+            EtaArgument::Channels(pairs) => Eta::Channels(pairs),
+            EtaArgument::Spectrum(rows) => Eta::Spectrum(rows),
         }
     }
 }
@@ -379,12 +413,12 @@ impl Material {
     #[new]
     #[pyo3(signature = (*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
         albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-        halo_weight=None, multiple_scattering=None))]
+        halo_weight=None, multiple_scattering=None, rgb_mode=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         beta: f32,
         p: f32,
-        eta: Vec<[f32; 2]>, // any sequence of (n, k) sequences: tuples, or lists from TOML
+        eta: &Bound<'_, PyAny>, // (n, k) sequences (tuples, or lists from TOML), or (lam, n, k)
         sigma_s: Option<f32>,
         b: Option<f32>,
         c: Option<f32>,
@@ -396,13 +430,15 @@ impl Material {
         colour: Option<&str>,
         halo_weight: Option<&str>,
         multiple_scattering: Option<&str>,
+        rgb_mode: Option<&str>,
     ) -> PyResult<Self> {
         // The keywords are a material description's keys (`twoscale::desc`):
         // one reading, with its defaults and messages, for Python and TOML.
+        let eta = EtaArgument::read(eta)?;
         let keywords = Keywords {
             beta,
             p,
-            eta: &eta,
+            eta: eta.eta(),
             sigma_s,
             b,
             c,
@@ -414,11 +450,12 @@ impl Material {
             colour,
             halo_weight,
             multiple_scattering,
+            rgb_mode,
         };
         let desc = keywords
             .material()
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(Material::build(desc.material, desc.options))
+        Ok(Material::build(&desc))
     }
 
     /// from_toml(path): the material of a material file (TOML: a
@@ -430,7 +467,7 @@ impl Material {
     #[staticmethod]
     fn from_toml(path: std::path::PathBuf) -> PyResult<Self> {
         MaterialDesc::from_toml_file(path)
-            .map(|d| Material::build(d.material, d.options))
+            .map(|d| Material::build(&d.get()))
             .map_err(desc_error)
     }
 
@@ -438,17 +475,18 @@ impl Material {
     #[staticmethod]
     fn from_toml_string(text: &str) -> PyResult<Self> {
         MaterialDesc::from_toml_str(text)
-            .map(|d| Material::build(d.material, d.options))
+            .map(|d| Material::build(&d.get()))
             .map_err(desc_error)
     }
 
     /// preset(name, *, masking=None, sigma_rel=None, colour=None,
-    /// halo_weight=None, multiple_scattering=None): the shipped preset `name` (`Material.presets()`
-    /// lists them) with the given options (names as in `OPTIONS`; None: the
-    /// runtime's default).
+    /// halo_weight=None, multiple_scattering=None, rgb_mode=None): the shipped
+    /// preset `name` (`Material.presets()` lists them; its measured index
+    /// over the spectrum) with the given options (names as in `OPTIONS` and
+    /// `RGB_MODES`; None: the runtime's default, the paper's wavelengths).
     #[staticmethod]
     #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None,
-        multiple_scattering=None))]
+        multiple_scattering=None, rgb_mode=None))]
     fn preset(
         name: &str,
         masking: Option<&str>,
@@ -456,15 +494,14 @@ impl Material {
         colour: Option<&str>,
         halo_weight: Option<&str>,
         multiple_scattering: Option<&str>,
+        rgb_mode: Option<&str>,
     ) -> PyResult<Self> {
         let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
         let options = options(masking, sigma_rel, colour, halo_weight, multiple_scattering)?;
-        Ok(Material::with_spectrum(
-            spectral.paper_rgb(),
-            options,
-            Some(spectral),
-        ))
+        let desc = MaterialDesc::spectral(spectral, options, named(rgb_mode)?)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(Material::build(&desc))
     }
 
     /// presets(): the names of the shipped presets, for `Material.preset`.
@@ -476,8 +513,9 @@ impl Material {
             .collect()
     }
 
-    /// eval(wi, wo): ρ(wi, wo) per RGB channel in sr⁻¹ (red, green, blue at
-    /// `RGB_WAVELENGTHS`), float32 of shape `(..., 3)`.
+    /// eval(wi, wo): ρ(wi, wo) per RGB channel in sr⁻¹, float32 of shape
+    /// `(..., 3)`: red, green, blue at `RGB_WAVELENGTHS`, or linear sRGB by
+    /// integration over the spectrum (`rgb_mode="integrated"`).
     ///
     /// `wi` (towards the light) and `wo` (towards the viewer) are unit
     /// vectors in the local frame (normal +z), arrays of shape `(..., 3)`
@@ -499,9 +537,10 @@ impl Material {
     /// (µm, in [0.36, 0.83]), float32 of the broadcast leading shape of `wi`,
     /// `wo` (`(..., 3)`) and `lam` (`(...)`), from one construction that
     /// serves every wavelength (`twoscale::brdf::Spectral`, docs/model.md
-    /// §2.10; built by the first call). For presets (their measured index)
-    /// and materials whose `eta` is one (n, k) for every channel; other
-    /// materials, and `lam` outside the range, raise `ValueError`.
+    /// §2.12; built by the first call). For presets (their measured index),
+    /// materials given `eta=(lam, n, k)` and those whose `eta` is one (n, k)
+    /// for every channel; other materials, and `lam` outside the range,
+    /// raise `ValueError`.
     fn eval_spectral<'py>(
         &self,
         py: Python<'py>,
@@ -650,9 +689,14 @@ impl Material {
     /// a list of three dicts (red, green, blue) mapping names to float
     /// scalars and float32 or float64 arrays (the names and layouts of
     /// `TwoScale::visit_bakes` and `runtime/src/bake.rs`; not a stable
-    /// interface).
+    /// interface). For `rgb_mode="paper-wavelengths"` only.
     fn bakes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        self.model
+        let RgbModel::PaperWavelengths(model) = &*self.model else {
+            return Err(value_error(
+                "bakes() gives the model at the paper's wavelengths: build the material with rgb_mode='paper-wavelengths'",
+            ));
+        };
+        model
             .channels
             .iter()
             .map(|channel| bake_dict(py, |v| channel.visit_bakes(v)))
@@ -669,7 +713,7 @@ impl Material {
     fn spectral_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let Some(spectral) = &self.spectral else {
             return Err(value_error(
-                "spectral_bakes needs an index over the spectrum: a preset, or one (n, k) for every channel",
+                "spectral_bakes needs an index over the spectrum: a preset, eta=(lam, n, k), or one (n, k) for every channel",
             ));
         };
         let model = self.spectral_model(spectral);
@@ -699,12 +743,26 @@ impl Material {
             layer.lambertian = lambertian;
         }
         layer.validate().map_err(invalid)?;
-        let material = twoscale::brdf::Material {
-            layer,
-            ..self.material
-        };
-        let spectral = self.spectral.map(|s| SpectralMaterial { layer, ..s });
-        Ok(Material::with_spectrum(material, self.options, spectral))
+        let desc = match &self.spectral {
+            Some(spectral) => MaterialDesc::spectral(
+                SpectralMaterial {
+                    layer,
+                    ..spectral.get()
+                },
+                self.options,
+                self.rgb_mode,
+            ),
+            None => MaterialDesc::rgb(
+                twoscale::brdf::Material {
+                    layer,
+                    ..self.material
+                },
+                self.options,
+                self.rgb_mode,
+            ),
+        }
+        .map_err(|e| value_error(e.to_string()))?;
+        Ok(Material::build(&desc))
     }
 
     /// β, the EPD's roughness (slope scale), dimensionless.
@@ -768,6 +826,11 @@ impl Material {
             (HaloWeight::OPTION, o.halo_weight.name()),
             (MultipleScattering::OPTION, o.multiple_scattering.name()),
         ])
+    }
+    /// Which RGB `eval` gives: "paper-wavelengths" or "integrated" (`RGB_MODES`).
+    #[getter]
+    fn rgb_mode(&self) -> &'static str {
+        self.rgb_mode.name()
     }
 
     fn __repr__(&self) -> String {
@@ -1128,6 +1191,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         .map(|(k, v)| Ok((k, PyTuple::new(m.py(), v)?)));
     m.add("OPTIONS", options.collect::<PyResult<BTreeMap<_, _>>>()?)?;
     m.add("BASES", PyTuple::new(m.py(), names::<BaseKind>())?)?;
+    m.add("RGB_MODES", PyTuple::new(m.py(), names::<RgbMode>())?)?;
     m.add_function(wrap_pyfunction!(g1, m)?)?;
     m.add_function(wrap_pyfunction!(sigma_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(conv, m)?)?;

@@ -11,19 +11,22 @@ Directions are unit vectors in the local frame (normal +z), arrays of shape
 the light and ``wo`` towards the viewer. Lengths are in µm.
 
 ``OPTIONS`` maps each option keyword of ``Material`` to the names of its
-values (the default first) and ``BASES`` lists the base layers: the
-runtime's one list of each (``twoscale::validate::Named``).
+values (the default first), ``BASES`` lists the base layers and
+``RGB_MODES`` the RGB models (``rgb_mode``: the paper's wavelengths, the
+default, or the integral over the spectrum): the runtime's one list of each
+(``twoscale::validate::Named``).
 """
 
 import importlib
 from types import ModuleType
 
 from . import lookup, merl, reference
-from ._native import BASES, OPTIONS, RGB_WAVELENGTHS, Material
+from ._native import BASES, OPTIONS, RGB_MODES, RGB_WAVELENGTHS, Material
 from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
 __all__ = [
-    "BASES", "Material", "OPTIONS", "RGB_WAVELENGTHS", "fit", "lookup", "merl", "reference",
+    "BASES", "Material", "OPTIONS", "RGB_MODES", "RGB_WAVELENGTHS", "fit", "lookup", "merl",
+    "reference",
 ]
 
 

@@ -17,6 +17,7 @@ __all__ = [
     "RGB_WAVELENGTHS",
     "OPTIONS",
     "BASES",
+    "RGB_MODES",
     "g1",
     "sigma_ratio",
     "conv",
@@ -33,6 +34,7 @@ __all__ = [
 RGB_WAVELENGTHS: list[float]
 OPTIONS: dict[str, tuple[str, ...]]
 BASES: tuple[str, ...]
+RGB_MODES: tuple[str, ...]
 
 @final
 class Material:
@@ -41,7 +43,7 @@ class Material:
         *,
         beta: float,
         p: float,
-        eta: list[tuple[float, float]],
+        eta: list[tuple[float, float]] | tuple[ArrayLike, ArrayLike, ArrayLike],
         sigma_s: float | None = None,
         b: float | None = None,
         c: float | None = None,
@@ -53,6 +55,7 @@ class Material:
         colour: str | None = None,
         halo_weight: str | None = None,
         multiple_scattering: str | None = None,
+        rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod
     def preset(
@@ -63,6 +66,7 @@ class Material:
         colour: str | None = None,
         halo_weight: str | None = None,
         multiple_scattering: str | None = None,
+        rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod
     def presets() -> list[str]: ...
@@ -110,6 +114,8 @@ class Material:
     def lambertian(self) -> float: ...
     @property
     def options(self) -> dict[str, str]: ...
+    @property
+    def rgb_mode(self) -> str: ...
 
 def g1(
     p: NDArray[np.float64], a: NDArray[np.float64], *, reference: bool, clamp: bool = False

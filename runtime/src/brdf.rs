@@ -76,7 +76,7 @@ use zerocopy::FromZeros;
 
 mod integrated;
 mod spectral;
-pub use integrated::{INTEGRATED_COUNT, INTEGRATED_WAVELENGTHS, IntegratedRgb};
+pub use integrated::{INTEGRATED_COUNT, INTEGRATED_WAVELENGTHS, IntegratedRgb, RgbMode, RgbModel};
 pub use spectral::{SPECTRAL_COUNT, SPECTRAL_WAVELENGTHS, Spectral};
 
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).

@@ -15,7 +15,7 @@
 //! is expected. Each implementation forwards to the type's own methods
 //! (static dispatch: no cost over calling them directly).
 
-use crate::brdf::{ChannelBake, Rgb, TwoScale};
+use crate::brdf::{ChannelBake, IntegratedRgb, Rgb, RgbModel, TwoScale};
 use crate::hp15::Hp15;
 use crate::math::{BELOW_ONE, upper_unit};
 use crate::sh::ShBrdfTable;
@@ -152,6 +152,71 @@ impl<B: Borrow<ChannelBake>> Bxdf for Rgb<'_, B> {
             pdf: s.pdf,
             value: s.value,
         })
+    }
+}
+
+impl<B: Borrow<ChannelBake>> Bxdf for IntegratedRgb<'_, B> {
+    type Value = [f32; 3];
+
+    fn flags(&self) -> BxdfFlags {
+        self.nodes()
+            .iter()
+            .map(Bxdf::flags)
+            .fold(BxdfFlags::NONE, BitOr::bitor)
+    }
+
+    #[inline]
+    fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
+        IntegratedRgb::eval(self, i, o)
+    }
+
+    #[inline]
+    fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        IntegratedRgb::pdf(self, i, o)
+    }
+
+    #[inline]
+    fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<BxdfSample<[f32; 3]>> {
+        IntegratedRgb::sample(self, i, u).map(|s| BxdfSample {
+            o: s.o,
+            pdf: s.pdf,
+            value: s.value,
+        })
+    }
+}
+
+impl<B: Borrow<ChannelBake>> Bxdf for RgbModel<'_, B> {
+    type Value = [f32; 3];
+
+    fn flags(&self) -> BxdfFlags {
+        match self {
+            RgbModel::PaperWavelengths(m) => m.flags(),
+            RgbModel::Integrated(m) => m.flags(),
+        }
+    }
+
+    #[inline]
+    fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
+        match self {
+            RgbModel::PaperWavelengths(m) => Rgb::eval(m, i, o),
+            RgbModel::Integrated(m) => IntegratedRgb::eval(m, i, o),
+        }
+    }
+
+    #[inline]
+    fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
+        match self {
+            RgbModel::PaperWavelengths(m) => Rgb::pdf(m, i, o),
+            RgbModel::Integrated(m) => IntegratedRgb::pdf(m, i, o),
+        }
+    }
+
+    #[inline]
+    fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<BxdfSample<[f32; 3]>> {
+        match self {
+            RgbModel::PaperWavelengths(m) => Bxdf::sample(m, i, u),
+            RgbModel::Integrated(m) => Bxdf::sample(m, i, u),
+        }
     }
 }
 

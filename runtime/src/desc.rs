@@ -27,7 +27,13 @@
 //!
 //! `eta` holds one `(n, k)` pair per channel: red, green, blue at
 //! [`crate::brdf::RGB_WAVELENGTHS`] for a material; one per wavelength of
-//! the file for `materials.toml`. Numbers are read as `f64` and rounded to
+//! the file for `materials.toml`. A material may instead give its index
+//! over the spectrum, `eta = { lambda = [0.4, 0.5, 0.6], n = […], k = […] }`
+//! (λ in µm, increasing; [`crate::optical::Tabulated`]): its RGB at the
+//! paper's wavelengths is the spectrum there, and `rgb_mode = "integrated"`
+//! (default `"paper-wavelengths"`, [`RgbMode`]) makes the model's RGB the
+//! integral over the spectrum. Python's `Material(eta=(lam, n, k))` and
+//! the C API's `ts_material_desc.eta_rows` are the same form. Numbers are read as `f64` and rounded to
 //! the runtime's `f32`, as Python's keywords are.
 //!
 //! With the feature `toml`, [`MaterialDesc::from_toml_str`] and
@@ -35,8 +41,11 @@
 //! missing or mistyped ones and values outside their domain are refused
 //! with a [`DescError`] naming the key.
 
-use crate::brdf::{Layer, Material, Options, Surface};
+use crate::brdf::{Layer, Material, Options, RgbMode, Surface};
 use crate::fresnel::Complex;
+#[cfg(feature = "std")]
+use crate::optical::OwnedSpectralMaterial;
+use crate::optical::{Ior, SpectralMaterial, Tabulated};
 use crate::validate::{self, Refused};
 
 /// The default of `sigma_s` (no diffraction).
@@ -56,6 +65,22 @@ const ETA_NAMES: [(&str, &str); 3] = [
     ("eta[2].n", "eta[2].k"),
 ];
 
+/// The index of a material as given: `(n, k)` per channel, or rows
+/// `(λ µm, n, k)` of a spectrum ([`crate::optical::Tabulated`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Eta<'a> {
+    /// `(n, k)` per channel.
+    Channels(&'a [[f32; 2]]),
+    /// `(λ, n, k)` rows, λ increasing.
+    Spectrum(&'a [[f32; 3]]),
+}
+
+impl Default for Eta<'_> {
+    fn default() -> Self {
+        Eta::Channels(&[])
+    }
+}
+
 /// A material by its keywords as given (`None`: not given, the default).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Keywords<'a> {
@@ -63,8 +88,8 @@ pub struct Keywords<'a> {
     pub beta: f32,
     /// EPD shape p.
     pub p: f32,
-    /// `(n, k)` per channel.
-    pub eta: &'a [[f32; 2]],
+    /// The index: `(n, k)` per channel, or a spectrum.
+    pub eta: Eta<'a>,
     /// σs, µm ([`DEFAULT_SIGMA_S`]).
     pub sigma_s: Option<f32>,
     /// b, µm ([`DEFAULT_B`]).
@@ -87,20 +112,28 @@ pub struct Keywords<'a> {
     pub halo_weight: Option<&'a str>,
     /// [`crate::brdf::MultipleScattering`]'s name.
     pub multiple_scattering: Option<&'a str>,
+    /// [`RgbMode`]'s name (default: the paper's wavelengths).
+    pub rgb_mode: Option<&'a str>,
 }
 
 impl<'a> Keywords<'a> {
     /// The layer and options, with `eta` checked for `channels` pairs, each
-    /// a valid index ([`validate::eta`], named `eta[j].n`, `eta[j].k`).
-    /// Checked in this order: the number of pairs, the base's name, its
-    /// albedo, the layer ([`Layer::validate`]), each index, the options'
-    /// names. `channels` is 1 to 3.
-    pub fn layer(&self, channels: usize) -> Result<(Layer, Options), Refused<'a>> {
-        if self.eta.len() != channels || channels > ETA_NAMES.len() {
-            return Err(Refused::EtaCount {
-                found: self.eta.len(),
-                expected: channels,
-            });
+    /// a valid index ([`validate::eta`], named `eta[j].n`, `eta[j].k`), or
+    /// valid spectrum rows when `channels` is `None`
+    /// ([`validate::optical_constants`]). Checked in this order: the number
+    /// of pairs, the base's name, its albedo, the layer
+    /// ([`Layer::validate`]), each index, the options' names. `channels` is
+    /// 1 to 3.
+    fn checked(&self, channels: Option<usize>) -> Result<(Layer, Options), Refused<'a>> {
+        let found = match self.eta {
+            Eta::Channels(pairs) => pairs.len(),
+            Eta::Spectrum(rows) => rows.len(),
+        };
+        let pairs = matches!(self.eta, Eta::Channels(_));
+        if let Some(expected) = channels
+            && (!pairs || found != expected || expected > ETA_NAMES.len())
+        {
+            return Err(Refused::EtaCount { found, expected });
         }
         let base = validate::base_layer(validate::named(self.base)?, self.albedo)?;
         let layer = Layer {
@@ -115,8 +148,13 @@ impl<'a> Keywords<'a> {
             lambertian: self.lambertian.unwrap_or(DEFAULT_LAMBERTIAN),
         };
         layer.validate()?;
-        for (&names, &[n, k]) in ETA_NAMES.iter().zip(self.eta) {
-            validate::eta(names, Complex::new(n, k))?;
+        match self.eta {
+            Eta::Channels(pairs) => {
+                for (&names, &[n, k]) in ETA_NAMES.iter().zip(pairs) {
+                    validate::eta(names, Complex::new(n, k))?;
+                }
+            }
+            Eta::Spectrum(rows) => validate::optical_constants(rows)?,
         }
         let options = Options {
             masking: validate::named(self.masking)?,
@@ -128,36 +166,153 @@ impl<'a> Keywords<'a> {
         Ok((layer, options))
     }
 
-    /// The RGB material: [`Self::layer`] with three pairs (red, green,
-    /// blue), then [`Material::validate`].
-    pub fn material(&self) -> Result<MaterialDesc, Refused<'a>> {
-        let (layer, options) = self.layer(3)?;
-        let mut eta_rgb = [Complex::new(0.0, 0.0); 3];
-        for (eta, &[n, k]) in eta_rgb.iter_mut().zip(self.eta) {
-            *eta = Complex::new(n, k);
+    /// The layer and options with `eta` one `(n, k)` pair per channel
+    /// (`channels`, 1 to 3; the order of checks is [`Self::material`]'s).
+    pub fn layer(&self, channels: usize) -> Result<(Layer, Options), Refused<'a>> {
+        self.checked(Some(channels))
+    }
+
+    /// The material: three `(n, k)` pairs (red, green, blue) or a spectrum,
+    /// then [`MaterialDesc::rgb`] or [`MaterialDesc::spectral`]. Checked in this order: the number of
+    /// pairs, the base's name, its albedo, the layer ([`Layer::validate`]),
+    /// each index (or the rows), the options' names, `rgb_mode`.
+    pub fn material(&self) -> Result<MaterialDesc<'a>, Refused<'a>> {
+        let channels = match self.eta {
+            Eta::Channels(_) => Some(3),
+            Eta::Spectrum(_) => None,
+        };
+        let (layer, options) = self.checked(channels)?;
+        let rgb_mode = validate::named(self.rgb_mode)?;
+        match self.eta {
+            Eta::Channels(pairs) => {
+                let mut eta_rgb = [Complex::new(0.0, 0.0); 3];
+                for (eta, &[n, k]) in eta_rgb.iter_mut().zip(pairs) {
+                    *eta = Complex::new(n, k);
+                }
+                MaterialDesc::rgb(Material { layer, eta_rgb }, options, rgb_mode)
+            }
+            Eta::Spectrum(rows) => {
+                let eta = Ior::Tabulated(Tabulated::new(rows)?);
+                MaterialDesc::spectral(SpectralMaterial { layer, eta }, options, rgb_mode)
+            }
         }
-        let material = Material { layer, eta_rgb };
-        material.validate()?;
-        Ok(MaterialDesc { material, options })
     }
 }
 
-/// A validated RGB material and its options: what a material file
-/// describes (and the C API's `ts_material_desc`).
+/// The rows `(λ, n, k)` of three arrays of one length (Python's
+/// `eta=(lam, n, k)`, a material file's `eta = { lambda = […], n = […],
+/// k = […] }`); the rows are checked later ([`Keywords::material`]).
+#[cfg(feature = "std")]
+pub fn spectrum_rows(
+    lambda: &[f32],
+    n: &[f32],
+    k: &[f32],
+) -> Result<std::vec::Vec<[f32; 3]>, Refused<'static>> {
+    if lambda.len() != n.len() || lambda.len() != k.len() {
+        return Err(Refused::SpectrumLengths([lambda.len(), n.len(), k.len()]));
+    }
+    Ok((0..lambda.len()).map(|j| [lambda[j], n[j], k[j]]).collect())
+}
+
+/// A validated material and its options: the RGB material at the paper's
+/// wavelengths, its index over the spectrum when it has one, and which RGB
+/// the model gives. What a material file describes (and the C API's
+/// `ts_material_desc`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MaterialDesc {
-    /// The material.
+pub struct MaterialDesc<'a> {
+    /// The material at [`crate::brdf::RGB_WAVELENGTHS`].
     pub material: Material,
+    /// The material over the spectrum: given as one, or the one index of a
+    /// material with the same `(n, k)` in every channel
+    /// ([`SpectralMaterial::with_one_index`]); else `None`.
+    pub spectral: Option<SpectralMaterial<'a>>,
     /// The model's options.
     pub options: Options,
+    /// Which RGB the model gives ([`crate::brdf::RgbModel`]).
+    pub rgb_mode: RgbMode,
+}
+
+impl<'a> MaterialDesc<'a> {
+    /// An RGB material (validated, [`Material::validate`]); its spectrum if
+    /// every channel has the same index. [`RgbMode::Integrated`] needs one
+    /// ([`Refused::IntegratedNeedsSpectrum`]).
+    pub fn rgb(
+        material: Material,
+        options: Options,
+        rgb_mode: RgbMode,
+    ) -> Result<MaterialDesc<'static>, Refused<'static>> {
+        material.validate()?;
+        let spectral = SpectralMaterial::with_one_index(&material);
+        if rgb_mode == RgbMode::Integrated && spectral.is_none() {
+            return Err(Refused::IntegratedNeedsSpectrum);
+        }
+        Ok(MaterialDesc {
+            material,
+            spectral,
+            options,
+            rgb_mode,
+        })
+    }
+
+    /// A material over the spectrum (validated,
+    /// [`SpectralMaterial::validate`]); its RGB material is the spectrum at
+    /// the paper's wavelengths.
+    pub fn spectral(
+        spectral: SpectralMaterial<'a>,
+        options: Options,
+        rgb_mode: RgbMode,
+    ) -> Result<MaterialDesc<'a>, Refused<'a>> {
+        spectral.validate()?;
+        Ok(MaterialDesc {
+            material: spectral.paper_rgb(),
+            spectral: Some(spectral),
+            options,
+            rgb_mode,
+        })
+    }
+
+    /// A copy that owns its rows (feature `std`).
+    #[cfg(feature = "std")]
+    pub fn to_owned_desc(&self) -> OwnedMaterialDesc {
+        OwnedMaterialDesc {
+            material: self.material,
+            spectral: self.spectral.as_ref().map(OwnedSpectralMaterial::new),
+            options: self.options,
+            rgb_mode: self.rgb_mode,
+        }
+    }
+}
+
+/// A [`MaterialDesc`] that owns its spectrum's rows (feature `std`): what a
+/// material file or a front end's material keeps.
+#[cfg(feature = "std")]
+#[derive(Clone, Debug, PartialEq)]
+pub struct OwnedMaterialDesc {
+    material: Material,
+    spectral: Option<OwnedSpectralMaterial>,
+    options: Options,
+    rgb_mode: RgbMode,
+}
+
+#[cfg(feature = "std")]
+impl OwnedMaterialDesc {
+    /// The description, borrowing the rows.
+    pub fn get(&self) -> MaterialDesc<'_> {
+        MaterialDesc {
+            material: self.material,
+            spectral: self.spectral.as_ref().map(OwnedSpectralMaterial::get),
+            options: self.options,
+            rgb_mode: self.rgb_mode,
+        }
+    }
 }
 
 #[cfg(feature = "toml")]
-pub use self::file::{DescError, DescErrorKind, KeywordTable};
+pub use self::file::{DescError, DescErrorKind, EtaTable, KeywordTable};
 
 #[cfg(feature = "toml")]
 mod file {
-    use super::{Keywords, MaterialDesc};
+    use super::{Eta, Keywords, MaterialDesc, OwnedMaterialDesc, spectrum_rows};
     use serde::Deserialize;
     use std::fmt;
     use std::path::Path;
@@ -175,7 +330,7 @@ mod file {
         /// [`Keywords::p`].
         pub p: f32,
         /// [`Keywords::eta`].
-        pub eta: Vec<[f32; 2]>,
+        pub eta: EtaTable,
         /// [`Keywords::sigma_s`].
         pub sigma_s: Option<f32>,
         /// [`Keywords::b`].
@@ -198,6 +353,52 @@ mod file {
         pub halo_weight: Option<String>,
         /// [`Keywords::multiple_scattering`].
         pub multiple_scattering: Option<String>,
+        /// [`Keywords::rgb_mode`].
+        pub rgb_mode: Option<String>,
+    }
+
+    /// `eta` of a material table: `[[n, k], …]` per channel, or
+    /// `{ lambda = […], n = […], k = […] }` (µm), read into rows.
+    #[derive(Clone, Debug, PartialEq, Deserialize)]
+    #[serde(try_from = "RawEta")]
+    pub enum EtaTable {
+        /// `(n, k)` per channel.
+        Channels(Vec<[f32; 2]>),
+        /// `(λ, n, k)` rows ([`spectrum_rows`]).
+        Spectrum(Vec<[f32; 3]>),
+    }
+
+    impl Default for EtaTable {
+        fn default() -> Self {
+            EtaTable::Channels(Vec::new())
+        }
+    }
+
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum RawEta {
+        Channels(Vec<[f32; 2]>),
+        Spectrum(SpectrumArrays),
+    }
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct SpectrumArrays {
+        lambda: Vec<f32>,
+        n: Vec<f32>,
+        k: Vec<f32>,
+    }
+
+    impl TryFrom<RawEta> for EtaTable {
+        type Error = String;
+        fn try_from(raw: RawEta) -> Result<Self, String> {
+            match raw {
+                RawEta::Channels(pairs) => Ok(EtaTable::Channels(pairs)),
+                RawEta::Spectrum(a) => spectrum_rows(&a.lambda, &a.n, &a.k)
+                    .map(EtaTable::Spectrum)
+                    .map_err(|e| e.to_string()),
+            }
+        }
     }
 
     impl KeywordTable {
@@ -206,7 +407,10 @@ mod file {
             Keywords {
                 beta: self.beta,
                 p: self.p,
-                eta: &self.eta,
+                eta: match &self.eta {
+                    EtaTable::Channels(pairs) => Eta::Channels(pairs),
+                    EtaTable::Spectrum(rows) => Eta::Spectrum(rows),
+                },
                 sigma_s: self.sigma_s,
                 b: self.b,
                 c: self.c,
@@ -218,6 +422,7 @@ mod file {
                 colour: self.colour.as_deref(),
                 halo_weight: self.halo_weight.as_deref(),
                 multiple_scattering: self.multiple_scattering.as_deref(),
+                rgb_mode: self.rgb_mode.as_deref(),
             }
         }
     }
@@ -261,25 +466,29 @@ mod file {
 
     impl std::error::Error for DescError {}
 
-    impl MaterialDesc {
+    impl MaterialDesc<'_> {
         /// The material of a material file's text (module documentation).
         /// A refused value is reported as `[material] beta = 20: must be in
         /// [0.0001, 10]`; a syntax or schema fault with toml's message
         /// (line, column and the key).
-        pub fn from_toml_str(text: &str) -> Result<MaterialDesc, DescError> {
+        pub fn from_toml_str(text: &str) -> Result<OwnedMaterialDesc, DescError> {
             let file: MaterialFile = toml::from_str(text).map_err(|e| DescError {
                 kind: DescErrorKind::Syntax,
                 message: e.to_string().trim_end().to_string(),
             })?;
-            file.material.keywords().material().map_err(|e| DescError {
-                kind: DescErrorKind::Refused,
-                message: format!("[material] {e}"),
-            })
+            file.material
+                .keywords()
+                .material()
+                .map(|d| d.to_owned_desc())
+                .map_err(|e| DescError {
+                    kind: DescErrorKind::Refused,
+                    message: format!("[material] {e}"),
+                })
         }
 
         /// [`Self::from_toml_str`] of the file at `path` (UTF-8); every
         /// message starts with the path.
-        pub fn from_toml_file(path: impl AsRef<Path>) -> Result<MaterialDesc, DescError> {
+        pub fn from_toml_file(path: impl AsRef<Path>) -> Result<OwnedMaterialDesc, DescError> {
             let path = path.as_ref();
             let text = std::fs::read_to_string(path).map_err(|e| DescError {
                 kind: DescErrorKind::Io,
@@ -306,7 +515,7 @@ mod tests {
         Keywords {
             beta: 0.1,
             p: 1.0,
-            eta: &GOLD,
+            eta: Eta::Channels(&GOLD),
             ..Keywords::default()
         }
     }
@@ -327,7 +536,7 @@ mod tests {
         let k = Keywords {
             base: Some("plastic"),
             albedo: Some(0.8),
-            eta: &[[1.5, 0.0]; 3],
+            eta: Eta::Channels(&[[1.5, 0.0]; 3]),
             masking: Some("height-correlated"),
             sigma_rel: Some("symmetrised"),
             colour: Some("white"),
@@ -354,7 +563,7 @@ mod tests {
         let cases: [(Keywords<'_>, &str); 7] = [
             (
                 Keywords {
-                    eta: &GOLD[..2],
+                    eta: Eta::Channels(&GOLD[..2]),
                     ..gold()
                 },
                 "eta must be three (n, k) pairs (red, green, blue), got 2",
@@ -389,7 +598,7 @@ mod tests {
             ),
             (
                 Keywords {
-                    eta: &[[0.2, 3.0], [0.2, -1.0], [0.2, 3.0]],
+                    eta: Eta::Channels(&[[0.2, 3.0], [0.2, -1.0], [0.2, 3.0]]),
                     ..gold()
                 },
                 "eta[1].k = -1: must be finite and ≥ 0",
@@ -406,7 +615,7 @@ mod tests {
             assert_eq!(k.material().unwrap_err().to_string(), message);
         }
         let e = Keywords {
-            eta: &GOLD,
+            eta: Eta::Channels(&GOLD),
             ..gold()
         }
         .layer(2)
@@ -421,10 +630,89 @@ mod tests {
         );
     }
 
+    #[test]
+    fn a_spectrum_gives_the_rgb_and_the_spectral_material() {
+        let rows = crate::optical::AU_JOHNSON;
+        let k = Keywords {
+            eta: Eta::Spectrum(&rows),
+            rgb_mode: Some("integrated"),
+            ..gold()
+        };
+        let d = k.material().unwrap();
+        let s = d.spectral.unwrap();
+        assert_eq!(s.eta, Ior::Tabulated(Tabulated::new(&rows).unwrap()));
+        assert_eq!(d.material, s.paper_rgb());
+        assert_eq!(d.rgb_mode, RgbMode::Integrated);
+        // One index for every channel is a spectrum too; different ones are not.
+        let d = Keywords {
+            eta: Eta::Channels(&[[1.5, 0.0]; 3]),
+            ..gold()
+        }
+        .material()
+        .unwrap();
+        assert_eq!(d.spectral.unwrap().eta, Ior::Constant(Complex::real(1.5)));
+        assert_eq!(d.rgb_mode, RgbMode::PaperWavelengths);
+        assert_eq!(gold().material().unwrap().spectral, None);
+    }
+
+    #[test]
+    fn spectral_refusals_have_their_message() {
+        let integrated = Keywords {
+            rgb_mode: Some("integrated"),
+            ..gold()
+        };
+        assert_eq!(
+            integrated.material().unwrap_err().to_string(),
+            "rgb_mode 'integrated' needs an index over the spectrum: eta = (lambda, n, k), \
+             or one (n, k) for every channel"
+        );
+        let mode = Keywords {
+            rgb_mode: Some("spectral"),
+            ..gold()
+        };
+        assert_eq!(
+            mode.material().unwrap_err().to_string(),
+            "rgb_mode must be one of 'paper-wavelengths' or 'integrated', got 'spectral'"
+        );
+        let decreasing = Keywords {
+            eta: Eta::Spectrum(&[[0.5, 1.0, 2.0], [0.4, 1.0, 2.0]]),
+            ..gold()
+        };
+        assert_eq!(
+            decreasing.material().unwrap_err().to_string(),
+            "lambda = 0.4: must be finite and > 0.5 (µm, increasing rows)"
+        );
+        // A spectrum where one index per wavelength is expected (materials.toml).
+        let spectrum = Keywords {
+            eta: Eta::Spectrum(&[[0.5, 1.0, 2.0]; 3]),
+            ..gold()
+        };
+        assert!(matches!(
+            spectrum.layer(3),
+            Err(Refused::EtaCount { found: 3, .. })
+        ));
+    }
+
+    #[cfg(feature = "std")]
+    #[test]
+    fn spectrum_rows_need_one_length() {
+        assert_eq!(
+            spectrum_rows(&[0.4, 0.5], &[1.0, 1.1], &[2.0, 2.1]).unwrap(),
+            vec![[0.4, 1.0, 2.0], [0.5, 1.1, 2.1]]
+        );
+        assert_eq!(
+            spectrum_rows(&[0.4, 0.5], &[1.0], &[2.0, 2.1])
+                .unwrap_err()
+                .to_string(),
+            "eta = (lambda, n, k) needs three arrays of one length, got 2, 1 and 2"
+        );
+    }
+
     #[cfg(feature = "toml")]
     mod toml_files {
         use super::super::*;
         use crate::brdf::BaseLayer;
+        use crate::optical::{Ior, Tabulated};
 
         const FIT: &str = r#"
 [material]
@@ -445,12 +733,49 @@ smape = 0.05
         #[test]
         fn a_fit_file_reads() {
             let d = MaterialDesc::from_toml_str(FIT).unwrap();
+            let d = d.get();
             let m = d.material;
             assert_eq!(m.layer.surface.beta, 0.0598f64 as f32);
             assert_eq!(m.layer.surface.p, 1.0);
             assert_eq!(m.layer.lambertian, 0.01f64 as f32);
             assert_eq!(m.layer.base, BaseLayer::Conductor);
             assert_eq!(m.eta_rgb[0], Complex::new(0.163, 3.56));
+        }
+
+        #[test]
+        fn a_spectral_file_reads() {
+            let text = FIT.replacen(
+                "eta = [[0.163, 3.56], [0.584, 2.15], [1.403, 1.925]]",
+                "eta = { lambda = [0.4, 0.5, 0.7], n = [1.5, 1.0, 0.2], k = [1.9, 2.0, 4.0] }\n\
+                 rgb_mode = \"integrated\"",
+                1,
+            );
+            let d = MaterialDesc::from_toml_str(&text).unwrap();
+            let d = d.get();
+            let s = d.spectral.unwrap();
+            assert_eq!(
+                s.eta,
+                Ior::Tabulated(
+                    Tabulated::new(&[[0.4, 1.5, 1.9], [0.5, 1.0, 2.0], [0.7, 0.2, 4.0]]).unwrap()
+                )
+            );
+            assert_eq!(d.rgb_mode, RgbMode::Integrated);
+            assert_eq!(d.material.eta_rgb, s.eta.at_rgb());
+            let short = text.replacen("k = [1.9, 2.0, 4.0]", "k = [1.9, 2.0]", 1);
+            let e = MaterialDesc::from_toml_str(&short).unwrap_err();
+            assert_eq!(e.kind, DescErrorKind::Syntax);
+            assert!(
+                e.message.contains(
+                    "eta = (lambda, n, k) needs three arrays of one length, got 3, 3 and 2"
+                ),
+                "{e}"
+            );
+            let bad = text.replacen("lambda = [0.4, 0.5, 0.7]", "lambda = [0.4, 0.5, 0.5]", 1);
+            let e = MaterialDesc::from_toml_str(&bad).unwrap_err();
+            assert_eq!(
+                e.message,
+                "[material] lambda = 0.5: must be finite and > 0.5 (µm, increasing rows)"
+            );
         }
 
         #[test]

@@ -171,6 +171,46 @@ impl SpectralMaterial<'_> {
     }
 }
 
+/// A [`SpectralMaterial`] that owns its rows (feature `std`): what a front
+/// end keeps of a material given at run time (Python's `Material`, the C
+/// API's handle, a material file). Built from a valid material only, so
+/// [`OwnedSpectralMaterial::get`] gives one.
+#[cfg(feature = "std")]
+#[derive(Clone, Debug, PartialEq)]
+pub struct OwnedSpectralMaterial {
+    layer: Layer,
+    /// The constant index, or `None` for `rows`.
+    constant: Option<Complex>,
+    rows: std::vec::Vec<[f32; 3]>,
+}
+
+#[cfg(feature = "std")]
+impl OwnedSpectralMaterial {
+    /// A copy of `material` (its rows copied).
+    pub fn new(material: &SpectralMaterial<'_>) -> Self {
+        let (constant, rows) = match material.eta {
+            Ior::Constant(eta) => (Some(eta), std::vec::Vec::new()),
+            Ior::Tabulated(t) => (None, t.rows.to_vec()),
+        };
+        OwnedSpectralMaterial {
+            layer: material.layer,
+            constant,
+            rows,
+        }
+    }
+
+    /// The material, borrowing the rows.
+    pub fn get(&self) -> SpectralMaterial<'_> {
+        SpectralMaterial {
+            layer: self.layer,
+            eta: match self.constant {
+                Some(eta) => Ior::Constant(eta),
+                None => Ior::Tabulated(Tabulated { rows: &self.rows }),
+            },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

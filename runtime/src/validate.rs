@@ -20,7 +20,7 @@
 
 use crate::brdf::{
     BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, MultipleScattering,
-    SigmaRelMode, Surface,
+    RgbMode, SigmaRelMode, Surface,
 };
 use crate::epd::{BETA_RANGE, P_RANGE};
 use crate::fresnel::Complex;
@@ -309,6 +309,14 @@ impl Named for MultipleScattering {
     ];
 }
 
+impl Named for RgbMode {
+    const OPTION: &'static str = "rgb_mode";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("paper-wavelengths", RgbMode::PaperWavelengths),
+        ("integrated", RgbMode::Integrated),
+    ];
+}
+
 impl Named for BaseKind {
     const OPTION: &'static str = "base";
     const NAMES: &'static [(&'static str, Self)] = &[
@@ -387,6 +395,11 @@ pub enum Refused<'a> {
     AlbedoOnConductor,
     /// A plastic or subsurface base without its albedo.
     MissingAlbedo(BaseKind),
+    /// `eta = (lambda, n, k)` whose three arrays differ in length.
+    SpectrumLengths([usize; 3]),
+    /// `rgb_mode = "integrated"` for a material without an index over the
+    /// spectrum (different (n, k) per channel).
+    IntegratedNeedsSpectrum,
 }
 
 impl From<Invalid> for Refused<'_> {
@@ -420,6 +433,16 @@ impl fmt::Display for Refused<'_> {
                 BaseKind::Conductor.name()
             ),
             Refused::MissingAlbedo(kind) => write!(f, "base '{}' needs an albedo", kind.name()),
+            Refused::SpectrumLengths([l, n, k]) => write!(
+                f,
+                "eta = (lambda, n, k) needs three arrays of one length, got {l}, {n} and {k}"
+            ),
+            Refused::IntegratedNeedsSpectrum => write!(
+                f,
+                "rgb_mode '{}' needs an index over the spectrum: eta = (lambda, n, k), \
+                 or one (n, k) for every channel",
+                RgbMode::Integrated.name()
+            ),
         }
     }
 }

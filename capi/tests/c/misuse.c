@@ -233,6 +233,8 @@ int main(int argc, char **argv) {
     bad.beta = NAN;
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "beta");
     bad = desc;
+    bad.eta_rows = NULL; /* the channels' index is read only without rows */
+    bad.eta_row_count = 0;
     bad.eta_im[2] = INFINITY;
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "eta_im[2]");
     bad = desc;
@@ -283,6 +285,8 @@ int main(int argc, char **argv) {
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
                 "ts_material_desc.base_albedo = 0.5");
     bad = desc;
+    bad.eta_rows = NULL;
+    bad.eta_row_count = 0;
     bad.eta_im[1] = -1.0f;
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID, "ts_material_desc.eta_im[1] = -1");
 

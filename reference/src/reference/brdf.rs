@@ -132,7 +132,8 @@ impl fmt::Display for Uncovered {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(
             "the f64 reference covers conductors without a Lambertian term, and their \
-             energy compensation (multiple_scattering) without diffraction (sigma_s = 0)",
+             energy compensation (multiple_scattering) without diffraction (sigma_s = 0) \
+             at the paper's wavelengths",
         )
     }
 }

@@ -267,3 +267,44 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
         })
     }
 }
+
+/// Which RGB a material's model gives: the paper's three wavelengths
+/// ([`super::Rgb`], HP15 §5.5; the default, which the Dr.Jit plugin, T4
+/// and the docs' figures mirror) or the integral over the spectrum
+/// ([`IntegratedRgb`], docs/model.md §2.12). Named `rgb_mode` in material
+/// files and Python, `ts_material_desc.rgb_mode` in C.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RgbMode {
+    /// ρ at 0.645, 0.526, 0.444 µm as red, green, blue.
+    #[default]
+    PaperWavelengths,
+    /// `ρ_c = ∫ ρ(λ) w_c(λ) dλ` (needs the index over the spectrum).
+    Integrated,
+}
+
+/// The RGB model of [`RgbMode`]: [`super::Rgb`] or [`IntegratedRgb`].
+#[derive(Clone)]
+#[allow(clippy::large_enum_variant)] // one per material, boxed by the front ends
+pub enum RgbModel<'a, B = ChannelBake> {
+    /// [`RgbMode::PaperWavelengths`].
+    PaperWavelengths(super::Rgb<'a, B>),
+    /// [`RgbMode::Integrated`].
+    Integrated(IntegratedRgb<'a, B>),
+}
+
+#[cfg(feature = "std")]
+impl<'a> RgbModel<'a, std::boxed::Box<ChannelBake>> {
+    /// The model `desc.rgb_mode` names, its bakes on the heap
+    /// ([`crate::desc::MaterialDesc`] holds the spectrum that
+    /// [`RgbMode::Integrated`] needs).
+    pub fn boxed(tables: &Tables<'a>, desc: &crate::desc::MaterialDesc<'_>) -> Self {
+        match (desc.rgb_mode, &desc.spectral) {
+            (RgbMode::Integrated, Some(spectral)) => {
+                RgbModel::Integrated(IntegratedRgb::boxed(tables, spectral, desc.options))
+            }
+            _ => {
+                RgbModel::PaperWavelengths(super::Rgb::boxed(tables, &desc.material, desc.options))
+            }
+        }
+    }
+}
