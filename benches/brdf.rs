@@ -16,7 +16,9 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use suite::brdf::NarrowNdfConvolution;
 use suite::cost::{BATCH, Inputs, LAMBDA, NICKEL_LIKE, RGB_PRESET, ggx, nickel, rgb_preset};
-use twoscale::brdf::{IntegratedRgb, Options, Rgb, Spectral, TwoScale};
+use twoscale::brdf::{
+    BaseLayer, IntegratedRgb, Layer, MultipleScattering, Options, Rgb, Spectral, TwoScale,
+};
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 use twoscale::{Convolution, TableSet};
 
@@ -50,6 +52,23 @@ fn brdf(c: &mut Criterion) {
             let mut sum = 0.0f32;
             for &(i, o) in &pairs {
                 sum += model.eval(black_box(i), black_box(o));
+            }
+            sum
+        })
+    });
+    // The same model with the energy-compensation lobe (issue 27; target ≤ 1.15× off).
+    let compensated = TwoScale::new(
+        &set.brdf_tables_with(conv),
+        conductor(HP17_NICKEL_SURFACE),
+        LAMBDA,
+        NICKEL_LIKE,
+        kulla_conty(),
+    );
+    group.bench_function(format!("two_scale_eval_kulla_conty_{suffix}"), |b| {
+        b.iter(|| {
+            let mut sum = 0.0f32;
+            for &(i, o) in &pairs {
+                sum += compensated.eval(black_box(i), black_box(o));
             }
             sum
         })
@@ -171,6 +190,18 @@ fn brdf(c: &mut Criterion) {
             )
         })
     });
+    // With the compensation lobe: T6's column and the halo's deficit (σs > 0).
+    setup.bench_function("two_scale_new_kulla_conty", |b| {
+        b.iter(|| {
+            TwoScale::new(
+                &set.brdf_tables(),
+                conductor(black_box(HP17_NICKEL_SURFACE)),
+                LAMBDA,
+                NICKEL_LIKE,
+                kulla_conty(),
+            )
+        })
+    });
     setup.bench_function("rgb_preset", |b| {
         b.iter(|| {
             Rgb::new(
@@ -199,6 +230,23 @@ fn brdf(c: &mut Criterion) {
         })
     });
     setup.finish();
+}
+
+/// A conductor layer of `surface`.
+fn conductor(surface: twoscale::brdf::Surface) -> Layer {
+    Layer {
+        surface,
+        base: BaseLayer::Conductor,
+        lambertian: 0.0,
+    }
+}
+
+/// The default options with the energy-compensation lobe.
+fn kulla_conty() -> Options {
+    Options {
+        multiple_scattering: MultipleScattering::KullaConty,
+        ..Options::default()
+    }
 }
 
 criterion_group!(benches, brdf);

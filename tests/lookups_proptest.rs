@@ -6,7 +6,8 @@ use proptest::prelude::*;
 use std::sync::LazyLock;
 use twoscale::TableSet;
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, Options, SigmaRelMode, Surface,
+    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, MultipleScattering, Options,
+    SigmaRelMode, Surface,
 };
 use twoscale::conv::Convolution;
 use twoscale::epd::Epd;
@@ -90,7 +91,7 @@ proptest! {
     fn brdf_is_finite(params in [finite(), finite(), finite(), finite(), finite(),
                                  finite(), finite()],
                       eta in [finite(), finite(), finite(), finite(), finite(), finite()],
-                      base in 0usize..3, options in [0usize..2, 0usize..2, 0usize..2, 0usize..2],
+                      base in 0usize..3, options in [0usize..2, 0usize..2, 0usize..2, 0usize..2, 0usize..2],
                       i in vec3(), o in vec3(), u in vec3()) {
         let [beta, p, sigma_s, b, c, albedo, lambertian] = params;
         let material = Material {
@@ -110,6 +111,8 @@ proptest! {
             sigma_rel: [SigmaRelMode::Incident, SigmaRelMode::Symmetrised][options[1]],
             colour: [ColourTerms::Physical, ColourTerms::White][options[2]],
             halo_weight: [HaloWeight::Printed, HaloWeight::Incident][options[3]],
+            multiple_scattering: [MultipleScattering::None, MultipleScattering::KullaConty]
+                [options[4]],
         };
         let set = &*SET;
         let model = set.rgb(&material, options);

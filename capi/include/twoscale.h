@@ -138,6 +138,17 @@
 #define TS_HALO_INCIDENT 1
 
 /**
+ * `ts_material_desc.multiple_scattering`: single scattering only (the papers' model).
+ */
+#define TS_MULTIPLE_NONE 0
+
+/**
+ * `ts_material_desc.multiple_scattering`: the Kulla–Conty energy-compensation
+ * lobe (docs/model.md §2.11).
+ */
+#define TS_MULTIPLE_KULLA_CONTY 1
+
+/**
  * `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
  * (`ts_rgb_wavelengths`) as red, green, blue (the default).
  */
@@ -295,6 +306,10 @@ typedef struct {
    * `TS_HALO_*`.
    */
   int32_t halo_weight;
+  /**
+   * `TS_MULTIPLE_*`.
+   */
+  int32_t multiple_scattering;
   /**
    * `TS_RGB_MODE_*`.
    */

@@ -20,8 +20,8 @@ use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
 use twoscale::brdf::{
-    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material, Options,
-    RGB_WAVELENGTHS, RgbMode, RgbModel, SigmaRelMode, Surface,
+    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material,
+    MultipleScattering, Options, RGB_WAVELENGTHS, RgbMode, RgbModel, SigmaRelMode, Surface,
 };
 use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
@@ -77,6 +77,11 @@ pub const TS_COLOUR_WHITE: i32 = 1;
 pub const TS_HALO_PRINTED: i32 = 0;
 /// `ts_material_desc.halo_weight`: `A = A(θi)` for the halo (energy-bounded).
 pub const TS_HALO_INCIDENT: i32 = 1;
+/// `ts_material_desc.multiple_scattering`: single scattering only (the papers' model).
+pub const TS_MULTIPLE_NONE: i32 = 0;
+/// `ts_material_desc.multiple_scattering`: the Kulla–Conty energy-compensation
+/// lobe (docs/model.md §2.11).
+pub const TS_MULTIPLE_KULLA_CONTY: i32 = 1;
 /// `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
 /// (`ts_rgb_wavelengths`) as red, green, blue (the default).
 pub const TS_RGB_MODE_PAPER_WAVELENGTHS: i32 = 0;
@@ -185,6 +190,8 @@ pub struct ts_material_desc {
     pub colour: i32,
     /// `TS_HALO_*`.
     pub halo_weight: i32,
+    /// `TS_MULTIPLE_*`.
+    pub multiple_scattering: i32,
     /// `TS_RGB_MODE_*`.
     pub rgb_mode: i32,
 }
@@ -210,6 +217,7 @@ impl Default for ts_material_desc {
             sigma_rel: TS_SIGMA_REL_INCIDENT,
             colour: TS_COLOUR_PHYSICAL,
             halo_weight: TS_HALO_PRINTED,
+            multiple_scattering: TS_MULTIPLE_NONE,
             rgb_mode: TS_RGB_MODE_PAPER_WAVELENGTHS,
         }
     }
@@ -520,11 +528,28 @@ impl ts_material_desc {
                 ("TS_HALO_INCIDENT", TS_HALO_INCIDENT, HaloWeight::Incident),
             ],
         )?;
+        let multiple_scattering = constant(
+            "multiple_scattering",
+            self.multiple_scattering,
+            &[
+                (
+                    "TS_MULTIPLE_NONE",
+                    TS_MULTIPLE_NONE,
+                    MultipleScattering::None,
+                ),
+                (
+                    "TS_MULTIPLE_KULLA_CONTY",
+                    TS_MULTIPLE_KULLA_CONTY,
+                    MultipleScattering::KullaConty,
+                ),
+            ],
+        )?;
         let options = Options {
             masking,
             sigma_rel,
             colour,
             halo_weight,
+            multiple_scattering,
         };
         let material = Material {
             layer: Layer {
@@ -649,6 +674,10 @@ impl ts_material_desc {
             halo_weight: match options.halo_weight {
                 HaloWeight::Printed => TS_HALO_PRINTED,
                 HaloWeight::Incident => TS_HALO_INCIDENT,
+            },
+            multiple_scattering: match options.multiple_scattering {
+                MultipleScattering::None => TS_MULTIPLE_NONE,
+                MultipleScattering::KullaConty => TS_MULTIPLE_KULLA_CONTY,
             },
             rgb_mode: match desc.rgb_mode {
                 RgbMode::PaperWavelengths => TS_RGB_MODE_PAPER_WAVELENGTHS,
@@ -1308,11 +1337,20 @@ mod tests {
                             sigma_rel,
                             colour,
                             halo_weight,
+                            multiple_scattering: MultipleScattering::None,
                         })
                     })
             })
+            .flat_map(|o| {
+                [MultipleScattering::None, MultipleScattering::KullaConty].map(
+                    |multiple_scattering| Options {
+                        multiple_scattering,
+                        ..o
+                    },
+                )
+            })
             .collect::<Vec<_>>();
-        assert_eq!(all_options.len(), 16);
+        assert_eq!(all_options.len(), 32);
         for (name, material) in PRESETS {
             for options in &all_options {
                 for rgb_mode in [RgbMode::PaperWavelengths, RgbMode::Integrated] {

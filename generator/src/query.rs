@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use twoscale::brdf::{ChannelBake, RgbMode, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::brdf::{ChannelBake, MultipleScattering, RgbMode, SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::OwnedMaterialDesc;
 use twoscale::optical::SpectralMaterial;
 use twoscale::{
@@ -263,6 +263,8 @@ pub enum QueryError {
     MaterialUnsupported(Quantity),
     /// The material of `--material` is one the reference does not cover.
     Uncovered(brdf::Uncovered),
+    /// The reference's compensation lobe of the `--material` could not be built.
+    Reference(brdf::BrdfError),
     /// `--material` with `rgb_mode = "integrated"` and a `channel` column:
     /// the reference gives the paper's three wavelengths only.
     IntegratedUnsupported,
@@ -307,6 +309,7 @@ impl fmt::Display for QueryError {
                 q.name()
             ),
             QueryError::Uncovered(e) => write!(f, "--material: {e}"),
+            QueryError::Reference(e) => write!(f, "--material: the reference failed: {e}"),
             QueryError::IntegratedUnsupported => write!(
                 f,
                 "--material: rows of {} compare with the reference at the paper's wavelengths; \
@@ -522,6 +525,9 @@ enum MaterialModel<'a> {
         model: Box<Rgb<'a, Box<ChannelBake>>>,
         params: [brdf::Params; 3],
         options: twoscale::brdf::Options,
+        /// The reference's energy-compensation lobe per channel, when the
+        /// material's options ask for it.
+        compensation: Option<Box<[brdf::Compensation; 3]>>,
     },
     /// Rows of [`SPECTRAL_COLUMNS`]: the spectral model, and the reference's
     /// parameters with `n`, `k`, `λ` set per row from the material's index.
@@ -539,18 +545,30 @@ impl MaterialModel<'_> {
     fn evaluate(&self, x: &[f64]) -> Result<Vec<String>, RowError> {
         let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
         let f = |v: f64| v as f32;
-        let (value, params, options) = match self {
+        let (value, params, options, multiple) = match self {
             MaterialModel::Channels {
                 model,
                 params,
                 options,
+                compensation,
             } => {
                 let channel = x[0];
                 let ch = [0.0, 1.0, 2.0]
                     .iter()
                     .position(|&c| c == channel)
                     .ok_or(RowError::Channel(channel))?;
-                (model.eval(i.map(f), o.map(f))[ch], params[ch], options)
+                let multiple = match compensation {
+                    Some(lobes) => lobes[ch]
+                        .value(i, o)
+                        .map_err(|e| RowError::Reference(e.to_string()))?,
+                    None => 0.0,
+                };
+                (
+                    model.eval(i.map(f), o.map(f))[ch],
+                    params[ch],
+                    options,
+                    multiple,
+                )
             }
             MaterialModel::Spectral {
                 model,
@@ -577,12 +595,12 @@ impl MaterialModel<'_> {
                     lambda: lambda.into(),
                     ..*params
                 };
-                (model.eval(i.map(f), o.map(f), lambda), params, options)
+                (model.eval(i.map(f), o.map(f), lambda), params, options, 0.0)
             }
         };
         let reference = brdf::two_scale(&params, i, o, options)
             .map_err(|e| RowError::Reference(e.to_string()))?;
-        Ok(vec![short32(value), short(reference.total())])
+        Ok(vec![short32(value), short(reference.total() + multiple)])
     }
 }
 
@@ -618,7 +636,8 @@ pub fn run(
         }
         Some(desc) => Some((
             desc.get(),
-            brdf::Params::rgb(&desc.get().material).map_err(QueryError::Uncovered)?,
+            brdf::Params::rgb_with(&desc.get().material, &desc.get().options)
+                .map_err(QueryError::Uncovered)?,
         )),
         None => None,
     };
@@ -650,6 +669,12 @@ pub fn run(
         }
         Some((desc, _)) if !spectral_rows && desc.rgb_mode == RgbMode::Integrated => {
             return Err(QueryError::IntegratedUnsupported);
+        }
+        // The reference's compensation lobe is built per channel, not per row's λ.
+        Some((desc, _))
+            if spectral_rows && desc.options.multiple_scattering != MultipleScattering::None =>
+        {
+            return Err(QueryError::Uncovered(brdf::Uncovered));
         }
         _ => {}
     }
@@ -691,6 +716,9 @@ pub fn run(
                 model: Box::new(Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options)),
                 params,
                 options: desc.options,
+                compensation: brdf::Compensation::rgb(&params, &desc.options)
+                    .map_err(QueryError::Reference)?
+                    .map(Box::new),
             },
         }),
         _ => None,

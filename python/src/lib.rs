@@ -26,7 +26,7 @@ use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 use twoscale::brdf::{
     BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
-    Options, SigmaRelMode, Surface,
+    MultipleScattering, Options, SigmaRelMode, Surface,
 };
 use twoscale::brdf::{RgbMode, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{self, DescError, DescErrorKind, Eta, Keywords, MaterialDesc};
@@ -205,12 +205,14 @@ fn options(
     sigma_rel: Option<&str>,
     colour: Option<&str>,
     halo_weight: Option<&str>,
+    multiple_scattering: Option<&str>,
 ) -> PyResult<Options> {
     Ok(Options {
         masking: named(masking)?,
         sigma_rel: named(sigma_rel)?,
         colour: named(colour)?,
         halo_weight: named(halo_weight)?,
+        multiple_scattering: named(multiple_scattering)?,
     })
 }
 
@@ -246,7 +248,7 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 
 /// Material(*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
 /// albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-/// halo_weight=None, rgb_mode=None): the RGB two-scale model of one material, built once
+/// halo_weight=None, multiple_scattering=None, rgb_mode=None): the RGB two-scale model of one material, built once
 /// (the runtime bakes its per-material tables) and evaluated over arrays of
 /// directions.
 ///
@@ -411,7 +413,7 @@ impl Material {
     #[new]
     #[pyo3(signature = (*, beta, p, eta, sigma_s=None, b=None, c=None, base=None,
         albedo=None, lambertian=None, masking=None, sigma_rel=None, colour=None,
-        halo_weight=None, rgb_mode=None))]
+        halo_weight=None, multiple_scattering=None, rgb_mode=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         beta: f32,
@@ -427,6 +429,7 @@ impl Material {
         sigma_rel: Option<&str>,
         colour: Option<&str>,
         halo_weight: Option<&str>,
+        multiple_scattering: Option<&str>,
         rgb_mode: Option<&str>,
     ) -> PyResult<Self> {
         // The keywords are a material description's keys (`twoscale::desc`):
@@ -446,6 +449,7 @@ impl Material {
             sigma_rel,
             colour,
             halo_weight,
+            multiple_scattering,
             rgb_mode,
         };
         let desc = keywords
@@ -476,24 +480,25 @@ impl Material {
     }
 
     /// preset(name, *, masking=None, sigma_rel=None, colour=None,
-    /// halo_weight=None, rgb_mode=None): the shipped preset `name`
-    /// (`Material.presets()` lists them; its measured index over the
-    /// spectrum) with the given options (names as in `OPTIONS` and
+    /// halo_weight=None, multiple_scattering=None, rgb_mode=None): the shipped
+    /// preset `name` (`Material.presets()` lists them; its measured index
+    /// over the spectrum) with the given options (names as in `OPTIONS` and
     /// `RGB_MODES`; None: the runtime's default, the paper's wavelengths).
     #[staticmethod]
     #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None,
-        rgb_mode=None))]
+        multiple_scattering=None, rgb_mode=None))]
     fn preset(
         name: &str,
         masking: Option<&str>,
         sigma_rel: Option<&str>,
         colour: Option<&str>,
         halo_weight: Option<&str>,
+        multiple_scattering: Option<&str>,
         rgb_mode: Option<&str>,
     ) -> PyResult<Self> {
         let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
-        let options = options(masking, sigma_rel, colour, halo_weight)?;
+        let options = options(masking, sigma_rel, colour, halo_weight, multiple_scattering)?;
         let desc = MaterialDesc::spectral(spectral, options, named(rgb_mode)?)
             .map_err(|e| value_error(e.to_string()))?;
         Ok(Material::build(&desc))
@@ -649,19 +654,27 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let params =
-            ref_brdf::Params::rgb(&self.material).map_err(|e| value_error(e.to_string()))?;
+        let options = self.options;
+        let params = ref_brdf::Params::rgb_with(&self.material, &options)
+            .map_err(|e| value_error(e.to_string()))?;
+        let compensation = py
+            .detach(|| ref_brdf::Compensation::rgb(&params, &options))
+            .map_err(|e| value_error(e.to_string()))?;
         let v = vectors([("wi", wi), ("wo", wo)])?;
         let [wi, wo] = &v.rows;
-        let options = self.options;
         let values = py.detach(|| {
             (0..v.len() * 3)
                 .into_par_iter()
                 .map(|j| {
                     let (k, ch) = (j / 3, j % 3);
                     let f64s = |v: [f32; 3]| v.map(f64::from);
-                    ref_brdf::two_scale(&params[ch], f64s(wi[k]), f64s(wo[k]), &options)
-                        .map(|v| v.total())
+                    let (i, o) = (f64s(wi[k]), f64s(wo[k]));
+                    let multiple = match &compensation {
+                        Some(lobes) => lobes[ch].value(i, o),
+                        None => Ok(0.0),
+                    };
+                    ref_brdf::two_scale(&params[ch], i, o, &options)
+                        .and_then(|v| Ok(v.total() + multiple?))
                         .map_err(|e| format!("row {k}: {e}"))
                 })
                 .collect::<Result<Vec<f64>, String>>()
@@ -802,7 +815,7 @@ impl Material {
         self.material.layer.lambertian
     }
     /// The options as a dict of keyword names ("colour", "halo_weight",
-    /// "masking", "sigma_rel") to their values.
+    /// "masking", "multiple_scattering", "sigma_rel") to their values.
     #[getter]
     fn options(&self) -> BTreeMap<&'static str, &'static str> {
         let o = self.options;
@@ -811,6 +824,7 @@ impl Material {
             (SigmaRelMode::OPTION, o.sigma_rel.name()),
             (ColourTerms::OPTION, o.colour.name()),
             (HaloWeight::OPTION, o.halo_weight.name()),
+            (MultipleScattering::OPTION, o.multiple_scattering.name()),
         ])
     }
     /// Which RGB `eval` gives: "paper-wavelengths" or "integrated" (`RGB_MODES`).
@@ -1170,6 +1184,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         (SigmaRelMode::OPTION, names::<SigmaRelMode>()),
         (ColourTerms::OPTION, names::<ColourTerms>()),
         (HaloWeight::OPTION, names::<HaloWeight>()),
+        (MultipleScattering::OPTION, names::<MultipleScattering>()),
     ]);
     let options = options
         .into_iter()

@@ -99,6 +99,8 @@ MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
     ("gold-hp17-geometry", {"sigma_rel": "symmetrised"}),
     ("gold-hp17-geometry", {"halo_weight": "incident"}),
     ("white-plastic", {"colour": "white"}),
+    ("gold-rough", {"multiple_scattering": "kulla-conty"}),
+    ("white-plastic", {"multiple_scattering": "kulla-conty"}),
 ]
 
 
@@ -230,6 +232,8 @@ CHI2_CASES = [
     ("marble, 10°", dict(material="marble"), 10.0),
     ("strong halo, 20°", STRONG_HALO, 20.0),
     ("strong halo, grazing 80°", STRONG_HALO, 80.0),
+    ("compensated gold-rough, 60°",
+     dict(material="gold-rough", multiple_scattering="kulla-conty"), 60.0),
 ]
 
 
@@ -254,6 +258,20 @@ def test_white_furnace(name, theta):
     standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
     print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")
     assert np.all(np.abs(mean - expected) < 4 * standard_error + 2e-3)
+
+
+def test_white_furnace_with_energy_compensation():
+    """A β = 0.8 conductor (σs = 0, reciprocal, so the render's integral over
+    the light's directions is the albedo) renders at 1 ± 0.005 with
+    ``multiple_scattering="kulla-conty"``; without, it is dark."""
+    kw = dict(beta=0.8, p=1.0, eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)], colour="white")
+    for options, lo, hi in [({}, 0.0, 0.95), ({"multiple_scattering": "kulla-conty"}, 0.995, 1.005)]:
+        material = twoscale.Material(**kw, **options)
+        pixels = furnace_render(tm.bsdf_dict(material), 45, seed=0)
+        mean = pixels.mean(axis=0)
+        standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
+        print(f"furnace β = 0.8 {options} θo=45: render {mean} ± {standard_error}")
+        assert np.all((mean > lo - 4 * standard_error) & (mean < hi + 4 * standard_error))
 
 
 @pytest.mark.parametrize("alpha", [0.1, 0.3])

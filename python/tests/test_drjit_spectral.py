@@ -35,13 +35,21 @@ def spectral_variant():
         mi.set_variant(saved)
 
 
-@pytest.mark.parametrize("name", twoscale.Material.presets() + ["white-plastic/white"])
+def preset_with(name):
+    """The preset `name`, or `preset/white` with white colour terms, or
+    `preset/kulla-conty` with the energy compensation."""
+    preset, _, option = name.partition("/")
+    key = {"white": "colour", "kulla-conty": "multiple_scattering"}.get(option)
+    return twoscale.Material.preset(preset, **({key: option} if key else {}))
+
+
+@pytest.mark.parametrize("name", twoscale.Material.presets()
+                         + ["white-plastic/white", "gold-rough/kulla-conty"])
 def test_eval_equals_the_runtime(name):
     """`SpectralModel.eval_spectral` equals `Material.eval_spectral` within
     2e-4 relative where ρ exceeds 1e-6 of the peak, on 10⁴ pairs at four
     uniform wavelengths each (the ends included), inside a symbolic loop."""
-    preset, _, colour = name.partition("/")
-    material = twoscale.Material.preset(preset, **({"colour": colour} if colour else {}))
+    material = preset_with(name)
     model = tb.SpectralModel(material)
     light, camera = pairs(seed(name, "spectral"))
     rng = np.random.default_rng(seed(name, "lam"))
@@ -60,15 +68,15 @@ def test_eval_equals_the_runtime(name):
     assert small_ok
 
 
-@pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble", "silver", "white-plastic/white"])
+@pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble", "silver", "white-plastic/white",
+                                  "gold-rough/kulla-conty"])
 def test_pdf_and_sample_equal_the_runtime(name):
     """`pdf_spectral` and `sample_spectral` (the model nearest the hero
     wavelength) equal `Material.pdf_spectral` within 2e-4 relative where
     above 1e-6 of the peak, and `Material.sample_spectral`'s directions
     within 1e-4 (the diffraction sampler's f32 logarithm, as in RGB), failing
     on the same rows, on 10⁴ pairs at uniform wavelengths."""
-    preset, _, colour = name.partition("/")
-    material = twoscale.Material.preset(preset, **({"colour": colour} if colour else {}))
+    material = preset_with(name)
     model = tb.SpectralModel(material)
     light, camera = pairs(seed(name, "spectral pdf"))
     rng = np.random.default_rng(seed(name, "spectral u"))

@@ -54,6 +54,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        multiple_scattering: str | None = None,
         rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod
@@ -64,6 +65,7 @@ class Material:
         sigma_rel: str | None = None,
         colour: str | None = None,
         halo_weight: str | None = None,
+        multiple_scattering: str | None = None,
         rgb_mode: str | None = None,
     ) -> Material: ...
     @staticmethod

@@ -257,14 +257,14 @@ class _Channel:
 
     # -- the sampler's densities ---------------------------------------
     def lobe_weights(self, cos_i):
-        """`DirectionBake::lobe_weights`: `[specular, diffraction, base]`, sum 1 (f64)."""
+        """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
+        sum 1 (f64)."""
         i, frac = self.direction_cell(mi.Float(cos_i))
         w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
-             for k in range(3)]
-        total = w[0] + w[1] + w[2]
+             for k in range(4)]
+        total = w[0] + w[1] + w[2] + w[3]
         ok = total > 0.0
-        return [dr.select(ok, w[0] / total, 1.0), dr.select(ok, w[1] / total, 0.0),
-                dr.select(ok, w[2] / total, 0.0)]
+        return [dr.select(ok, w[0] / total, 1.0)] + [dr.select(ok, x / total, 0.0) for x in w[1:]]
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
@@ -674,16 +674,16 @@ class _Channel:
         return single + t * multi + lambertian
 
     def lobes(self, g, geo, params):
-        """`TwoScale::lobes`: (specular, diffraction, base) at a pair, the
-        diffraction lobe times `params["halo_factor"]` and the base layer's
-        with `params`' albedo and k_d (:meth:`base_value`)."""
+        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair,
+        the diffraction lobe times `params["halo_factor"]` and the base
+        layer's with `params`' albedo and k_d (:meth:`base_value`)."""
         s = self.s
         wi, wo = geo["wi"], geo["wo"]
         cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
         cell_i = self.direction_cell(mi.Float(cos_i))
         cell_o = self.direction_cell(mi.Float(cos_o))
-        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(7))]
-        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(7))]
+        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(8))]
+        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(8))]
         # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
         x = self.d["x_scale"] * cos_d * cos_d
         if s["sigma_s"] > 0.0:
@@ -725,7 +725,10 @@ class _Channel:
         else:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
-        return _finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base)
+        # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
+        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
+                _finite_or_zero(multiple))
 
 
 def default_params(material: twoscale.Material):
@@ -812,9 +815,10 @@ class Model:
         g = self.masking(geo)
         values = []
         for channel in self.channels:
-            spec, diff, base = channel.lobes(g, geo, self.params)
+            spec, diff, base, multiple = channel.lobes(g, geo, self.params)
             values.append(mi.Float(_finite_or_zero(
-                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base)))))
+                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base))
+                + mi.Float64(mi.Float(multiple)))))
         return dr.select(valid, mi.Color3f(*values), 0.0)
 
     def pdf(self, wi, wo):
@@ -830,7 +834,8 @@ class Model:
             value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
             if channel.diffraction:
                 value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo, geo), 0.0)
-            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            # The base and the compensation lobe share the cosine-weighted density.
+            value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
             total += mi.Float64(_finite_or_zero(mi.Float(value)))
         return dr.select(valid, _finite_or_zero(mi.Float(total / 3.0)), 0.0)
 
@@ -853,10 +858,10 @@ class Model:
         # The picked channel's lobe weights.
         weights = [ch.lobe_weights(wi.z) for ch in self.channels]
         w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
-             for n in range(3)]
+             for n in range(4)]
         # `pick_lobe`.
         cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
-        for n in range(3):
+        for n in range(4):
             positive = w[n] > 0.0
             cumulative += dr.select(positive, w[n], 0.0)
             last = dr.select(positive, n, last)
@@ -876,8 +881,8 @@ class Model:
         # Base: cosine-weighted.
         r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
         ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-        o = dr.select(lobe == 2, ob, o)
-        ok = dr.select(lobe == 2, True, ok)
+        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
+        ok = dr.select(lobe >= 2, True, ok)
         ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
         # `upper_unit(to_f32(o))`, back to f32.
         o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
@@ -966,11 +971,11 @@ class SpectralModel(Model):
         cos_d = mi.Float(geo["cos_d"])
         surface, base, total, fresnel = [], [], [], []
         for channel in self.channels:
-            spec, diff, b = channel.lobes(g, geo, self.params)
-            spec, diff, b = (mi.Float64(mi.Float(x)) for x in (spec, diff, b))
+            spec, diff, b, mult = channel.lobes(g, geo, self.params)
+            spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
             surface.append(spec + diff)
-            base.append(b)
-            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b))))
+            base.append(b + mult)  # the base and the compensation lobe: linear in λ
+            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult))))
             fresnel.append(mi.Float64(1.0) if self.white else mi.Float64(
                 channel.direction(channel.direction_cell(cos_d), [6])[0]))
         out = []
@@ -1013,7 +1018,7 @@ class SpectralModel(Model):
             value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
             if channel.diffraction:
                 value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo, geo), 0.0)
-            value += dr.select(w[2] > 0.0, w[2] * base, 0.0)
+            value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
             total = dr.select(nearest == m, value, total)
         return dr.select(valid, _finite_or_zero(mi.Float(total)), 0.0)
 
@@ -1030,13 +1035,13 @@ class SpectralModel(Model):
         pick = mi.Float64(dr.clip(u.x, 0.0, below_one))
         u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
         u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
-        w = [mi.Float64(0.0)] * 3
+        w = [mi.Float64(0.0)] * 4
         for m, channel in enumerate(self.channels):
             wm = channel.lobe_weights(wi.z)
-            w = [dr.select(nearest == m, wm[n], w[n]) for n in range(3)]
+            w = [dr.select(nearest == m, wm[n], w[n]) for n in range(4)]
         # `pick_lobe`.
         cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
-        for n in range(3):
+        for n in range(4):
             positive = w[n] > 0.0
             cumulative += dr.select(positive, w[n], 0.0)
             last = dr.select(positive, n, last)
@@ -1052,8 +1057,8 @@ class SpectralModel(Model):
                 ok = dr.select(here, ok_d, ok)
         r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
         ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-        o = dr.select(lobe == 2, ob, o)
-        ok = dr.select(lobe == 2, True, ok)
+        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
+        ok = dr.select(lobe >= 2, True, ok)
         ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
         o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
         ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))

@@ -26,8 +26,10 @@ name           type     meaning
 ``lambertian`` float    k_d of a Lambertian term (default 0)
 ``masking``,   string   the options (``twoscale.OPTIONS``; default: the
 ``sigma_rel``,          paper's model), with ``material`` or explicit
-``colour``,             parameters
-``halo_weight``
+``colour``,             parameters (``multiple_scattering="kulla-conty"``
+``halo_weight``,        adds the energy-compensation lobe, docs/model.md
+``multiple_``           §2.11)
+``scattering``
 ============== ======== ====================================================
 
 **Direction convention.** Mitsuba's ``si.wi`` points towards the camera

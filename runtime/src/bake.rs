@@ -113,10 +113,11 @@ pub trait BakeVisitor {
 /// One direction's quantities at one wavelength (module documentation).
 #[derive(Clone, Debug, FromZeros)]
 pub(crate) struct DirectionBake {
-    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 0]` per node: what `eval`
-    /// reads, in one row.
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E_s]` per node: what `eval`
+    /// reads, in one row (`1 − E_s(μ)`, the white albedo the compensation lobe puts back, 0
+    /// when it is off).
     rows: [[f32; ROW]; MU_NODES],
-    /// `[w_spec, w_diff, w_base, 0]` per node: what the sampler and `pdf` read.
+    /// `[w_spec, w_diff, w_base, w_ms]` per node: what the sampler and `pdf` read.
     weights: [[f32; 4]; MU_NODES],
 }
 
@@ -143,7 +144,7 @@ impl DirectionCell {
 /// Interpolated [`DirectionBake`] row at one `cos θ`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirectionValues {
-    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 0]`.
+    /// `[a, Re U, Im U, Re W, Im W, σrel/σs, F, 1 − E_s]`.
     pub v: [f32; ROW],
 }
 
@@ -166,6 +167,13 @@ impl DirectionValues {
     pub fn sigma_ratio(&self) -> f64 {
         f64::from(self.v[5])
     }
+
+    /// `1 − E_s(μ)`, the light single scattering loses (0 unless the
+    /// compensation lobe is on).
+    #[inline]
+    pub fn lost(&self) -> f64 {
+        f64::from(self.v[7])
+    }
 }
 
 /// The lobe weights of [`DirectionBake`] at its nodes, as computed by
@@ -175,7 +183,8 @@ pub(crate) struct LobeWeightNodes([[f32; 4]; MU_NODES]);
 impl DirectionBake {
     /// Tabulates in place F and Q̄'s factors of `eta` (when `q` is given) and
     /// σrel/σs of the spectrum `(B, c)` from T2; the lobe weights are
-    /// cleared (set them with [`DirectionBake::set_lobe_weights`]).
+    /// cleared (set them with [`DirectionBake::set_lobe_weights`]), and so is
+    /// `1 − E_s` (set it with [`DirectionBake::set_albedo`]).
     pub fn init(
         &mut self,
         eta: Complex,
@@ -218,11 +227,24 @@ impl DirectionBake {
         bake
     }
 
+    /// Stores `1 − E_s(μ)` at the nodes from `albedo(μ)` (clamped to
+    /// [0, 1]) and returns `E_avg = 2 ∫₀¹ E μ dμ` of the stored values as
+    /// `eval` interpolates them (linear in `√μ`,
+    /// [`crate::albedo::cosine_weighted_mean`]), so that the compensation lobe
+    /// `∝ (1 − E_s(μi)) (1 − E_s(μo)) / (1 − E_avg)` integrates exactly.
+    pub fn set_albedo(&mut self, albedo: impl Fn(f64) -> f32) -> f64 {
+        for (k, row) in self.rows.iter_mut().enumerate() {
+            let x = k as f64 / (MU_NODES - 1) as f64;
+            row[7] = 1.0 - albedo(x * x).max(0.0).min(1.0);
+        }
+        1.0 - crate::albedo::cosine_weighted_mean(MU_NODES, |k| self.rows[k][7])
+    }
+
     /// The lobe weights `weights(values at cos θ, cos θ)` at the nodes, for
     /// [`DirectionBake::set_lobe_weights`].
     pub fn lobe_weight_nodes(
         &self,
-        weights: impl Fn(&DirectionValues, f64) -> [f64; 3],
+        weights: impl Fn(&DirectionValues, f64) -> [f64; 4],
     ) -> LobeWeightNodes {
         let mut nodes = [[0.0f32; 4]; MU_NODES];
         for (k, node) in nodes.iter_mut().enumerate() {
@@ -276,18 +298,18 @@ impl DirectionBake {
         );
     }
 
-    /// The sampler's lobe weights `[specular, diffraction, base]` (sum 1) at
-    /// `cos θ` (clamped to [0, 1]).
+    /// The sampler's lobe weights `[specular, diffraction, base, multiple]`
+    /// (sum 1) at `cos θ` (clamped to [0, 1]).
     #[inline]
-    pub fn lobe_weights(&self, cos: f32) -> [f64; 3] {
+    pub fn lobe_weights(&self, cos: f32) -> [f64; 4] {
         let at = DirectionCell::new(cos);
         let (a, b) = (&self.weights[at.index], &self.weights[at.index + 1]);
-        let w = [0, 1, 2].map(|k| f64::from(a[k] + at.fraction * (b[k] - a[k])).max(0.0));
-        let total = w[0] + w[1] + w[2];
+        let w = [0, 1, 2, 3].map(|k| f64::from(a[k] + at.fraction * (b[k] - a[k])).max(0.0));
+        let total = w[0] + w[1] + w[2] + w[3];
         if total > 0.0 {
             w.map(|x| x / total)
         } else {
-            [1.0, 0.0, 0.0]
+            [1.0, 0.0, 0.0, 0.0]
         }
     }
 }

@@ -13,6 +13,17 @@
 //!           u = (b/λ) cos θd                                              (HP17 32-33, 40)
 //! ```
 //!
+//! With [`MultipleScattering::KullaConty`] a fourth term puts back the
+//! light that single scattering loses (docs/model.md §2.11):
+//!
+//! ```text
+//! ρ_ms    = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))
+//! F_ms    = F_avg² E_avg / (1 − F_avg (1 − E_avg)),   F_avg = 2 ∫ F(η, μ) μ dμ
+//! ```
+//!
+//! with E_s the white albedo (F = Q̄ = 1) of the specular peak and the halo:
+//! T6's E ([`AlbedoTable`]) plus the halo's deficit, computed per material.
+//!
 //! `σrel = σrel(θi)` comes from T2 ([`SigmaRatioTable`]), D and G from the EPD
 //! distribution ([`Epd`], T1), `C` from any [`Convolution`] (the T3 tables, or
 //! an adapter), F and Q̄ from [`crate::fresnel`]. The constant of ρ_CTD makes
@@ -54,7 +65,7 @@ use crate::bake::{
 };
 use crate::conv::{ConvSlice, Convolution};
 use crate::epd::Epd;
-use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants};
+use crate::fresnel::{Complex, DiffuseFresnelTable, QConstants, fresnel_average};
 use crate::halo::HaloBake;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
@@ -209,6 +220,22 @@ pub enum HaloWeight {
     Incident,
 }
 
+/// Whether the light that bounces more than once between microfacets is
+/// put back (docs/model.md §2.11).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MultipleScattering {
+    /// Single scattering only, as both papers (the default): rough and
+    /// heavy-tailed surfaces lose up to half of the light.
+    #[default]
+    None,
+    /// A Kulla–Conty energy-compensation lobe (a fourth, diffuse-like lobe,
+    /// [`Lobe::Multiple`]):
+    /// `ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))`, `E_s`
+    /// the white albedo of the specular peak and the halo (T6's E plus the
+    /// halo's deficit), `F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))`.
+    KullaConty,
+}
+
 /// Model options; `Options::default()` is the paper's model.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Options {
@@ -220,6 +247,8 @@ pub struct Options {
     pub colour: ColourTerms,
     /// Which `A` weighs the halo.
     pub halo_weight: HaloWeight,
+    /// Energy compensation for multiple scattering.
+    pub multiple_scattering: MultipleScattering,
 }
 
 /// The tables the model reads. `convolution` is the source of C: the T3b
@@ -250,9 +279,12 @@ pub enum Lobe {
     Diffraction,
     /// `ρ_base + k_d/π`, cosine-weighted.
     Base,
+    /// `ρ_ms`, the energy compensation of [`MultipleScattering::KullaConty`],
+    /// cosine-weighted.
+    Multiple,
 }
 
-/// The three terms of ρ at one pair of directions (sr⁻¹).
+/// The terms of ρ at one pair of directions (sr⁻¹).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Lobes {
     /// `A_spec(θd) · ρ_CT`.
@@ -261,13 +293,18 @@ pub struct Lobes {
     pub diffraction: f32,
     /// `ρ_base + k_d/π`.
     pub base: f32,
+    /// `ρ_ms` (0 unless [`MultipleScattering::KullaConty`]).
+    pub multiple: f32,
 }
 
 impl Lobes {
-    /// `ρ`, the sum of the three terms.
+    /// `ρ`, the sum of the four terms.
     pub fn total(&self) -> f32 {
         finite_or_zero(
-            f64::from(self.specular) + f64::from(self.diffraction) + f64::from(self.base),
+            f64::from(self.specular)
+                + f64::from(self.diffraction)
+                + f64::from(self.base)
+                + f64::from(self.multiple),
         )
     }
 }
@@ -411,6 +448,10 @@ pub struct TwoScale<'a, B = ChannelBake> {
     /// `Re η` (the varnish index of the base layers).
     eta_re: f64,
     lambertian: f64,
+    /// `F_ms / (π (1 − E_avg))` of the compensation lobe (0 when off).
+    multiple_scale: f64,
+    /// `F_ms`, the compensation lobe's albedo over `1 − E_s(μi)` (0 when off).
+    multiple_colour: f64,
     options: Options,
     /// The per-material tables.
     bake: B,
@@ -488,6 +529,20 @@ struct Pair {
     /// `sin θi sin θo (cos φ, sin φ)` with φ = φo − φi − π (for Q̄).
     along: f64,
     across: f64,
+}
+
+/// What [`TwoScale::surface_terms`] computes at a pair.
+#[derive(Clone, Copy)]
+struct SurfaceTerms {
+    /// `A_spec(θd)`.
+    a_spec: f64,
+    /// `ρ_CT`.
+    rho_ct: f64,
+    /// `ρ_CTD`.
+    diffraction: f64,
+    /// The direction bake at `cos θi` and `cos θo`.
+    at_i: DirectionValues,
+    at_o: DirectionValues,
 }
 
 impl<'a> TwoScale<'a> {
@@ -602,6 +657,8 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             f_dr_int,
             eta_re: f64::from(eta.re),
             lambertian: unit(layer.lambertian),
+            multiple_scale: 0.0,
+            multiple_colour: 0.0,
             options,
             bake,
         }
@@ -637,6 +694,35 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
         let specular = tables
             .albedo
             .column(surface.beta, surface.p, self.options.masking);
+        (self.multiple_colour, self.multiple_scale) = match self.options.multiple_scattering {
+            MultipleScattering::None => (0.0, 0.0),
+            MultipleScattering::KullaConty => {
+                // The halo's share of the white albedo (0 without diffraction).
+                let mut deficit = [0.0f64; DEFICIT_NODES];
+                if sigma_s > 0.0 && big_b > 0.0 {
+                    for (j, value) in deficit.iter_mut().enumerate() {
+                        let x = j as f64 / (DEFICIT_NODES - 1) as f64;
+                        *value = self.halo_deficit((x * x).max(DEFICIT_MIN_COS));
+                    }
+                }
+                let deficit_at = |cos: f64| {
+                    let t = math::sqrt(cos.max(0.0).min(1.0)) * (DEFICIT_NODES - 1) as f64;
+                    let k = (t as usize).min(DEFICIT_NODES - 2);
+                    let f = t - k as f64;
+                    deficit[k] + f * (deficit[k + 1] - deficit[k])
+                };
+                let e_avg =
+                    self.bake.borrow_mut().direction.set_albedo(|cos| {
+                        (f64::from(specular.albedo(cos)) + deficit_at(cos)) as f32
+                    });
+                let f_avg = if self.options.colour == ColourTerms::White {
+                    1.0
+                } else {
+                    fresnel_average(eta)
+                };
+                compensation(e_avg, f_avg)
+            }
+        };
         let halo = self.halo_albedo_nodes();
         let weights = self.bake().direction.lobe_weight_nodes(|at, cos| {
             let energies = LobeEnergies {
@@ -646,6 +732,72 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             self.weights_at(at, cos, energies)
         });
         self.bake.borrow_mut().direction.set_lobe_weights(&weights);
+    }
+
+    /// The halo's change to the surface's white albedo at `cos θi`
+    /// (docs/model.md §2.11):
+    ///
+    /// ```text
+    /// Δ(μ) = ∫ [(A_spec(θd) − 1) ρ_CT + ρ_CTD]_{F = Q̄ = 1} cos θo dωo
+    /// ```
+    ///
+    /// so that `E(μ) + Δ(μ)` is the white albedo of the specular peak and
+    /// the halo together (E of T6). In polar coordinates `(α, φ)` around the
+    /// mirror direction, `α = e^t` from `10⁻³ w` to π (`w` the narrower of
+    /// the NDF's width β and the halo's `λ/2b`) by 4-point Gauss–Legendre on
+    /// [`DEFICIT_PANELS`] panels of t, φ by the trapezoid rule on
+    /// [`DEFICIT_AZIMUTHS`] points; both terms come from the same nodes.
+    fn halo_deficit(&self, cos_i: f64) -> f64 {
+        const GAUSS_4: [(f64, f64); 2] = [
+            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+        ];
+        let sin_i = math::sqrt((1.0 - cos_i * cos_i).max(0.0));
+        let i = [sin_i as f32, 0.0, cos_i as f32];
+        // The mirror direction r and two unit vectors orthogonal to it.
+        let r = [-sin_i, 0.0, cos_i];
+        let e1 = [cos_i, 0.0, sin_i];
+        let e2 = [0.0, 1.0, 0.0];
+        let halo_width = 0.5 * self.lambda / f64::from(self.surface.b).max(1e-6);
+        let width = f64::from(self.surface.beta)
+            .min(halo_width)
+            .max(1e-4)
+            .min(1.0);
+        let (t0, t1) = (math::ln(1e-3 * width), math::ln(PI));
+        let h = (t1 - t0) / DEFICIT_PANELS as f64;
+        let mut total = 0.0;
+        for k in 0..DEFICIT_PANELS {
+            let mid = t0 + (k as f64 + 0.5) * h;
+            for (x, weight) in GAUSS_4 {
+                for t in [mid - 0.5 * h * x, mid + 0.5 * h * x] {
+                    let alpha = math::exp(t);
+                    let (sa, ca) = (math::sin(alpha), math::cos(alpha));
+                    // The integrand is even in φ (i lies in the xz-plane): the
+                    // trapezoid rule over [0, π], ends halved, doubled.
+                    let half = DEFICIT_AZIMUTHS / 2;
+                    let mut ring = 0.0;
+                    for m in 0..=half {
+                        let phi = PI * m as f64 / half as f64;
+                        let (sp, cp) = (math::sin(phi), math::cos(phi));
+                        let o = [0, 1, 2].map(|c| ca * r[c] + sa * (cp * e1[c] + sp * e2[c]));
+                        if !(o[2] > 0.0) {
+                            continue;
+                        }
+                        let Some(pair) = self.pair(i, to_f32(o)) else {
+                            continue;
+                        };
+                        let terms = self.surface_terms(&pair, true);
+                        let value = (terms.a_spec - 1.0) * terms.rho_ct + terms.diffraction;
+                        if value.is_finite() {
+                            let end = if m == 0 || m == half { 0.5 } else { 1.0 };
+                            ring += end * value * o[2];
+                        }
+                    }
+                    total += 0.5 * h * weight * ring * (2.0 * PI / half as f64) * sa * alpha;
+                }
+            }
+        }
+        total
     }
 
     /// The storage of the bakes, to rebuild another model in
@@ -668,7 +820,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     pub(crate) fn has_lobes(&self) -> (bool, bool) {
         let diffraction = self.surface.sigma_s > 0.0 && self.surface.b > 0.0;
         let base = self.base != BaseLayer::Conductor && !self.white();
-        (diffraction, base || self.lambertian > 0.0)
+        (
+            diffraction,
+            base || self.lambertian > 0.0 || self.multiple_scale > 0.0,
+        )
     }
 
     /// Hands the model's constants and bakes to `v` (names in the
@@ -709,6 +864,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             ("f_dr_int", self.f_dr_int),
             ("eta_re", self.eta_re),
             ("lambertian", self.lambertian),
+            ("multiple_scale", self.multiple_scale),
             ("base", base),
             ("albedo", albedo),
             ("white", flag(self.white())),
@@ -844,7 +1000,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         self.eval_lobes(i, o).total()
     }
 
-    /// The three terms of ρ(i, o) separately.
+    /// The four terms of ρ(i, o) separately.
     pub fn eval_lobes(&self, i: [f32; 3], o: [f32; 3]) -> Lobes {
         match self.pair(i, o) {
             Some(pair) => self.lobes(&pair),
@@ -854,6 +1010,22 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// The terms of ρ at a pair (HP17 24-33).
     fn lobes(&self, pair: &Pair) -> Lobes {
+        let t = self.surface_terms(pair, self.white());
+        let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
+        // ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
+        let multiple = self.multiple_scale * t.at_i.lost() * t.at_o.lost();
+        Lobes {
+            specular: finite_or_zero(t.a_spec * t.rho_ct),
+            diffraction: finite_or_zero(t.diffraction),
+            base: finite_or_zero(self.base_value(&t.at_i, &t.at_o, cos_i, cos_o)),
+            multiple: finite_or_zero(multiple),
+        }
+    }
+
+    /// The surface lobes' factors at a pair (HP17 24-33), with white colour
+    /// terms (F = Q̄ = 1) when `white`.
+    #[inline(always)]
+    fn surface_terms(&self, pair: &Pair, white: bool) -> SurfaceTerms {
         let Pair {
             geometry:
                 Geometry {
@@ -888,12 +1060,16 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
         // ρ_CT = F D G / (4 cos θi cos θo)                          (HP17 26)
         // D last: the other factors do not wait for its exponentials.
-        let rho_ct = self.fresnel_at(cells[2]) * g / (4.0 * cos_i * cos_o) * d;
-        let specular = a_spec * rho_ct;
+        let f = if white {
+            1.0
+        } else {
+            f64::from(self.bake().direction.fresnel_at(cells[2]))
+        };
+        let rho_ct = f * g / (4.0 * cos_i * cos_o) * d;
 
         // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
         let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && g > 0.0 {
-            let q = if self.white() {
+            let q = if white {
                 1.0
             } else {
                 match &self.q {
@@ -924,10 +1100,12 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             0.0
         };
 
-        Lobes {
-            specular: finite_or_zero(specular),
-            diffraction: finite_or_zero(diffraction),
-            base: finite_or_zero(self.base_value(&at_i, &at_o, cos_i, cos_o)),
+        SurfaceTerms {
+            a_spec,
+            rho_ct,
+            diffraction,
+            at_i,
+            at_o,
         }
     }
 
@@ -970,36 +1148,36 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         base + lambertian
     }
 
-    /// The lobe-selection probabilities `[specular, diffraction, base]` for
-    /// incidence `i` (sum 1; all 0 for `i` below the horizon), proportional
-    /// to estimates of the lobes' directional albedos at θi
+    /// The lobe-selection probabilities `[specular, diffraction, base,
+    /// multiple]` for incidence `i` (sum 1; all 0 for `i` below the horizon),
+    /// proportional to estimates of the lobes' directional albedos at θi
     /// (docs/design/halo-sampling.md):
     ///
     /// ```text
-    /// E_s = A(θi) F(η, cos θi) E(μ; β, p)      A(θi) = exp(−(4π σrel(θi) cos θi / λ)²) (HP17 25),
+    /// E_s  = A(θi) F(η, cos θi) E(μ; β, p)      A(θi) = exp(−(4π σrel(θi) cos θi / λ)²) (HP17 25),
     ///                                           E of T6 (F = 1), F = 1 with white colour terms
-    /// E_d = ∫ ρ_CTD cos θo dωo                   by the diffraction lobe's own sampler, 34 lattice
+    /// E_d  = ∫ ρ_CTD cos θo dωo                  by the diffraction lobe's own sampler, 34 lattice
     ///                                           points at 9 incidences, linear in √cos θi between
-    /// E_b = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
-    ///       (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
-    /// w   ∝ [E_s, max(E_d, 10⁻³ ΣE), E_b]      (E_d's floor only where the lobe exists)
+    /// E_b  = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
+    ///        (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
+    /// E_ms = F_ms (1 − E_s(μi)), the compensation lobe's albedo (0 when off; E_s of §2.11)
+    /// w    ∝ [E_s, max(E_d, 10⁻³ ΣE), E_b, E_ms]  (E_d's floor only where the lobe exists)
     /// ```
     ///
     /// When every estimate is 0 (η = 1 and no base) the split
-    /// `[A, 1 − A, 0]` is used. The weights are tabulated with the material
+    /// `[A, 1 − A, 0, 0]` is used. The weights are tabulated with the material
     /// (linear in `√cos θi` between 257 nodes): `sample` and `pdf` read the
     /// same table, so the weights add no error to the pdf.
-    pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 3] {
+    pub fn lobe_weights(&self, i: [f32; 3]) -> [f32; 4] {
         let Some(wi) = upper_unit(i) else {
-            return [0.0; 3];
+            return [0.0; 4];
         };
-        let w = self.weights(wi[2]);
-        [w[0] as f32, w[1] as f32, w[2] as f32]
+        self.weights(wi[2]).map(|w| w as f32)
     }
 
     /// The lobe weights at `cos θi`, from the direction bake's table of
     /// [`TwoScale::weights_at`].
-    fn weights(&self, cos_i: f64) -> [f64; 3] {
+    fn weights(&self, cos_i: f64) -> [f64; 4] {
         self.bake().direction.lobe_weights(cos_i as f32)
     }
 
@@ -1047,7 +1225,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// The lobe weights (see [`TwoScale::lobe_weights`]) with F from `at_i`
     /// and the lobes' albedo estimates `e`.
-    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64, e: LobeEnergies) -> [f64; 3] {
+    fn weights_at(&self, at_i: &DirectionValues, cos_i: f64, e: LobeEnergies) -> [f64; 4] {
         let sigma_rel = f64::from(self.surface.sigma_s) * at_i.sigma_ratio();
         let t = self.x_scale * cos_i * cos_i * sigma_rel * sigma_rel;
         let a = math::exp(-t);
@@ -1068,12 +1246,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         if self.has_lobes().0 {
             e_d = e_d.max(HALO_FLOOR * (e_s + e_d + e_b));
         }
-        let w = [e_s, e_d, e_b];
-        let total = w[0] + w[1] + w[2];
+        // ∫ ρ_ms cos θo dωo = F_ms (1 − E_s(μi)): π (1 − E_avg) cancels.
+        let e_ms = self.multiple_colour * at_i.lost();
+        let w = [e_s, e_d, e_b, e_ms];
+        let total = w[0] + w[1] + w[2] + w[3];
         if total > 0.0 && total.is_finite() {
             w.map(|x| x / total)
         } else {
-            [a, 1.0 - a, 0.0]
+            [a, 1.0 - a, 0.0, 0.0]
         }
     }
 
@@ -1107,10 +1287,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         if w[0] > 0.0 {
             total += w[0] * specular;
         }
-        for (k, lobe) in [(1, Lobe::Diffraction), (2, Lobe::Base)] {
-            if w[k] > 0.0 {
-                total += w[k] * self.lobe_pdf(lobe, geometry);
-            }
+        if w[1] > 0.0 {
+            total += w[1] * self.lobe_pdf(Lobe::Diffraction, geometry);
+        }
+        // The base and the compensation lobe share the cosine-weighted density.
+        let diffuse = w[2] + w[3];
+        if diffuse > 0.0 {
+            total += diffuse * self.lobe_pdf(Lobe::Base, geometry);
         }
         total
     }
@@ -1127,7 +1310,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
     ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`; the
     ///   half-vector draw's `Σ_j w_j p_j(ζ) / (4 N(θh))` (`crate::halo`);
-    /// * base: `cos θo / π`.
+    /// * base and multiple: `cos θo / π`.
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
     pub fn pdf_lobe(&self, lobe: Lobe, i: [f32; 3], o: [f32; 3]) -> f32 {
@@ -1143,7 +1326,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         match lobe {
             Lobe::Specular => self.specular_pdf(geometry),
             Lobe::Diffraction => self.diffraction_pdf(geometry),
-            Lobe::Base => wo[2] / PI,
+            Lobe::Base | Lobe::Multiple => wo[2] / PI,
         }
     }
 
@@ -1236,7 +1419,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///   with `o_p = −i_p + λ f`; the arc that keeps `o_p` in the disc is
     ///   centred on `+i_p` as written here (at ψ = 0, `o_p` moves from the
     ///   mirror direction towards `i`'s side);
-    /// * base: cosine-weighted hemisphere.
+    /// * base and multiple: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
@@ -1247,7 +1430,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
             Lobe::Diffraction => self.sample_diffraction(wi, u)?,
-            Lobe::Base => {
+            Lobe::Base | Lobe::Multiple => {
                 let r = math::sqrt(u[0]);
                 let phi = 2.0 * PI * u[1];
                 [
@@ -1372,10 +1555,47 @@ fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
 /// mixture with the half-vector draw (docs/design/halo-sampling.md).
 const SPECTRUM_SHARE: f64 = 0.1;
 
+/// Nodes of [`TwoScale::halo_deficit`] over `√cos θi` (linear between).
+const DEFICIT_NODES: usize = 17;
+/// The smallest `cos θi` at which the deficit is computed (the first node's).
+const DEFICIT_MIN_COS: f64 = 1e-4;
+/// Panels of [`TwoScale::halo_deficit`]'s rule in `ln α`.
+const DEFICIT_PANELS: usize = 16;
+/// Azimuths of [`TwoScale::halo_deficit`]'s rule.
+const DEFICIT_AZIMUTHS: usize = 32;
+
+/// `(F_ms, F_ms / (π (1 − E_avg)))` of the compensation lobe
+/// (docs/model.md §2.11) for the albedo average `E_avg` and the Fresnel
+/// average `F_avg`:
+///
+/// ```text
+/// F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))
+/// ```
+///
+/// (the light that leaves after k ≥ 2 bounces, `Σ F_avg^k E_avg (1 − E_avg)^(k−1)`,
+/// over its value at `F_avg = 1`, `1 − E_avg`). `(0, 0)` when
+/// `1 − E_avg ≤ 1e-6` (nothing to put back).
+fn compensation(e_avg: f64, f_avg: f64) -> (f64, f64) {
+    let lost = 1.0 - e_avg;
+    if !(lost > 1e-6) {
+        return (0.0, 0.0);
+    }
+    let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * lost);
+    if !f_ms.is_finite() {
+        return (0.0, 0.0);
+    }
+    (f_ms, f_ms / (PI * lost))
+}
+
 /// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
 /// past the last interval falls on the last lobe of positive weight.
-fn pick_lobe(pick: f64, w: [f64; 3]) -> Lobe {
-    const LOBES: [Lobe; 3] = [Lobe::Specular, Lobe::Diffraction, Lobe::Base];
+fn pick_lobe(pick: f64, w: [f64; 4]) -> Lobe {
+    const LOBES: [Lobe; 4] = [
+        Lobe::Specular,
+        Lobe::Diffraction,
+        Lobe::Base,
+        Lobe::Multiple,
+    ];
     let mut cumulative = 0.0;
     let mut last = Lobe::Specular;
     for (k, lobe) in LOBES.into_iter().enumerate() {

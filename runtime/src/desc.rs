@@ -19,6 +19,7 @@
 //! sigma_rel = "incident"
 //! colour = "physical"
 //! halo_weight = "printed"
+//! multiple_scattering = "none"   # or "kulla-conty" (docs/model.md §2.11)
 //!
 //! [metrics]            # optional and not read: what the fit measured
 //! rmse = [0.01, 0.01, 0.01]
@@ -109,6 +110,8 @@ pub struct Keywords<'a> {
     pub colour: Option<&'a str>,
     /// [`crate::brdf::HaloWeight`]'s name.
     pub halo_weight: Option<&'a str>,
+    /// [`crate::brdf::MultipleScattering`]'s name.
+    pub multiple_scattering: Option<&'a str>,
     /// [`RgbMode`]'s name (default: the paper's wavelengths).
     pub rgb_mode: Option<&'a str>,
 }
@@ -158,6 +161,7 @@ impl<'a> Keywords<'a> {
             sigma_rel: validate::named(self.sigma_rel)?,
             colour: validate::named(self.colour)?,
             halo_weight: validate::named(self.halo_weight)?,
+            multiple_scattering: validate::named(self.multiple_scattering)?,
         };
         Ok((layer, options))
     }
@@ -347,6 +351,8 @@ mod file {
         pub colour: Option<String>,
         /// [`Keywords::halo_weight`].
         pub halo_weight: Option<String>,
+        /// [`Keywords::multiple_scattering`].
+        pub multiple_scattering: Option<String>,
         /// [`Keywords::rgb_mode`].
         pub rgb_mode: Option<String>,
     }
@@ -415,6 +421,7 @@ mod file {
                 sigma_rel: self.sigma_rel.as_deref(),
                 colour: self.colour.as_deref(),
                 halo_weight: self.halo_weight.as_deref(),
+                multiple_scattering: self.multiple_scattering.as_deref(),
                 rgb_mode: self.rgb_mode.as_deref(),
             }
         }
@@ -498,7 +505,9 @@ mod file {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::{BaseKind, BaseLayer, ColourTerms, HaloWeight, Masking, SigmaRelMode};
+    use crate::brdf::{
+        BaseKind, BaseLayer, ColourTerms, HaloWeight, Masking, MultipleScattering, SigmaRelMode,
+    };
 
     const GOLD: [[f32; 2]; 3] = [[0.163, 3.56], [0.584, 2.15], [1.403, 1.925]];
 
@@ -532,6 +541,7 @@ mod tests {
             sigma_rel: Some("symmetrised"),
             colour: Some("white"),
             halo_weight: Some("incident"),
+            multiple_scattering: Some("kulla-conty"),
             ..gold()
         };
         let d = k.material().unwrap();
@@ -543,6 +553,7 @@ mod tests {
                 sigma_rel: SigmaRelMode::Symmetrised,
                 colour: ColourTerms::White,
                 halo_weight: HaloWeight::Incident,
+                multiple_scattering: MultipleScattering::KullaConty,
             }
         );
     }

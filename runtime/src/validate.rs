@@ -19,8 +19,8 @@
 //! that reads back to the same value.
 
 use crate::brdf::{
-    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, RgbMode, SigmaRelMode,
-    Surface,
+    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, MultipleScattering,
+    RgbMode, SigmaRelMode, Surface,
 };
 use crate::epd::{BETA_RANGE, P_RANGE};
 use crate::fresnel::Complex;
@@ -298,6 +298,14 @@ impl Named for HaloWeight {
     const NAMES: &'static [(&'static str, Self)] = &[
         ("printed", HaloWeight::Printed),
         ("incident", HaloWeight::Incident),
+    ];
+}
+
+impl Named for MultipleScattering {
+    const OPTION: &'static str = "multiple_scattering";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("none", MultipleScattering::None),
+        ("kulla-conty", MultipleScattering::KullaConty),
     ];
 }
 
@@ -629,6 +637,7 @@ mod tests {
         all::<SigmaRelMode>();
         all::<ColourTerms>();
         all::<HaloWeight>();
+        all::<MultipleScattering>();
         all::<BaseKind>();
         assert_eq!(Masking::NAMES[0].1, Masking::default());
         assert_eq!(

@@ -14,15 +14,16 @@ use std::hint::black_box;
 use std::process::Command;
 use suite::cost::{self, Inputs};
 use twoscale::TableSet;
-use twoscale::brdf::{Options, Rgb, TwoScale};
+use twoscale::brdf::{BaseLayer, Layer, MultipleScattering, Options, Rgb, TwoScale};
 use twoscale::materials::{HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
-pub const OPERATIONS: [&str; 10] = [
+pub const OPERATIONS: [&str; 11] = [
     "ggx-eval",
     "ggx-eval-rgb",
     "ggx-sample-eval",
     "eval",
+    "eval-kulla-conty",
     "eval-t3a",
     "eval-rgb",
     "pdf",
@@ -39,6 +40,7 @@ enum Operation {
     GgxEvalRgb,
     GgxSampleEval,
     Eval,
+    EvalKullaConty,
     EvalT3a,
     EvalRgb,
     Pdf,
@@ -55,6 +57,7 @@ impl Operation {
             "ggx-eval-rgb" => Operation::GgxEvalRgb,
             "ggx-sample-eval" => Operation::GgxSampleEval,
             "eval" => Operation::Eval,
+            "eval-kulla-conty" => Operation::EvalKullaConty,
             "eval-t3a" => Operation::EvalT3a,
             "eval-rgb" => Operation::EvalRgb,
             "pdf" => Operation::Pdf,
@@ -76,6 +79,8 @@ impl Operation {
 pub struct Workload<'a> {
     set: &'a TableSet<'static>,
     model: TwoScale<'a>,
+    /// `model` with the energy-compensation lobe (issue 27).
+    model_kc: TwoScale<'a>,
     model_fit: TwoScale<'a>,
     ggx: cost::Ggx,
     rgb: Rgb<'a>,
@@ -90,6 +95,20 @@ impl<'a> Workload<'a> {
         Workload {
             set,
             model: cost::nickel(set, &set.convolution),
+            model_kc: TwoScale::new(
+                &set.brdf_tables(),
+                Layer {
+                    surface: HP17_NICKEL_SURFACE,
+                    base: BaseLayer::Conductor,
+                    lambertian: 0.0,
+                },
+                cost::LAMBDA,
+                cost::NICKEL_LIKE,
+                Options {
+                    multiple_scattering: MultipleScattering::KullaConty,
+                    ..Options::default()
+                },
+            ),
             model_fit: cost::nickel(set, fit),
             ggx: cost::ggx(),
             rgb,
@@ -117,6 +136,7 @@ impl<'a> Workload<'a> {
                     .sample_eval(black_box(iu), [u[1], u[2]])
                     .map_or(0.0, |(_, pdf, value)| value / pdf),
                 Operation::Eval => model.eval(black_box(i), black_box(o)),
+                Operation::EvalKullaConty => self.model_kc.eval(black_box(i), black_box(o)),
                 Operation::EvalT3a => model_fit.eval(black_box(i), black_box(o)),
                 Operation::EvalRgb => rgb.eval(black_box(i), black_box(o))[1],
                 Operation::Pdf => model.pdf(black_box(i), black_box(o)),
@@ -145,11 +165,13 @@ impl<'a> Workload<'a> {
 
 /// The baseline an operation's ratio is taken against (empty: none):
 /// eval-rgb against the RGB GGX eval, sample against GGX's visible-normal
-/// sample + eval, the other BRDF operations against the GGX eval.
+/// sample + eval, eval with the compensation lobe against eval without, the
+/// other BRDF operations against the GGX eval.
 fn baseline(operation: &str) -> &'static str {
     match operation {
         "eval-rgb" => "ggx-eval-rgb",
         "sample" => "ggx-sample-eval",
+        "eval-kulla-conty" => "eval",
         _ if operation.starts_with("ggx") || operation.starts_with("construct") => "",
         _ => "ggx-eval",
     }

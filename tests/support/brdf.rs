@@ -106,6 +106,26 @@ pub struct SamplerCheck {
     pub success: f64,
 }
 
+impl SamplerCheck {
+    /// Asserts `∫ pdf ≤ 1 + 1e-5` and that it is the success rate of `n`
+    /// draws within 5 binomial standard errors `√(s(1 − s)/n)` plus
+    /// `slack` (the cell rule's error); `label` names the case.
+    pub fn assert_pdf_is_the_success_rate(&self, n: usize, slack: f64, label: &str) {
+        let se = (self.success * (1.0 - self.success) / n as f64).sqrt();
+        assert!(
+            self.pdf_integral <= 1.0 + 1e-5,
+            "{label}: ∫pdf {}",
+            self.pdf_integral
+        );
+        assert!(
+            (self.pdf_integral - self.success).abs() <= 5.0 * se + slack,
+            "{label}: ∫pdf {} vs sampled {}",
+            self.pdf_integral,
+            self.success
+        );
+    }
+}
+
 /// χ² test of a direction sampler against its claimed solid-angle density.
 ///
 /// Cells are in coordinates around the mirror direction `r = (−ix, −iy, iz)`:

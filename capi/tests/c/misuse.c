@@ -245,6 +245,11 @@ int main(int argc, char **argv) {
     EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
                 "halo_weight = -1 is not one of TS_HALO_PRINTED (0), TS_HALO_INCIDENT (1)");
     bad = desc;
+    bad.multiple_scattering = 2;
+    EXPECT_NULL(ts_material_new(embedded, &bad), TS_ERR_INVALID,
+                "multiple_scattering = 2 is not one of TS_MULTIPLE_NONE (0), "
+                "TS_MULTIPLE_KULLA_CONTY (1)");
+    bad = desc;
     bad.masking = 1; /* by name: TS_MASKING_HEIGHT_CORRELATED */
     CHECK(TS_MASKING_HEIGHT_CORRELATED == 1);
     {

@@ -15,7 +15,8 @@ use std::f64::consts::PI;
 use std::fmt;
 
 use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Masking, Material, Options, RGB_WAVELENGTHS, SigmaRelMode,
+    BaseLayer, ColourTerms, HaloWeight, Masking, Material, MultipleScattering, Options,
+    RGB_WAVELENGTHS, SigmaRelMode,
 };
 
 use crate::quad::QuadError;
@@ -107,20 +108,123 @@ impl Params {
             lambda: RGB_WAVELENGTHS[ch].into(),
         }))
     }
+
+    /// [`Params::rgb`] for `material` with `options`: also refuses the
+    /// energy compensation of a surface with diffraction, which
+    /// [`Compensation`] does not cover.
+    pub fn rgb_with(material: &Material, options: &Options) -> Result<[Params; 3], Uncovered> {
+        if options.multiple_scattering != MultipleScattering::None
+            && material.layer.surface.sigma_s > 0.0
+        {
+            return Err(Uncovered);
+        }
+        Params::rgb(material)
+    }
 }
 
 /// A material the reference does not cover ([`Params::rgb`]): a base layer
-/// or a Lambertian term.
+/// or a Lambertian term (or, for `query brdf`, the energy compensation of a
+/// surface with diffraction).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Uncovered;
 
 impl fmt::Display for Uncovered {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("the f64 reference covers conductors without a Lambertian term")
+        f.write_str(
+            "the f64 reference covers conductors without a Lambertian term, and their \
+             energy compensation (multiple_scattering) without diffraction (sigma_s = 0) \
+             at the paper's wavelengths",
+        )
     }
 }
 
 impl std::error::Error for Uncovered {}
+
+/// The energy-compensation lobe of docs/model.md §2.11 in f64, for a
+/// surface without diffraction (σs = 0; with diffraction the runtime adds the
+/// halo's deficit, which the reference does not compute):
+///
+/// ```text
+/// ρ_ms = F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)),
+/// F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)),   F_avg = 2 ∫ F μ dμ
+/// ```
+///
+/// with E and E_avg of [`albedo`](crate::reference::albedo) (adaptive, to
+/// 1e-9) and F_avg by adaptive Gauss–Kronrod of [`fresnel::fresnel`]
+/// (1 with white colour terms).
+pub struct Compensation {
+    curve: epd::LambdaCurve,
+    beta: f64,
+    masking: Masking,
+    /// `F_ms / (π (1 − E_avg))`.
+    scale: f64,
+}
+
+impl Compensation {
+    /// The lobe of `params` with `options` (its masking and colour terms);
+    /// building it computes E_avg (about a second).
+    pub fn new(params: &Params, options: &Options) -> Result<Compensation, BrdfError> {
+        let curve = epd::LambdaCurve::new(params.p)?;
+        let e_avg = crate::reference::albedo::albedo_average(&curve, params.beta, options.masking)?;
+        let f_avg = if options.colour == ColourTerms::White {
+            1.0
+        } else {
+            let eta = fresnel::Complex64::new(params.n, params.k);
+            let failure = std::cell::Cell::new(None);
+            let value = crate::quad::integrate(
+                |mu| match fresnel::fresnel(eta, mu) {
+                    Ok(f) => 2.0 * f * mu,
+                    Err(e) => {
+                        failure.set(Some(e));
+                        0.0
+                    }
+                },
+                0.0,
+                1.0,
+                crate::quad::Tolerance::new(1e-13, 1e-12),
+            )?
+            .value;
+            if let Some(e) = failure.get() {
+                return Err(e.into());
+            }
+            value
+        };
+        let lost = 1.0 - e_avg;
+        let f_ms = f_avg * f_avg * e_avg / (1.0 - f_avg * lost);
+        Ok(Compensation {
+            curve,
+            beta: params.beta,
+            masking: options.masking,
+            scale: if lost > 1e-6 { f_ms / (PI * lost) } else { 0.0 },
+        })
+    }
+
+    /// The lobes of the three channels `params` when `options` ask for the
+    /// compensation (`None` otherwise).
+    pub fn rgb(
+        params: &[Params; 3],
+        options: &Options,
+    ) -> Result<Option<[Compensation; 3]>, BrdfError> {
+        if options.multiple_scattering == MultipleScattering::None {
+            return Ok(None);
+        }
+        let [r, g, b] = params.each_ref().map(|p| Compensation::new(p, options));
+        Ok(Some([r?, g?, b?]))
+    }
+
+    /// ρ_ms(i, o); 0 at or below the horizon.
+    pub fn value(&self, i: [f64; 3], o: [f64; 3]) -> Result<f64, BrdfError> {
+        let (wi, wo) = (normalise(i, "i")?, normalise(o, "o")?);
+        if !(wi[2] > 0.0 && wo[2] > 0.0) || self.scale == 0.0 {
+            return Ok(0.0);
+        }
+        let lost = |mu: f64| -> Result<f64, BrdfError> {
+            let e = crate::reference::albedo::albedo(&self.curve, self.beta, mu, self.masking)?;
+            Ok(1.0 - e.clamp(0.0, 1.0))
+        };
+        Ok(self.scale * lost(wi[2])? * lost(wo[2])?)
+    }
+}
 
 /// The three terms of ρ (sr⁻¹): `A_spec ρ_CT`, `ρ_CTD`, and their sum.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! ρ_c(i,o) = ∫ ρ(i,o,λ) w_c(λ) dλ                       (w_c: crate::colour)
-//!          ≈ Σ_k [ρ_s + ρ_CTD](λ_k) R_kc(cos θd) + ρ_base(λ_k) P_kc
+//!          ≈ Σ_k [ρ_s + ρ_CTD](λ_k) R_kc(cos θd) + [ρ_base + ρ_ms](λ_k) P_kc
 //! R_kc(μ)  = Σ_j hat_k(λ_j) W_c,j F(η(λ_j), μ) / F(η(λ_k), μ)
 //! P_kc     = Σ_j hat_k(λ_j) W_c,j
 //! ```
@@ -214,7 +214,8 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
         for (k, node) in self.nodes.iter().enumerate() {
             let lobes = node.lobes(&pair);
             let surface = f64::from(lobes.specular) + f64::from(lobes.diffraction);
-            let base = f64::from(lobes.base);
+            // The compensation lobe's colour is F_avg's, per node: plain weights.
+            let base = f64::from(lobes.base) + f64::from(lobes.multiple);
             for c in 0..3 {
                 out[c] += surface * f64::from(r[k][c]) + base * f64::from(self.colour.plain[k][c]);
             }

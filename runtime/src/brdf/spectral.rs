@@ -4,7 +4,7 @@
 //! wavelength, interpolated linearly in λ and multiplied by F(θd) at λ:
 //!
 //! ```text
-//! ρ(i,o,λ) ≈ F(η(λ), θd) Σ_k hat_k(λ) [ρ_spec + ρ_CTD](λ_k)/F(η(λ_k), θd) + Σ_k hat_k(λ) ρ_base(λ_k)
+//! ρ(i,o,λ) ≈ F(η(λ), θd) Σ_k hat_k(λ) [ρ_spec + ρ_CTD](λ_k)/F(η(λ_k), θd) + Σ_k hat_k(λ) [ρ_base + ρ_ms](λ_k)
 //! ```
 //!
 //! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
@@ -167,9 +167,11 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
                 (1.0 - f) * f64::from(a.total()) + f * f64::from(b.total())
             } else {
                 let fl = f64::from(fresnel(self.eta_at(lambda), cos_d));
+                // The base and the compensation lobe (F_avg's colour): linear in λ.
+                let plain = |l: &Lobes| f64::from(l.base) + f64::from(l.multiple);
                 fl * ((1.0 - f) * surface(&a) / fa + f * surface(&b) / fb)
-                    + (1.0 - f) * f64::from(a.base)
-                    + f * f64::from(b.base)
+                    + (1.0 - f) * plain(&a)
+                    + f * plain(&b)
             };
             finite_or_zero(value.max(0.0))
         })
