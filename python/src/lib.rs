@@ -705,9 +705,9 @@ impl Material {
 
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
-    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 11 models', µm),
+    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),
     /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, and
-    /// `models`, a list of 11 dicts as `bakes()` gives them (not a stable
+    /// `models`, a list of 19 dicts as `bakes()` gives them (not a stable
     /// interface). Raises `ValueError` as `eval_spectral` does for a
     /// material without an index over the spectrum.
     fn spectral_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

@@ -22,7 +22,7 @@ the cosine lobe). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
-:meth:`twoscale.Material.spectral_bakes`: the 11 models' bakes, interpolated
+:meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes, interpolated
 in λ, with F(θd) at each of the path's four wavelengths in closed form;
 ``pdf`` and ``sample`` those of the model nearest the hero wavelength).
 
@@ -918,10 +918,10 @@ def _fresnel(n, k, cos):
 
 class SpectralModel(Model):
     """The model at any wavelength of a :class:`twoscale.Material`
-    (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 11
+    (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 19
     models of ``Material.spectral_bakes()`` sharing the surface, their
     surface lobes divided by F(θd) and interpolated linearly in λ, times
-    F(θd) at λ in closed form (η linear between 5 nm nodes); the base lobes
+    F(θd) at λ in closed form (η linear between 1 nm nodes); the base lobes
     interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
     the nearest model (``Spectral::pdf``, ``Spectral::sample``)."""
 
@@ -951,7 +951,7 @@ class SpectralModel(Model):
         return k, dr.select(f > 0.0, dr.minimum(f, 1.0), 0.0)
 
     def eta_at(self, lam):
-        """`Spectral::eta_at`: η at λ (f32), linear between the 5 nm nodes."""
+        """`Spectral::eta_at`: η at λ (f32), linear between the 1 nm nodes."""
         t = (lam - self.eta_first) / self.eta_step
         j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), self.eta_nodes - 2)
         f = dr.clip(t - mi.Float(j), 0.0, 1.0)

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
-//! computed at λ per call (η(λ) from a 5 nm table of the material's index,
+//! computed at λ per call (η(λ) from a 1 nm table of the material's index,
 //! F in closed form); the rest of ρ is smooth in λ. `sample` and `pdf` at λ
 //! are those of the model nearest λ.
 
@@ -22,19 +22,22 @@ use crate::optical::SpectralMaterial;
 use core::borrow::{Borrow, BorrowMut};
 
 /// Number of wavelengths of [`Spectral`].
-pub const SPECTRAL_COUNT: usize = 11;
+pub const SPECTRAL_COUNT: usize = 19;
 
-/// The wavelengths of [`Spectral`]'s models, µm: [0.36, 0.83], 0.04 apart
-/// where the eye is most sensitive, wider towards the red end.
+/// The wavelengths of [`Spectral`]'s models, µm: [0.36, 0.83], 0.02 apart
+/// over 0.44–0.64 (the metals' absorption edges: gold, copper), 0.03–0.04
+/// beyond (docs/model.md §2.12).
 pub const SPECTRAL_WAVELENGTHS: [f32; SPECTRAL_COUNT] = [
-    0.36, 0.40, 0.44, 0.48, 0.52, 0.56, 0.60, 0.64, 0.69, 0.76, 0.83,
+    0.36, 0.40, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54, 0.56, 0.58, 0.60, 0.62, 0.64, 0.67, 0.70, 0.73,
+    0.76, 0.795, 0.83,
 ];
 
-/// Nodes of the 5 nm table of η.
-const ETA_NODES: usize = 95;
+/// Nodes of the 1 nm table of η (finer than the measured indices' rows:
+/// linear in λ every 5 nm cost a rough gold up to 1% of ρ at 0.496 µm).
+const ETA_NODES: usize = 471;
 /// First node and spacing of the table of η, µm.
 const ETA_FIRST: f32 = 0.36;
-const ETA_STEP: f32 = 0.005;
+const ETA_STEP: f32 = 0.001;
 
 /// The hats' cell of `lambda` on `nodes` (held at the ends): `(k, f)` with
 /// `hat_k = 1 − f`, `hat_{k+1} = f`.
@@ -53,11 +56,11 @@ fn cell(nodes: &[f32], lambda: f32) -> (usize, f32) {
 /// The two-scale BRDF at any wavelength of [0.36, 0.83] µm (module
 /// documentation); wavelengths outside are clamped to it. The bakes are held
 /// as `B` as [`TwoScale`]'s: boxed (`Spectral::boxed`, feature `std`) or in
-/// caller-provided storage ([`Spectral::new_in`]); 11 × 45 KB.
+/// caller-provided storage ([`Spectral::new_in`]); [`SPECTRAL_COUNT`] bakes.
 #[derive(Clone)]
 pub struct Spectral<'a, B = ChannelBake> {
     nodes: [TwoScale<'a, B>; SPECTRAL_COUNT],
-    /// η every 5 nm from 0.36 µm.
+    /// η every 1 nm from 0.36 µm.
     eta: [Complex; ETA_NODES],
     white: bool,
 }
@@ -122,7 +125,7 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         if lambda > lo { lambda.min(hi) } else { lo }
     }
 
-    /// η at `lambda` (clamped), linear between the 5 nm nodes.
+    /// η at `lambda` (clamped), linear between the 1 nm nodes.
     fn eta_at(&self, lambda: f32) -> Complex {
         let t = (lambda - ETA_FIRST) / ETA_STEP;
         let j = (math::floor(f64::from(t.max(0.0))) as usize).min(ETA_NODES - 2);
