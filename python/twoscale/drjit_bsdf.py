@@ -859,35 +859,39 @@ class Model:
         weights = [ch.lobe_weights(wi.z) for ch in self.channels]
         w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
              for n in range(4)]
-        # `pick_lobe`.
-        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
-        for n in range(4):
-            positive = w[n] > 0.0
-            cumulative += dr.select(positive, w[n], 0.0)
-            last = dr.select(positive, n, last)
-            chosen = dr.select((chosen < 0) & positive & (lobe_pick < cumulative), n, chosen)
-        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
-        # Specular: reflect wi about a visible normal (the bake is the channels').
-        m, ok_spec = self.channels[0].visible_sample(wi, u1, u2)
-        o = 2.0 * dr.dot(wi, m) * m - wi
-        ok = ok_spec
-        # Diffraction: the picked channel's law.
-        for n, channel in enumerate(self.channels):
-            if channel.diffraction:
-                od, ok_d = channel.diffraction_sample(wi, u1, u2)
-                here = (lobe == 1) & (k == n)
-                o = dr.select(here, od, o)
-                ok = dr.select(here, ok_d, ok)
-        # Base: cosine-weighted.
-        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
-        ok = dr.select(lobe >= 2, True, ok)
-        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
-        # `upper_unit(to_f32(o))`, back to f32.
-        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
-        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
-        return o, ok
+        return _draw(self, [k == n for n in range(len(self.channels))], w, lobe_pick,
+                     wi, u1, u2, valid)
+
+
+def _draw(model, selected, w, pick, wi, u1, u2, valid):
+    """`pick_lobe` of the weights `w` with `pick`, then `TwoScale::sample_lobe`'s
+    direction from `u1, u2`: a visible normal of the shared specular bake, the
+    diffraction law of the channel (model) where `selected[n]`, the cosine lobe
+    for the base and the compensation lobe. Returns the direction
+    (``mi.Vector3f``, `upper_unit(to_f32(o))`) and whether one was drawn."""
+    cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+    for n in range(4):
+        positive = w[n] > 0.0
+        cumulative += dr.select(positive, w[n], 0.0)
+        last = dr.select(positive, n, last)
+        chosen = dr.select((chosen < 0) & positive & (pick < cumulative), n, chosen)
+    lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
+    m, ok = model.channels[0].visible_sample(wi, u1, u2)
+    o = 2.0 * dr.dot(wi, m) * m - wi
+    for n, channel in enumerate(model.channels):
+        if channel.diffraction:
+            od, ok_d = channel.diffraction_sample(wi, u1, u2)
+            here = (lobe == 1) & selected[n]
+            o = dr.select(here, od, o)
+            ok = dr.select(here, ok_d, ok)
+    r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+    ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+    o = dr.select(lobe >= 2, ob, o)
+    ok = dr.select(lobe >= 2, True, ok)
+    ok &= ~((lobe == 1) & ~model.channels_have_diffraction)
+    o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+    ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
+    return o, ok
 
 
 def _fresnel(n, k, cos):
@@ -1039,30 +1043,8 @@ class SpectralModel(Model):
         for m, channel in enumerate(self.channels):
             wm = channel.lobe_weights(wi.z)
             w = [dr.select(nearest == m, wm[n], w[n]) for n in range(4)]
-        # `pick_lobe`.
-        cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
-        for n in range(4):
-            positive = w[n] > 0.0
-            cumulative += dr.select(positive, w[n], 0.0)
-            last = dr.select(positive, n, last)
-            chosen = dr.select((chosen < 0) & positive & (pick < cumulative), n, chosen)
-        lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
-        m_, ok = self.channels[0].visible_sample(wi, u1, u2)
-        o = 2.0 * dr.dot(wi, m_) * m_ - wi
-        for m, channel in enumerate(self.channels):
-            if channel.diffraction:
-                od, ok_d = channel.diffraction_sample(wi, u1, u2)
-                here = (lobe == 1) & (nearest == m)
-                o = dr.select(here, od, o)
-                ok = dr.select(here, ok_d, ok)
-        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-        o = dr.select(lobe >= 2, ob, o)  # the base and the compensation lobe
-        ok = dr.select(lobe >= 2, True, ok)
-        ok &= ~((lobe == 1) & ~self.channels_have_diffraction)
-        o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
-        ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
-        return o, ok
+        return _draw(self, [nearest == m for m in range(len(self.channels))], w, pick,
+                     wi, u1, u2, valid)
 
 
 def _scalar_bsdf_class():
