@@ -1160,7 +1160,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///                                           points at 9 incidences, linear in √cos θi between
     /// E_b  = base albedo estimate: plastic (1 − F(θi)) ρd (1 − F_dr,int)/(1 − ρd F_dr,int)
     ///        (its exact albedo), subsurface (1 − F(θi)) α, plus k_d
-    /// E_ms = F_ms (1 − E_s(μi)), the compensation lobe's albedo (0 when off; E_s of §2.11)
+    /// E_ms = F_ms (1 − E_w(μi)), the compensation lobe's albedo (0 when off), E_w the white
+    ///        albedo of docs/model.md §2.11 (T6's E plus the halo's deficit)
     /// w    ∝ [E_s, max(E_d, 10⁻³ ΣE), E_b, E_ms]  (E_d's floor only where the lobe exists)
     /// ```
     ///
