@@ -16,7 +16,10 @@ use generator::reference::brdf::{self as reference, ExactConvolution};
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
 use std::sync::Mutex;
-use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_sampler, random_direction};
+use suite::brdf::{
+    NarrowNdfConvolution, ProfileConvolution, chi_square_sampler, chi_square_two_scale,
+    random_direction,
+};
 use twoscale::Complex;
 use twoscale::brdf::{
     BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, MultipleScattering, Options,
@@ -448,25 +451,8 @@ fn sampling_matches_pdf() {
                     let i = from_angles(f64::to_radians(deg), 1.1);
                     let s = model.surface();
                     let scale = f64::from(2.0 * s.beta).min(f64::from(lambda / s.b));
-                    let check = match lobe {
-                        Some(lobe) => chi_square_sampler(
-                            i,
-                            |u| model.sample_lobe(lobe, i, [u[1], u[2]]),
-                            |o| f64::from(model.pdf_lobe(lobe, i, o)),
-                            n_lobe,
-                            scale,
-                            k as u64 + 100,
-                        ),
-                        None => chi_square_sampler(
-                            i,
-                            |u| model.sample(i, u).map(|s| s.o),
-                            |o| f64::from(model.pdf(i, o)),
-                            n,
-                            scale,
-                            k as u64 + 100,
-                        ),
-                    };
                     let count = if lobe.is_some() { n_lobe } else { n };
+                    let check = chi_square_two_scale(&model, lobe, i, count, scale, k as u64 + 100);
                     results
                         .lock()
                         .unwrap()
@@ -952,20 +938,8 @@ fn halo_sampling_chi2() {
     for (seed, &(k, s, deg, lobe)) in cases.iter().enumerate() {
         let model = TwoScale::conductor(&tables, s, 0.526, gold);
         let i = from_angles(f64::to_radians(deg), 0.3);
-        let check = chi_square_sampler(
-            i,
-            |u| match lobe {
-                Some(lobe) => model.sample_lobe(lobe, i, [u[1], u[2]]),
-                None => model.sample(i, u).map(|s| s.o),
-            },
-            |o| match lobe {
-                Some(lobe) => f64::from(model.pdf_lobe(lobe, i, o)),
-                None => f64::from(model.pdf(i, o)),
-            },
-            n,
-            0.5 * f64::from(s.beta),
-            seed as u64 + 900,
-        );
+        let scale = 0.5 * f64::from(s.beta);
+        let check = chi_square_two_scale(&model, lobe, i, n, scale, seed as u64 + 900);
         let label = format!("halo surface {k}, θi = {deg}°, {lobe:?}");
         if sampler_check_fails(&label, &check, n, alpha) {
             failures.push((

@@ -12,7 +12,7 @@ use generator::quad::{Tolerance, gauss_legendre, integrate};
 use generator::reference::fresnel::{self, Complex64};
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
-use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_sampler};
+use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_two_scale};
 use twoscale::Complex;
 use twoscale::brdf::{
     BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, MultipleScattering, Options, Surface,
@@ -494,24 +494,7 @@ fn sampling_matches_pdf_with_the_lobe() {
         let w = model.lobe_weights(i);
         assert!(w[3] > 0.0, "{name} {deg}°: the lobe has weight {w:?}");
         let scale = 2.0 * f64::from(model.surface().beta);
-        let check = match lobe {
-            Some(lobe) => chi_square_sampler(
-                i,
-                |u| model.sample_lobe(lobe, i, [u[1], u[2]]),
-                |o| f64::from(model.pdf_lobe(lobe, i, o)),
-                n,
-                scale,
-                k as u64 + 500,
-            ),
-            None => chi_square_sampler(
-                i,
-                |u| model.sample(i, u).map(|s| s.o),
-                |o| f64::from(model.pdf(i, o)),
-                n,
-                scale,
-                k as u64 + 500,
-            ),
-        };
+        let check = chi_square_two_scale(&model, lobe, i, n, scale, k as u64 + 500);
         eprintln!(
             "χ² {name} θi = {deg}° {lobe:?} (weights {w:?}): p = {:.4}, ∫pdf = {:.6}, sampled {:.6}",
             check.chi.p_value, check.pdf_integral, check.success

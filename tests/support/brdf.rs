@@ -6,6 +6,7 @@ use generator::quad::gauss_legendre;
 use generator::reference::conv;
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
+use twoscale::brdf::{Lobe, TwoScale};
 use twoscale::conv::{Convolution, kernel};
 
 /// A cheap stand-in for C where its accuracy does not matter (sampling
@@ -123,6 +124,37 @@ impl SamplerCheck {
             self.pdf_integral,
             self.success
         );
+    }
+}
+
+/// [`chi_square_sampler`] of `model` at incidence `i`: its whole sampler
+/// (`sample`, `pdf`) when `lobe` is `None`, else that lobe's (`sample_lobe`
+/// with `u[1], u[2]`, `pdf_lobe`).
+pub fn chi_square_two_scale(
+    model: &TwoScale<'_>,
+    lobe: Option<Lobe>,
+    i: [f32; 3],
+    n: usize,
+    scale: f64,
+    seed: u64,
+) -> SamplerCheck {
+    match lobe {
+        Some(lobe) => chi_square_sampler(
+            i,
+            |u| model.sample_lobe(lobe, i, [u[1], u[2]]),
+            |o| f64::from(model.pdf_lobe(lobe, i, o)),
+            n,
+            scale,
+            seed,
+        ),
+        None => chi_square_sampler(
+            i,
+            |u| model.sample(i, u).map(|s| s.o),
+            |o| f64::from(model.pdf(i, o)),
+            n,
+            scale,
+            seed,
+        ),
     }
 }
 
