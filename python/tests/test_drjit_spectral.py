@@ -93,6 +93,54 @@ def test_pdf_and_sample_equal_the_runtime(name):
     assert np.abs(o - ref_o)[ok].max() <= 1e-4
 
 
+class _Poisoned:
+    """`material` whose `spectral_bakes()` has NaN in every stacked quantity
+    of the models not in `keep`."""
+
+    def __init__(self, material, keep):
+        self.material, self.keep = material, keep
+
+    def __getattr__(self, name):
+        return getattr(self.material, name)
+
+    def spectral_bakes(self):
+        bakes = self.material.spectral_bakes()
+        for name in bakes["per_node"]:
+            value = np.array(bakes["models"][name], copy=True)
+            value[[k for k in range(len(value)) if k not in self.keep]] = np.nan
+            bakes["models"][name] = value
+        return bakes
+
+
+@pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble"])
+def test_each_wavelength_reads_its_models_only(name):
+    """With every model but those around the path's four wavelengths (and
+    model 0, the shared surface's source) made NaN, `eval_spectral` is
+    unchanged bit for bit; with every model but the hero wavelength's
+    nearest, `pdf_spectral` and `sample_spectral` are."""
+    material = preset_with(name)
+    light, camera = pairs(seed(name, "poison"), 1000)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+    u = mi.Vector3f(np.random.default_rng(seed(name, "poison u")).random((3, len(light))))
+    # Cells 1, 7, 10 and 17 (from the nodes 0.40, 0.54, 0.60 and 0.795 µm).
+    lams = [mi.Float(x) for x in (0.41, 0.545, 0.61, 0.80)]
+    model = tb.SpectralModel(material)
+    poisoned = tb.SpectralModel(_Poisoned(material, {0, 1, 2, 7, 8, 10, 11, 17, 18}))
+    for a, b in zip(model.eval_spectral(wi, wo, lams), poisoned.eval_spectral(wi, wo, lams)):
+        assert np.array_equal(np.array(a), np.array(b))
+    assert np.array(model.eval_spectral(wi, wo, lams)[1]).max() > 0.0
+    hero = mi.Float(0.545)
+    nearest = tb.SpectralModel(_Poisoned(material, {0, 7}))
+    assert np.array_equal(np.array(model.pdf_spectral(wi, wo, hero)),
+                          np.array(nearest.pdf_spectral(wi, wo, hero)))
+    (o, ok), (o_p, ok_p) = (m.sample_spectral(wi, u, hero) for m in (model, nearest))
+    assert np.array_equal(np.array(ok), np.array(ok_p)) and np.array(ok).any()
+    assert np.array_equal(np.array(o), np.array(o_p))
+    # The poison is seen where it is read: the pdf at a model made NaN.
+    assert not np.array_equal(np.array(model.pdf_spectral(wi, wo, mi.Float(0.6))),
+                              np.array(nearest.pdf_spectral(wi, wo, mi.Float(0.6))))
+
+
 def adapter(props, wi, nm):
     """`mi.chi2.BSDFAdapter` with the paths' wavelengths set to `nm` (the
     adapter leaves them 0, which would test only the bluest model)."""
