@@ -22,9 +22,10 @@ the cosine lobe). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
-:meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes, interpolated
-in λ, with F(θd) at each of the path's four wavelengths in closed form;
-``pdf`` and ``sample`` those of the model nearest the hero wavelength).
+:meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes stacked along
+a node axis, the two models around each of the path's four wavelengths
+interpolated in λ, with F(θd) at λ in closed form; ``pdf`` and ``sample``
+those of the model nearest the hero wavelength).
 
 **Gradients.** The bakes are fixed per material (the runtime interprets the
 tables; a lookup's node positions have no useful derivative), so
