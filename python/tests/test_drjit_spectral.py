@@ -68,6 +68,31 @@ def test_eval_equals_the_runtime(name):
     assert small_ok
 
 
+@pytest.mark.parametrize("base", ["plastic", "subsurface"])
+def test_a_dispersive_base_equals_the_runtime(base):
+    """With η varying over λ the base layer's constants differ between the
+    models (per-model `eta_re`, `f_dr_int`): `eval_spectral` and
+    `pdf_spectral` equal the runtime's as in `test_eval_equals_the_runtime`."""
+    lam_eta = np.linspace(0.36, 0.83, 30)
+    material = twoscale.Material(beta=0.2, p=1.5, sigma_s=0.05, b=2.0, c=1.5,
+                                 eta=(lam_eta, 1.6 - 0.2 * (lam_eta - 0.36), 0.0 * lam_eta),
+                                 base=base, albedo=0.7, lambertian=0.1)
+    assert {"eta_re", "f_dr_int"} <= set(material.spectral_bakes()["per_node"])
+    model = tb.SpectralModel(material)
+    light, camera = pairs(seed(base, "dispersive"))
+    lam = np.random.default_rng(seed(base, "lam")).uniform(0.36, 0.83, (4, len(light)))
+    lam = lam.astype(np.float32)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+    ref = np.stack([material.eval_spectral(light, camera, row) for row in lam], axis=1)
+    got = np.array(mi.Spectrum(*model.eval_spectral(wi, wo, [mi.Float(x) for x in lam]))).T
+    worst, small_ok = relative_error(got.reshape(-1, 1), ref.reshape(-1, 1))
+    assert worst < TOLERANCE and small_ok, f"{base}: eval worst relative error {worst:.2e}"
+    got = np.array(model.pdf_spectral(wi, wo, mi.Float(lam[0])))
+    worst, small_ok = relative_error(got[:, None],
+                                     material.pdf_spectral(light, camera, lam[0])[:, None])
+    assert worst < TOLERANCE and small_ok, f"{base}: pdf worst relative error {worst:.2e}"
+
+
 @pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble", "silver", "white-plastic/white",
                                   "gold-rough/kulla-conty"])
 def test_pdf_and_sample_equal_the_runtime(name):

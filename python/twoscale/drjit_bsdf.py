@@ -954,11 +954,12 @@ class _NodeChannel(_Channel):
     model `k` (its rows offset by `k` models, its scalars gathered at `k`),
     so that a lane reads the models it needs and no other."""
 
-    # Read as Python floats (branches, literals) or from the shared tables:
-    # one value for every model.
+    # Read as Python floats (branches, literals), by `Model` from model 0
+    # (D, G) or from the shared tables: one value for every model.
     SHARED = {"sigma_s", "b", "white", "has_q", "symmetrised", "halo_incident", "base",
               "conv_baked", "height_correlated", "halo_spectrum_share", "conv_u0",
-              "conv_cos_h_min", "masking_beta", "masking_g1"}
+              "conv_cos_h_min", "masking_beta", "masking_g1", "beta", "p", "epd_norm",
+              "epd_inv_beta_sq"}
 
     # The tables read through `_node_row`: stacked even where the models agree.
     ROWS = ("direction_rows", "direction_weights", "conv_ln_c", "radial_inv_m", "halo_u",
