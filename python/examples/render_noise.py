@@ -5,9 +5,10 @@ BSDF against Mitsuba's ``roughconductor`` (Beckmann, visible normals), in
     python python/examples/render_noise.py [--size 64] [--spp 16] [--seeds 16]
         [--ref-renders 64] [--alphas 0.05 0.2 0.5] [--presets]
 
-For each BSDF: ``--seeds`` renders at ``--spp`` (timed: process
-CPU time per sample, after a warm-up render), and a reference, the mean of
-``--ref-renders`` more renders. Over the pixels the sphere covers whole
+For each BSDF: ``--seeds`` renders at ``--spp`` (timed: the median process
+CPU time of a render, after a warm-up render, per sample; the two BSDFs'
+renders alternate), and a reference, the mean of ``--ref-renders`` more
+renders. Over the pixels the sphere covers whole
 (the four corners' camera rays hit it) where the reference exceeds 10⁻³ of
 its mean there, and over the three channels:
 
@@ -62,27 +63,26 @@ def covered(scene):
     return hit[:-1, :-1] & hit[1:, :-1] & hit[:-1, 1:] & hit[1:, 1:]
 
 
-def renders(scene, spp, seeds, first_seed):
-    """(seeds, H, W, 3) renders at `spp` with consecutive seeds from
-    `first_seed`, and the process CPU time per sample."""
-    start = time.process_time()
-    images = [np.asarray(mi.render(scene, seed=first_seed + s, spp=spp), dtype=np.float64)
-              for s in range(seeds)]
-    size = images[0].shape[0] * images[0].shape[1]
-    return np.stack(images), (time.process_time() - start) / (seeds * size * spp)
-
-
-def measure(bsdf, size, spp, seeds, ref_renders):
-    """The statistics of one BSDF (module documentation): a dict with the
-    seeds' images `images`, the reference `ref` (H, W, 3) and its renders'
-    means `ref_means`, the coverage `covered` and the CPU time per sample `cost`."""
-    scene = benchmark_render.sphere_scene(bsdf, size, spp)
-    mi.render(scene, seed=0, spp=spp)  # warm-up: JIT compilation, plugin construction
-    images, cost = renders(scene, spp, seeds, 1)
-    refs, _ = renders(scene, spp, ref_renders, 1 + seeds)
-    cover = covered(scene)
-    return {"images": images, "ref": refs.mean(axis=0), "ref_renders": refs, "covered": cover,
-            "cost": cost}
+def measure(bsdfs, size, spp, seeds, ref_renders):
+    """The statistics of each of `bsdfs` (module documentation): a dict each
+    with the seeds' images `images` (K, H, W, 3), the reference `ref`
+    (H, W, 3) and its renders `ref_renders`, the coverage `covered` and the
+    CPU time per sample `cost`: the median over the seeds' renders, which
+    alternate between the BSDFs (so that a change of load falls on both)."""
+    scenes = [benchmark_render.sphere_scene(bsdf, size, spp) for bsdf in bsdfs]
+    for scene in scenes:
+        mi.render(scene, seed=0, spp=spp)  # warm-up: JIT compilation, plugin construction
+    images = [[] for _ in scenes]
+    times = [[] for _ in scenes]
+    for seed in range(1, 1 + seeds + ref_renders):
+        for scene, out, spent in zip(scenes, images, times):
+            start = time.process_time()
+            out.append(np.asarray(mi.render(scene, seed=seed, spp=spp), dtype=np.float64))
+            spent.append(time.process_time() - start)
+    return [{"images": np.stack(out[:seeds]), "ref": np.mean(out[seeds:], axis=0),
+             "ref_renders": np.stack(out[seeds:]), "covered": covered(scene),
+             "cost": float(np.median(spent[:seeds])) / (size * size * spp)}
+            for scene, out, spent in zip(scenes, images, times)]
 
 
 def mask_of(*stats):
@@ -194,8 +194,7 @@ def beckmann_rows(alphas, size, spp, seeds, ref_renders, show_where=False):
     print(HEADER.format("α"))
     for alpha in alphas:
         ours_bsdf, rough = benchmark_render.beckmann_pair(alpha, plugin=tm.NAME)
-        ours = measure(ours_bsdf, size, spp, seeds, ref_renders)
-        theirs = measure(rough, size, spp, seeds, ref_renders)
+        ours, theirs = measure([ours_bsdf, rough], size, spp, seeds, ref_renders)
         r = compare(ours, theirs, shared=True)
         print(row(alpha, r), flush=True)
         if show_where:
@@ -211,8 +210,8 @@ def preset_rows(size, spp, seeds, ref_renders):
         material = twoscale.Material.preset(name)
         eta = [e for e, _ in material.eta]
         k = [k for _, k in material.eta]
-        ours = measure({"type": tm.NAME, "material": name}, size, spp, seeds, ref_renders)
-        theirs = measure(benchmark_render.roughconductor(material.beta, eta, k), size, spp, seeds, ref_renders)
+        rough = benchmark_render.roughconductor(material.beta, eta, k)
+        ours, theirs = measure([{"type": tm.NAME, "material": name}, rough], size, spp, seeds, ref_renders)
         print(row(f"{name} ({material.beta:.3g}, {material.p:.3g})", compare(ours, theirs)), flush=True)
 
 

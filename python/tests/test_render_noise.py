@@ -35,14 +35,14 @@ def registered():
     tm.register()
 
 
-def stats(bsdf):
-    return rn.measure(bsdf, SIZE, SPP, SEEDS, REF)
+def stats(*bsdfs):
+    return rn.measure(bsdfs, SIZE, SPP, SEEDS, REF)
 
 
 @pytest.mark.parametrize("alpha", [0.05, 0.5])
 def test_beckmann_limit_noise_and_mean(alpha):
     ours, rough = rn.benchmark_render.beckmann_pair(alpha, plugin=tm.NAME)
-    r = rn.compare(stats(ours), stats(rough), shared=True)
+    r = rn.compare(*stats(ours, rough), shared=True)
     print(f"α {alpha}: noise ratio {r['noise']:.4f} ± {r['noise_se']:.1e}, "
           f"mean ratio {r['mean']:.4f} ± {r['mean_se']:.1e}, {r['pixels']} pixels")
     assert np.log(r["noise"]) <= np.log(1.05) + T * 0.5 * r["se_log_variance"], r
@@ -55,6 +55,6 @@ def test_the_measure_tells_samplers_apart():
     the 5% the target allows, at α = 0.5."""
     visible = rn.benchmark_render.roughconductor(0.5, *rn.benchmark_render.GOLD)
     d_cos = dict(visible, sample_visible=False)
-    r = rn.compare(stats(d_cos), stats(visible), shared=True)
+    r = rn.compare(*stats(d_cos, visible), shared=True)
     print(f"D cos / visible normals: noise ratio {r['noise']:.4f} ± {r['noise_se']:.1e}")
     assert np.log(r["noise"]) > np.log(1.05) + T * 0.5 * r["se_log_variance"], r
