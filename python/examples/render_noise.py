@@ -5,10 +5,9 @@ BSDF against Mitsuba's ``roughconductor`` (Beckmann, visible normals), in
     python python/examples/render_noise.py [--size 64] [--spp 16] [--seeds 16]
         [--ref-renders 64] [--alphas 0.05 0.2 0.5] [--presets]
 
-For each BSDF: ``--seeds`` renders at ``--spp`` (timed: the median process
-CPU time of a render, after a warm-up render, per sample; the two BSDFs'
-renders alternate), and a reference, the mean of ``--ref-renders`` more
-renders. Over the pixels the sphere covers whole
+For each BSDF: ``--seeds`` renders at ``--spp`` and a reference, the mean
+of ``--ref-renders`` more renders; and the process CPU time per sample,
+the slope between renders at ``--spp`` and 8 × ``--spp`` (`timed`). Over the pixels the sphere covers whole
 (the four corners' camera rays hit it) where the reference exceeds 10⁻³ of
 its mean there, and over the three channels:
 
@@ -63,26 +62,42 @@ def covered(scene):
     return hit[:-1, :-1] & hit[1:, :-1] & hit[:-1, 1:] & hit[1:, 1:]
 
 
-def measure(bsdfs, size, spp, seeds, ref_renders):
+def measure(bsdfs, size, spp, seeds, ref_renders, timing=5):
     """The statistics of each of `bsdfs` (module documentation): a dict each
     with the seeds' images `images` (K, H, W, 3), the reference `ref`
     (H, W, 3) and its renders `ref_renders`, the coverage `covered` and the
-    CPU time per sample `cost`: the median over the seeds' renders, which
-    alternate between the BSDFs (so that a change of load falls on both)."""
+    CPU time per sample `cost` (`timed`, with `timing` rounds; NaN with none)."""
     scenes = [benchmark_render.sphere_scene(bsdf, size, spp) for bsdf in bsdfs]
     for scene in scenes:
         mi.render(scene, seed=0, spp=spp)  # warm-up: JIT compilation, plugin construction
     images = [[] for _ in scenes]
-    times = [[] for _ in scenes]
     for seed in range(1, 1 + seeds + ref_renders):
-        for scene, out, spent in zip(scenes, images, times):
-            start = time.process_time()
+        for scene, out in zip(scenes, images):
             out.append(np.asarray(mi.render(scene, seed=seed, spp=spp), dtype=np.float64))
-            spent.append(time.process_time() - start)
+    costs = timed(scenes, size, spp, timing) if timing else [np.nan] * len(scenes)
     return [{"images": np.stack(out[:seeds]), "ref": np.mean(out[seeds:], axis=0),
-             "ref_renders": np.stack(out[seeds:]), "covered": covered(scene),
-             "cost": float(np.median(spent[:seeds])) / (size * size * spp)}
-            for scene, out, spent in zip(scenes, images, times)]
+             "ref_renders": np.stack(out[seeds:]), "covered": covered(scene), "cost": cost}
+            for scene, out, cost in zip(scenes, images, costs)]
+
+
+def timed(scenes, size, spp, rounds):
+    """The process CPU time per sample of each of `scenes`: the slope between
+    renders at `spp` and at 8 `spp` (medians of `rounds` renders each, the
+    scenes alternating so that a change of load falls on all), which leaves
+    out what a render costs whatever its samples (recording the kernel in
+    symbolic mode: ≈ 15 ms, as much as 16 spp at 64² pixels)."""
+    medians = []
+    for n in (spp, 8 * spp):
+        for scene in scenes:
+            mi.render(scene, seed=0, spp=n)  # warm-up
+        spent = [[] for _ in scenes]
+        for r in range(rounds):
+            for scene, out in zip(scenes, spent):
+                start = time.process_time()
+                np.asarray(mi.render(scene, seed=100_000 + r, spp=n))
+                out.append(time.process_time() - start)
+        medians.append([float(np.median(out)) for out in spent])
+    return [(hi - lo) / (size * size * 7 * spp) for lo, hi in zip(*medians)]
 
 
 def mask_of(*stats):
