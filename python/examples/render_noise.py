@@ -3,7 +3,7 @@ BSDF against Mitsuba's ``roughconductor`` (Beckmann, visible normals), in
 ``llvm_ad_rgb`` (symbolic mode), on the sphere of benchmark_render.py.
 
     python python/examples/render_noise.py [--size 64] [--spp 16] [--seeds 16]
-        [--ref-renders 64] [--alphas 0.05 0.2 0.5] [--presets]
+        [--ref-renders 64] [--alphas 0.05 0.2 0.5] [--presets] [--where]
 
 For each BSDF: ``--seeds`` renders at ``--spp`` and a reference, the mean
 of ``--ref-renders`` more renders; and the process CPU time per sample,
