@@ -170,6 +170,48 @@ def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
 
+def _conv_at(quads, first, constants, shape, s, sin_h, cos_h, u):
+    """`ConvBake::at` on the packets `quads` (:class:`_Channel`'s
+    `conv_quads`) from packet `first` on, with the bake's `constants`
+    (:meth:`_Channel.conv_constants`; scalars or per-lane), `shape` its
+    padded grid's and `s` the axes' constants (`conv_u0`, `conv_cos_h_min`)."""
+    big_b, u_linear, u_scale, ndf_quarter_width = constants
+    n_u, n_s = shape
+    nodes_u, nodes_s = n_u - 2, n_s - 2
+    u = dr.minimum(dr.maximum(u, 0.0), big_b)
+    sec_h = 1.0 / dr.maximum(cos_h, s["conv_cos_h_min"])
+    tan_h = dr.minimum(dr.maximum(sin_h, 0.0), 1.0) * sec_h
+    x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * u_linear) * u_scale
+    v = u + 0.5
+    nv = ndf_quarter_width * v
+    inv_w = dr.sqrt(16.0 + v * v / (1.0 / 64.0 + nv * nv))
+    x_h = sec_h + tan_h * inv_w
+    span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
+    x_s = _log2_axis(x_h) * (float(nodes_s - 1) / span)
+    ju, tu = _cell_at(x_u, nodes_u)
+    ks, ts = _cell_at(x_s, nodes_s)
+    wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
+    ln_c = mi.Float(0.0)
+    for a in range(4):
+        # The four nodes (ks … ks + 3) of row ju + a in one packet.
+        quad = _gather4(quads, first + (ju + a) * n_s + ks)
+        inner = mi.Float(0.0)
+        for b in range(4):
+            inner += ws[b] * quad[b]
+        ln_c += wu[a] * inner
+    value = dr.exp(ln_c)
+    return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+
+
+def _exp_and_one_minus_over(x, srs):
+    """`brdf::exp_and_one_minus_over`: `(e^−x s, (1 − e^−x s)/s)` in f64."""
+    t = x * srs
+    e = dr.exp(-t)
+    small = t < 1e-8
+    return (dr.select(small, 1.0 - t, e),
+            dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
+
+
 class _Channel:
     """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
 
@@ -193,7 +235,8 @@ class _Channel:
         # flattened grid (so that a Catmull–Rom row is one packet gather).
         ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()
         ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
-        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        self.conv_quads_np = np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel()
+        self.conv_quads = mi.Float(self.conv_quads_np)
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
@@ -226,34 +269,16 @@ class _Channel:
         return dr.select(z > 0.0, value, 0.0)
 
     # -- C over (u, θh) ------------------------------------------------
+    def conv_constants(self):
+        """`ConvBake`'s per-bake constants: `(big_b, u_linear, u_scale,
+        ndf_quarter_width)` (f32)."""
+        return tuple(self.f[k] for k in ("conv_big_b", "conv_u_linear", "conv_u_scale",
+                                         "conv_ndf_quarter_width"))
+
     def conv(self, sin_h, cos_h, u):
         """`ConvBake::at`."""
-        s, f = self.s, self.f
-        n_u, n_s = self.shapes["conv_ln_c"]
-        nodes_u, nodes_s = n_u - 2, n_s - 2
-        u = dr.minimum(dr.maximum(u, 0.0), f["conv_big_b"])
-        sec_h = 1.0 / dr.maximum(cos_h, s["conv_cos_h_min"])
-        tan_h = dr.minimum(dr.maximum(sin_h, 0.0), 1.0) * sec_h
-        x_u = (_log2_axis(1.0 + u / s["conv_u0"]) + u * f["conv_u_linear"]) * f["conv_u_scale"]
-        v = u + 0.5
-        nv = f["conv_ndf_quarter_width"] * v
-        inv_w = dr.sqrt(16.0 + v * v / (1.0 / 64.0 + nv * nv))
-        x_h = sec_h + tan_h * inv_w
-        span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
-        x_s = _log2_axis(x_h) * (float(nodes_s - 1) / span)
-        ju, tu = _cell_at(x_u, nodes_u)
-        ks, ts = _cell_at(x_s, nodes_s)
-        wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
-        ln_c = mi.Float(0.0)
-        for a in range(4):
-            # The four nodes (ks … ks + 3) of row ju + a in one packet.
-            quad = _gather4(self.conv_quads, (ju + a) * n_s + ks)
-            inner = mi.Float(0.0)
-            for b in range(4):
-                inner += ws[b] * quad[b]
-            ln_c += wu[a] * inner
-        value = dr.exp(ln_c)
-        return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+        return _conv_at(self.conv_quads, 0, self.conv_constants(), self.shapes["conv_ln_c"],
+                        self.s, sin_h, cos_h, u)
 
     # -- the sampler's densities ---------------------------------------
     def lobe_weights(self, cos_i):
@@ -693,14 +718,7 @@ class _Channel:
         else:
             sigma_rel_sq = mi.Float64(0.0)
 
-        def exp_and_one_minus_over(x, srs):
-            t = x * srs
-            e = dr.exp(-t)
-            small = t < 1e-8
-            return (dr.select(small, 1.0 - t, e),
-                    dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
-
-        a_spec, one_minus_a_over = exp_and_one_minus_over(x, sigma_rel_sq)
+        a_spec, one_minus_a_over = _exp_and_one_minus_over(x, sigma_rel_sq)
         fresnel_d = (mi.Float64(1.0) if s["white"] else
                      mi.Float64(self.direction(self.direction_cell(mi.Float(cos_d)), [6])[0]))
         rho_ct = fresnel_d * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
@@ -714,8 +732,8 @@ class _Channel:
             else:
                 q = mi.Float64(0.0)
             if s["halo_incident"]:
-                one_minus_a_over = exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
-                                                          sigma_rel_sq)[1]
+                one_minus_a_over = _exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
+                                                           sigma_rel_sq)[1]
             halo = self.d["halo_scale"] * one_minus_a_over
             c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
                                 mi.Float(self.d["big_b"] * cos_d))
@@ -729,6 +747,28 @@ class _Channel:
         multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
+
+    def node_terms(self, g, geo, params):
+        """`spectral::NodeTerms::new`: (σrel²/σs², Q̄, F(θd), ρ_base + k_d/π
+        + ρ_ms) of this model at a pair, in f64."""
+        s = self.s
+        wi, wo = geo["wi"], geo["wo"]
+        at_i, at_o = ([mi.Float64(v) for v in self.direction(self.direction_cell(mi.Float(w.z)),
+                                                             range(8))] for w in (wi, wo))
+        r_i, r_o = at_i[5], at_o[5]
+        ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
+        if s["white"]:
+            q, fresnel_d = mi.Float64(1.0), mi.Float64(1.0)
+        else:
+            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
+                 if s["has_q"] else mi.Float64(0.0))
+            fresnel_d = mi.Float64(
+                self.direction(self.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
+        base = self.base_value(at_i[6], at_o[6], wi.z, wo.z, params)
+        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        plain = (mi.Float64(_finite_or_zero(mi.Float(base)))
+                 + mi.Float64(_finite_or_zero(mi.Float(multiple))))
+        return ratio_sq, q, fresnel_d, plain
 
 
 def default_params(material: twoscale.Material):
@@ -939,6 +979,16 @@ class SpectralModel(Model):
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
         self.white = spectral["white"] != 0.0
+        # Per model: the constants `eval_spectral` scales to λ, and C's bakes
+        # one after another (`conv_packets` packets each).
+        self.node_constants = {
+            name: mi.Float64([ch.s[name] for ch in self.channels])
+            for name in ("lambda", "x_scale", "halo_scale", "big_b")}
+        self.conv_constants = [
+            mi.Float([ch.s[name] for ch in self.channels])
+            for name in ("conv_big_b", "conv_u_linear", "conv_u_scale", "conv_ndf_quarter_width")]
+        self.conv_packets = len(self.channels[0].conv_quads_np) // 4
+        self.conv_quads = mi.Float(np.concatenate([ch.conv_quads_np for ch in self.channels]))
 
     def clamped(self, lam):
         """λ (µm, f32) clamped to the models' range (NaN → the first)."""
@@ -969,38 +1019,68 @@ class SpectralModel(Model):
 
     def eval_spectral(self, wi, wo, lams):
         """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
-        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``)."""
+        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``):
+        each model's terms at the pair (:meth:`_Channel.node_terms`), then
+        the surface lobes at λ itself with C from the lower model's bake
+        (``Spectral::at_lambda``)."""
         valid, geo = self.geometry(wi, wo)
         g = self.masking(geo)
-        cos_d = mi.Float(geo["cos_d"])
-        surface, base, total, fresnel = [], [], [], []
-        for channel in self.channels:
-            spec, diff, b, mult = channel.lobes(g, geo, self.params)
-            spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
-            surface.append(spec + diff)
-            base.append(b + mult)  # the base and the compensation lobe: linear in λ
-            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult))))
-            fresnel.append(mi.Float64(1.0) if self.white else mi.Float64(
-                channel.direction(channel.direction_cell(cos_d), [6])[0]))
+        cos_i, cos_o, cos_d = geo["wi"].z, geo["wo"].z, geo["cos_d"]
+        terms = [channel.node_terms(g, geo, self.params) for channel in self.channels]
+        first = self.channels[0]
+        s = first.s
         out = []
         for lam in lams:
             lam = self.clamped(mi.Float(lam))
             k, f = self.cell(lam)
-
-            def at(values, m):
-                return sum(dr.select(m == j, v, 0.0) for j, v in enumerate(values))
-
-            fa, fb = at(fresnel, k), at(fresnel, k + 1)
             f = mi.Float64(f)
-            plain = (1.0 - f) * at(total, k) + f * at(total, k + 1)
-            fl = mi.Float64(_fresnel(*self.eta_at(lam), cos_d))
-            fa_safe = dr.select(fa > 0.0, fa, 1.0)
-            fb_safe = dr.select(fb > 0.0, fb, 1.0)
-            coloured = (fl * ((1.0 - f) * at(surface, k) / fa_safe
-                              + f * at(surface, k + 1) / fb_safe)
-                        + (1.0 - f) * at(base, k) + f * at(base, k + 1))
-            use_plain = (fa <= 0.0) | (fb <= 0.0) if not self.white else True
-            value = dr.select(use_plain, plain, coloured)
+
+            def at(j, m):
+                return sum(dr.select(m == n, t[j], 0.0) for n, t in enumerate(terms))
+
+            def lerp(j):
+                return (1.0 - f) * at(j, k) + f * at(j, k + 1)
+
+            def node(name):
+                return dr.gather(mi.Float64, self.node_constants[name], k)
+
+            # λ_k/λ: B, (4π/λ)² and the halo's 1/λ² from model k's.
+            ratio = node("lambda") / mi.Float64(lam)
+            x_scale = node("x_scale") * ratio * ratio
+            sigma_rel_sq = first.d["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0 else 0.0
+            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_d * cos_d,
+                                                                sigma_rel_sq)
+            fl = mi.Float64(1.0) if self.white else mi.Float64(
+                _fresnel(*self.eta_at(lam), mi.Float(cos_d)))
+            specular = a_spec * fl * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+            if first.diffraction:
+                if self.white:
+                    q = mi.Float64(1.0)
+                else:
+                    fa, fb = at(2, k), at(2, k + 1)
+                    coloured = (fa > 0.0) & (fb > 0.0)
+                    fa = dr.select(coloured, fa, 1.0)
+                    fb = dr.select(coloured, fb, 1.0)
+                    qa, qb = at(1, k), at(1, k + 1)
+                    q = dr.select(coloured, fl * ((1.0 - f) * qa / fa + f * qb / fb),
+                                  (1.0 - f) * qa + f * qb)
+                if s["halo_incident"]:
+                    one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_i * cos_i,
+                                                               sigma_rel_sq)[1]
+                halo = node("halo_scale") * ratio * ratio * one_minus_a_over
+                u = mi.Float(node("big_b") * ratio * cos_d)
+                constants = tuple(dr.gather(mi.Float, self.conv_constants[j], k)
+                                  for j in range(4))
+                c_value = _conv_at(self.conv_quads, k * self.conv_packets, constants,
+                                   first.shapes["conv_ln_c"], s, mi.Float(geo["sin_h"]),
+                                   mi.Float(geo["cos_h"]), u)
+                diffraction = dr.select(
+                    g > 0.0, q * g * halo * mi.Float64(dr.maximum(c_value, 0.0)), 0.0
+                ) * mi.Float64(self.params["halo_factor"])
+            else:
+                diffraction = mi.Float64(0.0)
+            value = (mi.Float64(_finite_or_zero(mi.Float(specular)))
+                     + mi.Float64(_finite_or_zero(mi.Float(diffraction))) + lerp(3))
             out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
         return out
 

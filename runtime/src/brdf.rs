@@ -1086,15 +1086,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 }
             };
             let halo = self.halo_scale * one_minus_a_over;
-            let u = (self.big_b * cos_d) as f32;
-            let c_value = f64::from(match self.bake().conv() {
-                Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
-                None => {
-                    self.conv
-                        .convolution_sin_cos(sin_h as f32, cos_h as f32, u, s.c, s.beta, s.p)
-                }
-            });
-            let c_value = if c_value > 0.0 { c_value } else { 0.0 };
+            let c_value = self.conv_at(sin_h, cos_h, (self.big_b * cos_d) as f32);
             q * g * halo * c_value
         } else {
             0.0
@@ -1107,6 +1099,20 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             at_i,
             at_o,
         }
+    }
+
+    /// C(θh; u) (≥ 0) from the bake, or from the source of C when it offers
+    /// no slice; `u` is clamped to the bake's `[0, B]`.
+    #[inline(always)]
+    fn conv_at(&self, sin_h: f64, cos_h: f64, u: f32) -> f64 {
+        let s = &self.surface;
+        let c_value = f64::from(match self.bake().conv() {
+            Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
+            None => self
+                .conv
+                .convolution_sin_cos(sin_h as f32, cos_h as f32, u, s.c, s.beta, s.p),
+        });
+        if c_value > 0.0 { c_value } else { 0.0 }
     }
 
     /// `ρ_base + k_d/π` (docs/model.md §2.6; HP17 42-47).
