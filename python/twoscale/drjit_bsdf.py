@@ -963,10 +963,11 @@ def _fresnel(n, k, cos):
 class SpectralModel(Model):
     """The model at any wavelength of a :class:`twoscale.Material`
     (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 19
-    models of ``Material.spectral_bakes()`` sharing the surface, their
-    surface lobes divided by F(θd) and interpolated linearly in λ, times
-    F(θd) at λ in closed form (η linear between 1 nm nodes); the base lobes
-    interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
+    models of ``Material.spectral_bakes()`` sharing the surface; at λ the
+    surface lobes at λ itself (F(θd) in closed form, η linear between 1 nm
+    nodes; C from the lower model's bake at u = b cos θd/λ) with σrel/σs and
+    Q̄/F(θd) interpolated linearly in λ between the two models; the base
+    lobes interpolated in λ (docs/model.md §2.12). ``pdf`` and ``sample_direction`` at λ are those of
     the nearest model (``Spectral::pdf``, ``Spectral::sample``)."""
 
     def __init__(self, material: twoscale.Material, params=None):

@@ -1,16 +1,22 @@
 //! The model at any wavelength of [0.36, 0.83] µm from one construction
 //! (docs/model.md §2.12): models at [`SPECTRAL_WAVELENGTHS`] sharing the
-//! surface's bakes, their surface lobes divided by F(θd) at their
-//! wavelength, interpolated linearly in λ and multiplied by F(θd) at λ:
+//! surface's bakes; at λ between the models k and k + 1 (hat weights), the
+//! surface lobes are evaluated at λ itself with what is slow in λ
+//! interpolated between the two models:
 //!
 //! ```text
-//! ρ(i,o,λ) ≈ F(η(λ), θd) Σ_k hat_k(λ) [ρ_spec + ρ_CTD](λ_k)/F(η(λ_k), θd) + Σ_k hat_k(λ) [ρ_base + ρ_ms](λ_k)
+//! ρ(i,o,λ) ≈ A_spec(λ) F(η(λ), θd) D G / (4 cos θi cos θo)
+//!          + Q̄(λ) G (1 − A(λ))/σrel²(λ) (c−1) σs² b² / (2π λ²) C(θh; b cos θd/λ)
+//!          + Σ_k hat_k(λ) [ρ_base + ρ_ms](λ_k)
+//! Q̄(λ)     = F(η(λ), θd) Σ_k hat_k(λ) Q̄(λ_k)/F(η(λ_k), θd),   σrel²(λ) = σs² Σ_k hat_k(λ) (σrel/σs)²(λ_k)
 //! ```
 //!
 //! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
 //! computed at λ per call (η(λ) from a 1 nm table of the material's index,
-//! F in closed form); the rest of ρ is smooth in λ. `sample` and `pdf` at λ
-//! are those of the model nearest λ.
+//! F in closed form); Q̄/F and σrel are smooth in λ. C depends on λ only
+//! through `u`, and model k's bake covers `[0, b/λ_k] ⊇ [0, b/λ]`: one C
+//! lookup per wavelength. `sample` and `pdf` at λ are those of the model
+//! nearest λ.
 
 use super::integrated::models_at;
 use super::{
@@ -192,31 +198,19 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         self.eval_at(i, o, lambdas)
     }
 
-    /// ρ(i, o) at `N` wavelengths: each model's per-direction terms once
-    /// ([`NodeTerms`], at most two per wavelength), then one evaluation per
-    /// wavelength ([`Spectral::at_lambda`]).
+    /// ρ(i, o) at `N` wavelengths: the pair's geometry, D and G once, then
+    /// per wavelength its two models' terms ([`NodeTerms`]; not shared
+    /// between wavelengths: a renderer's wavelengths rarely share a model,
+    /// and a cache cost more than it saved) and [`Spectral::at_lambda`].
     fn eval_at<const N: usize>(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; N]) -> [f32; N] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; N];
         };
-        // The models' terms computed so far: (model, terms), `done` of them.
-        let mut cache = [(usize::MAX, NodeTerms::default()); 8];
-        let mut done = 0;
-        let mut terms = |k: usize| -> NodeTerms {
-            if let Some(&(_, t)) = cache[..done].iter().find(|(m, _)| *m == k) {
-                return t;
-            }
-            let t = NodeTerms::new(&self.nodes[k], &pair, self.white);
-            if done < cache.len() {
-                cache[done] = (k, t);
-                done += 1;
-            }
-            t
-        };
         lambdas.map(|lambda| {
             let lambda = Self::clamped(lambda);
             let (k, f) = cell(&SPECTRAL_WAVELENGTHS, lambda);
-            let (a, b) = (terms(k), terms(k + 1));
+            let a = NodeTerms::new(&self.nodes[k], &pair, self.white);
+            let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white);
             self.at_lambda(&pair, lambda, k, f64::from(f), &a, &b)
         })
     }
