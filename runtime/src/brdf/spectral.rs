@@ -94,8 +94,7 @@ impl NodeTerms {
                 .max(0.0),
             (None, false) => 0.0,
         };
-        // ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
-        let multiple = node.multiple_scale * at_i.lost() * at_o.lost();
+        let multiple = node.multiple_value(&at_i, &at_o);
         NodeTerms {
             ratio_sq: node.sigma_ratio_sq(&at_i, &at_o),
             q,
