@@ -120,10 +120,10 @@ def test_pdf_and_sample_equal_the_runtime(name):
 
 class _Poisoned:
     """`material` whose `spectral_bakes()` has NaN in every stacked quantity
-    of the models not in `keep`."""
+    (those named by `only`, if given) of the models not in `keep`."""
 
-    def __init__(self, material, keep):
-        self.material, self.keep = material, keep
+    def __init__(self, material, keep, only=None):
+        self.material, self.keep, self.only = material, keep, only
 
     def __getattr__(self, name):
         return getattr(self.material, name)
@@ -131,6 +131,8 @@ class _Poisoned:
     def spectral_bakes(self):
         bakes = self.material.spectral_bakes()
         for name in bakes["per_node"]:
+            if self.only is not None and not self.only(name):
+                continue
             value = np.array(bakes["models"][name], copy=True)
             value[[k for k in range(len(value)) if k not in self.keep]] = np.nan
             bakes["models"][name] = value
@@ -141,7 +143,9 @@ class _Poisoned:
 def test_each_wavelength_reads_its_models_only(name):
     """With every model but those around the path's four wavelengths (and
     model 0, the shared surface's source) made NaN, `eval_spectral` is
-    unchanged bit for bit; with every model but the hero wavelength's
+    unchanged bit for bit, and so it is with C's bake and the constants
+    scaled to λ made NaN in all but the lower model of each wavelength's
+    cell; with every model but the hero wavelength's
     nearest, `pdf_spectral` and `sample_spectral` are."""
     material = preset_with(name)
     light, camera = pairs(seed(name, "poison"), 1000)
@@ -154,6 +158,16 @@ def test_each_wavelength_reads_its_models_only(name):
     for a, b in zip(model.eval_spectral(wi, wo, lams), poisoned.eval_spectral(wi, wo, lams)):
         assert np.array_equal(np.array(a), np.array(b))
     assert np.array(model.eval_spectral(wi, wo, lams)[1]).max() > 0.0
+    # C and the constants scaled to λ: the lower model's only.
+    def scaled(n):
+        return n.startswith("conv_") or n in ("lambda", "x_scale", "halo_scale", "big_b")
+
+    lower_only = tb.SpectralModel(_Poisoned(material, {0, 1, 7, 10, 17}, scaled))
+    for a, b in zip(model.eval_spectral(wi, wo, lams), lower_only.eval_spectral(wi, wo, lams)):
+        assert np.array_equal(np.array(a), np.array(b))
+    upper_only = tb.SpectralModel(_Poisoned(material, {0, 2, 8, 11, 18}, scaled))
+    assert not all(np.array_equal(np.array(a), np.array(b)) for a, b in
+                   zip(model.eval_spectral(wi, wo, lams), upper_only.eval_spectral(wi, wo, lams)))
     hero = mi.Float(0.545)
     nearest = tb.SpectralModel(_Poisoned(material, {0, 7}))
     assert np.array_equal(np.array(model.pdf_spectral(wi, wo, hero)),

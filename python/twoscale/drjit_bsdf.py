@@ -173,6 +173,15 @@ def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
 
+def _exp_and_one_minus_over(x, srs):
+    """`brdf::exp_and_one_minus_over`: `(e^−x s, (1 − e^−x s)/s)` in f64."""
+    t = x * srs
+    e = dr.exp(-t)
+    small = t < 1e-8
+    return (dr.select(small, 1.0 - t, e),
+            dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
+
+
 class _Channel:
     """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
 
@@ -704,14 +713,7 @@ class _Channel:
         else:
             sigma_rel_sq = mi.Float64(0.0)
 
-        def exp_and_one_minus_over(x, srs):
-            t = x * srs
-            e = dr.exp(-t)
-            small = t < 1e-8
-            return (dr.select(small, 1.0 - t, e),
-                    dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
-
-        a_spec, one_minus_a_over = exp_and_one_minus_over(x, sigma_rel_sq)
+        a_spec, one_minus_a_over = _exp_and_one_minus_over(x, sigma_rel_sq)
         fresnel_d = (mi.Float64(1.0) if s["white"] else
                      mi.Float64(self.direction(self.direction_cell(mi.Float(cos_d)), [6])[0]))
         rho_ct = fresnel_d * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
@@ -725,8 +727,8 @@ class _Channel:
             else:
                 q = mi.Float64(0.0)
             if s["halo_incident"]:
-                one_minus_a_over = exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
-                                                          sigma_rel_sq)[1]
+                one_minus_a_over = _exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
+                                                           sigma_rel_sq)[1]
             halo = self.d["halo_scale"] * one_minus_a_over
             c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
                                 mi.Float(self.d["big_b"] * cos_d))
@@ -740,6 +742,28 @@ class _Channel:
         multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
+
+    def node_terms(self, g, geo, params):
+        """`spectral::NodeTerms::new`: (σrel²/σs², Q̄, F(θd), ρ_base + k_d/π
+        + ρ_ms) of this model at a pair, in f64."""
+        s = self.s
+        wi, wo = geo["wi"], geo["wo"]
+        at_i, at_o = ([mi.Float64(v) for v in self.direction(self.direction_cell(mi.Float(w.z)),
+                                                             range(8))] for w in (wi, wo))
+        r_i, r_o = at_i[5], at_o[5]
+        ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
+        if s["white"]:
+            q, fresnel_d = mi.Float64(1.0), mi.Float64(1.0)
+        else:
+            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
+                 if s["has_q"] else mi.Float64(0.0))
+            fresnel_d = mi.Float64(
+                self.direction(self.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
+        base = self.base_value(at_i[6], at_o[6], wi.z, wo.z, params)
+        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        plain = (mi.Float64(_finite_or_zero(mi.Float(base)))
+                 + mi.Float64(_finite_or_zero(mi.Float(multiple))))
+        return ratio_sq, q, fresnel_d, plain
 
 
 def default_params(material: twoscale.Material):
@@ -1009,16 +1033,18 @@ class _NodeChannel(_Channel):
 class SpectralModel(Model):
     """The model at any wavelength of a :class:`twoscale.Material`
     (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 19
-    models of ``Material.spectral_bakes()`` sharing the surface, their
-    surface lobes divided by F(θd) and interpolated linearly in λ, times
-    F(θd) at λ in closed form (η linear between 1 nm nodes); the base lobes
-    interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
-    the nearest model (``Spectral::pdf``, ``Spectral::sample``).
+    models of ``Material.spectral_bakes()`` sharing the surface; at λ the
+    surface lobes at λ itself (F(θd) in closed form, η linear between 1 nm
+    nodes; C from the lower model's bake at u = b cos θd/λ) with σrel/σs and
+    Q̄/F(θd) interpolated linearly in λ between the two models; the base
+    lobes interpolated in λ (docs/model.md §2.12). ``pdf`` and
+    ``sample_direction`` at λ are those of the nearest model
+    (``Spectral::pdf``, ``Spectral::sample``).
 
     As ``Spectral::eval4``, the pair's geometry, D and G are computed once
     per path and each wavelength reads the two models around it (of the
-    stacked bakes, :class:`_NodeChannel`); ``pdf`` and ``sample`` read the
-    nearest model only."""
+    stacked bakes, :class:`_NodeChannel`; C the lower one's only); ``pdf``
+    and ``sample`` read the nearest model only."""
 
     def __init__(self, material: twoscale.Material, params=None):
         spectral = material.spectral_bakes()
@@ -1062,39 +1088,63 @@ class SpectralModel(Model):
 
         return at(0), at(1)
 
-    def node_terms(self, k, g, geo):
-        """Model `k`'s (per lane) surface lobes, base lobes, their total and
-        F(θd) at a pair (`Spectral::eval_at`'s `at(k)`), f64."""
-        node = self.stack.at(k)
-        spec, diff, b, mult = node.lobes(g, geo, self.params)
-        spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
-        total = mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult)))
-        fresnel = mi.Float64(1.0) if self.white else mi.Float64(
-            node.direction(node.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
-        # The base and the compensation lobe: linear in λ.
-        return spec + diff, b + mult, total, fresnel
-
     def eval_spectral(self, wi, wo, lams):
         """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
-        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``)."""
+        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``):
+        each model's terms at the pair (:meth:`_Channel.node_terms`), then
+        the surface lobes at λ itself with C from the lower model's bake
+        (``Spectral::at_lambda``)."""
         valid, geo = self.geometry(wi, wo)
         g = self.masking(geo)
-        cos_d = mi.Float(geo["cos_d"])
+        cos_i, cos_o, cos_d = geo["wi"].z, geo["wo"].z, geo["cos_d"]
+        s = self.channels[0].s
         out = []
         for lam in lams:
             lam = self.clamped(mi.Float(lam))
             k, f = self.cell(lam)
-            surface_a, base_a, total_a, fa = self.node_terms(k, g, geo)
-            surface_b, base_b, total_b, fb = self.node_terms(k + 1, g, geo)
             f = mi.Float64(f)
-            plain = (1.0 - f) * total_a + f * total_b
-            fl = mi.Float64(_fresnel(*self.eta_at(lam), cos_d))
-            fa_safe = dr.select(fa > 0.0, fa, 1.0)
-            fb_safe = dr.select(fb > 0.0, fb, 1.0)
-            coloured = (fl * ((1.0 - f) * surface_a / fa_safe + f * surface_b / fb_safe)
-                        + (1.0 - f) * base_a + f * base_b)
-            use_plain = (fa <= 0.0) | (fb <= 0.0) if not self.white else True
-            value = dr.select(use_plain, plain, coloured)
+            # The two models around λ: their terms at the pair.
+            lower, upper = self.stack.at(k), self.stack.at(k + 1)
+            ta = lower.node_terms(g, geo, self.params)
+            tb = upper.node_terms(g, geo, self.params)
+
+            def lerp(j):
+                return (1.0 - f) * ta[j] + f * tb[j]
+
+            # λ_k/λ: B, (4π/λ)² and the halo's 1/λ² from model k's.
+            ratio = lower.d["lambda"] / mi.Float64(lam)
+            x_scale = lower.d["x_scale"] * ratio * ratio
+            sigma_rel_sq = lower.d["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0 else 0.0
+            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_d * cos_d,
+                                                                sigma_rel_sq)
+            fl = mi.Float64(1.0) if self.white else mi.Float64(
+                _fresnel(*self.eta_at(lam), mi.Float(cos_d)))
+            specular = a_spec * fl * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+            if lower.diffraction:
+                if self.white:
+                    q = mi.Float64(1.0)
+                else:
+                    fa, fb = ta[2], tb[2]
+                    coloured = (fa > 0.0) & (fb > 0.0)
+                    fa = dr.select(coloured, fa, 1.0)
+                    fb = dr.select(coloured, fb, 1.0)
+                    qa, qb = ta[1], tb[1]
+                    q = dr.select(coloured, fl * ((1.0 - f) * qa / fa + f * qb / fb),
+                                  (1.0 - f) * qa + f * qb)
+                if s["halo_incident"]:
+                    one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_i * cos_i,
+                                                               sigma_rel_sq)[1]
+                halo = lower.d["halo_scale"] * ratio * ratio * one_minus_a_over
+                # C from the lower model's bake only, at u = b cos θd/λ.
+                u = mi.Float(lower.d["big_b"] * ratio * cos_d)
+                c_value = lower.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]), u)
+                diffraction = dr.select(
+                    g > 0.0, q * g * halo * mi.Float64(dr.maximum(c_value, 0.0)), 0.0
+                ) * mi.Float64(self.params["halo_factor"])
+            else:
+                diffraction = mi.Float64(0.0)
+            value = (mi.Float64(_finite_or_zero(mi.Float(specular)))
+                     + mi.Float64(_finite_or_zero(mi.Float(diffraction))) + lerp(3))
             out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
         return out
 

@@ -1012,8 +1012,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     fn lobes(&self, pair: &Pair) -> Lobes {
         let t = self.surface_terms(pair, self.white());
         let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
-        // ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))   (docs/model.md §2.11)
-        let multiple = self.multiple_scale * t.at_i.lost() * t.at_o.lost();
+        let multiple = self.multiple_value(&t.at_i, &t.at_o);
         Lobes {
             specular: finite_or_zero(t.a_spec * t.rho_ct),
             diffraction: finite_or_zero(t.diffraction),
@@ -1086,15 +1085,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 }
             };
             let halo = self.halo_scale * one_minus_a_over;
-            let u = (self.big_b * cos_d) as f32;
-            let c_value = f64::from(match self.bake().conv() {
-                Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
-                None => {
-                    self.conv
-                        .convolution_sin_cos(sin_h as f32, cos_h as f32, u, s.c, s.beta, s.p)
-                }
-            });
-            let c_value = if c_value > 0.0 { c_value } else { 0.0 };
+            let c_value = self.conv_at(sin_h, cos_h, (self.big_b * cos_d) as f32);
             q * g * halo * c_value
         } else {
             0.0
@@ -1107,6 +1098,27 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             at_i,
             at_o,
         }
+    }
+
+    /// C(θh; u) (≥ 0) from the bake, or from the source of C when it offers
+    /// no slice; `u` is clamped to the bake's `[0, B]`.
+    #[inline(always)]
+    fn conv_at(&self, sin_h: f64, cos_h: f64, u: f32) -> f64 {
+        let s = &self.surface;
+        let c_value = f64::from(match self.bake().conv() {
+            Some(bake) => bake.at(sin_h as f32, cos_h as f32, u),
+            None => self
+                .conv
+                .convolution_sin_cos(sin_h as f32, cos_h as f32, u, s.c, s.beta, s.p),
+        });
+        if c_value > 0.0 { c_value } else { 0.0 }
+    }
+
+    /// `ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg))`
+    /// (docs/model.md §2.11; 0 when the compensation lobe is off).
+    #[inline]
+    fn multiple_value(&self, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
+        self.multiple_scale * at_i.lost() * at_o.lost()
     }
 
     /// `ρ_base + k_d/π` (docs/model.md §2.6; HP17 42-47).

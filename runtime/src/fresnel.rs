@@ -190,10 +190,9 @@ impl Index {
     fn reflectance(&self, cos: f64) -> f64 {
         let c = self.c(cos);
         let cos_c = C64::real(cos);
-        let rs = (cos_c - c) / (cos_c + c);
-        let a = self.eta_sq * cos;
-        let rp = (a - c) / (a + c);
-        0.5 * (rs.norm_sqr() + rp.norm_sqr())
+        // |a − c|² / |a + c|²: no complex division.
+        let ratio = |a: C64| (a - c).norm_sqr() / (a + c).norm_sqr();
+        0.5 * (ratio(cos_c) + ratio(self.eta_sq * cos))
     }
 }
 

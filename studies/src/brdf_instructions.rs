@@ -14,11 +14,14 @@ use std::hint::black_box;
 use std::process::Command;
 use suite::cost::{self, Inputs};
 use twoscale::TableSet;
-use twoscale::brdf::{BaseLayer, Layer, MultipleScattering, Options, Rgb, TwoScale};
-use twoscale::materials::{HP17_NICKEL_SURFACE, PRESETS};
+use twoscale::brdf::{
+    BaseLayer, ChannelBake, IntegratedRgb, Layer, MultipleScattering, Options, Rgb, Spectral,
+    TwoScale,
+};
+use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
-pub const OPERATIONS: [&str; 11] = [
+pub const OPERATIONS: [&str; 14] = [
     "ggx-eval",
     "ggx-eval-rgb",
     "ggx-sample-eval",
@@ -26,6 +29,9 @@ pub const OPERATIONS: [&str; 11] = [
     "eval-kulla-conty",
     "eval-t3a",
     "eval-rgb",
+    "eval-rgb-integrated",
+    "eval-spectral",
+    "eval4-spectral",
     "pdf",
     "sample",
     "construct",
@@ -43,6 +49,9 @@ enum Operation {
     EvalKullaConty,
     EvalT3a,
     EvalRgb,
+    EvalRgbIntegrated,
+    EvalSpectral,
+    Eval4Spectral,
     Pdf,
     Sample,
     Construct,
@@ -60,6 +69,9 @@ impl Operation {
             "eval-kulla-conty" => Operation::EvalKullaConty,
             "eval-t3a" => Operation::EvalT3a,
             "eval-rgb" => Operation::EvalRgb,
+            "eval-rgb-integrated" => Operation::EvalRgbIntegrated,
+            "eval-spectral" => Operation::EvalSpectral,
+            "eval4-spectral" => Operation::Eval4Spectral,
             "pdf" => Operation::Pdf,
             "sample" => Operation::Sample,
             "construct" => Operation::Construct,
@@ -85,6 +97,10 @@ pub struct Workload<'a> {
     ggx: cost::Ggx,
     rgb: Rgb<'a>,
     rgb_eta: [twoscale::Complex; 3],
+    /// The RGB preset by integration over the spectrum (issue 26).
+    integrated: IntegratedRgb<'a, Box<ChannelBake>>,
+    /// HP17's nickel geometry at any wavelength (the `nickel` preset).
+    spectral: Spectral<'a, Box<ChannelBake>>,
     inputs: Inputs,
 }
 
@@ -113,6 +129,16 @@ impl<'a> Workload<'a> {
             ggx: cost::ggx(),
             rgb,
             rgb_eta,
+            integrated: IntegratedRgb::boxed(
+                &set.brdf_tables(),
+                &materials::spectral(cost::RGB_PRESET).expect("preset"),
+                Options::default(),
+            ),
+            spectral: Spectral::boxed(
+                &set.brdf_tables(),
+                &materials::spectral("nickel").expect("preset"),
+                Options::default(),
+            ),
             inputs: Inputs::new(),
         }
     }
@@ -139,6 +165,15 @@ impl<'a> Workload<'a> {
                 Operation::EvalKullaConty => self.model_kc.eval(black_box(i), black_box(o)),
                 Operation::EvalT3a => model_fit.eval(black_box(i), black_box(o)),
                 Operation::EvalRgb => rgb.eval(black_box(i), black_box(o))[1],
+                Operation::EvalRgbIntegrated => self.integrated.eval(black_box(i), black_box(o))[1],
+                Operation::EvalSpectral => {
+                    self.spectral.eval(black_box(i), black_box(o), cost::LAMBDA)
+                }
+                // The four wavelengths of benches/brdf.rs.
+                Operation::Eval4Spectral => {
+                    self.spectral
+                        .eval4(black_box(i), black_box(o), [0.45, 0.53, 0.61, 0.69])[1]
+                }
                 Operation::Pdf => model.pdf(black_box(i), black_box(o)),
                 Operation::Sample => model
                     .sample(black_box(iu), black_box(u))
@@ -170,6 +205,8 @@ impl<'a> Workload<'a> {
 fn baseline(operation: &str) -> &'static str {
     match operation {
         "eval-rgb" => "ggx-eval-rgb",
+        "eval-rgb-integrated" => "eval-rgb",
+        "eval-spectral" | "eval4-spectral" => "eval",
         "sample" => "ggx-sample-eval",
         "eval-kulla-conty" => "eval",
         _ if operation.starts_with("ggx") || operation.starts_with("construct") => "",

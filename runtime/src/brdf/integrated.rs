@@ -211,11 +211,17 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
         };
         let r = self.colour.surface_at(pair.geometry.cos_d);
         let mut out = [0.0f64; 3];
+        let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
         for (k, node) in self.nodes.iter().enumerate() {
-            let lobes = node.lobes(&pair);
-            let surface = f64::from(lobes.specular) + f64::from(lobes.diffraction);
+            // `TwoScale::lobes` in f64, without rounding each lobe to f32.
+            let t = node.surface_terms(&pair, node.white());
+            let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+            let surface = finite(t.a_spec * t.rho_ct + t.diffraction);
             // The compensation lobe's colour is F_avg's, per node: plain weights.
-            let base = f64::from(lobes.base) + f64::from(lobes.multiple);
+            let base = finite(
+                node.base_value(&t.at_i, &t.at_o, cos_i, cos_o)
+                    + node.multiple_value(&t.at_i, &t.at_o),
+            );
             for c in 0..3 {
                 out[c] += surface * f64::from(r[k][c]) + base * f64::from(self.colour.plain[k][c]);
             }

@@ -1,20 +1,27 @@
 //! The model at any wavelength of [0.36, 0.83] µm from one construction
 //! (docs/model.md §2.12): models at [`SPECTRAL_WAVELENGTHS`] sharing the
-//! surface's bakes, their surface lobes divided by F(θd) at their
-//! wavelength, interpolated linearly in λ and multiplied by F(θd) at λ:
+//! surface's bakes; at λ between the models k and k + 1 (hat weights), the
+//! surface lobes are evaluated at λ itself with what is slow in λ
+//! interpolated between the two models:
 //!
 //! ```text
-//! ρ(i,o,λ) ≈ F(η(λ), θd) Σ_k hat_k(λ) [ρ_spec + ρ_CTD](λ_k)/F(η(λ_k), θd) + Σ_k hat_k(λ) [ρ_base + ρ_ms](λ_k)
+//! ρ(i,o,λ) ≈ A_spec(λ) F(η(λ), θd) D G / (4 cos θi cos θo)
+//!          + Q̄(λ) G (1 − A(λ))/σrel²(λ) (c−1) σs² b² / (2π λ²) C(θh; b cos θd/λ)
+//!          + Σ_k hat_k(λ) [ρ_base + ρ_ms](λ_k)
+//! Q̄(λ)     = F(η(λ), θd) Σ_k hat_k(λ) Q̄(λ_k)/F(η(λ_k), θd),   σrel²(λ) = σs² Σ_k hat_k(λ) (σrel/σs)²(λ_k)
 //! ```
 //!
 //! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
 //! computed at λ per call (η(λ) from a 1 nm table of the material's index,
-//! F in closed form); the rest of ρ is smooth in λ. `sample` and `pdf` at λ
-//! are those of the model nearest λ.
+//! F in closed form); Q̄/F and σrel are smooth in λ. C depends on λ only
+//! through `u`, and model k's bake covers `[0, b/λ_k] ⊇ [0, b/λ]`: one C
+//! lookup per wavelength. `sample` and `pdf` at λ are those of the model
+//! nearest λ.
 
 use super::integrated::models_at;
 use super::{
-    BakeVisitor, ChannelBake, ColourTerms, Lobes, Options, Sample, Tables, TwoScale, finite_or_zero,
+    BakeVisitor, ChannelBake, ColourTerms, HaloWeight, Options, Pair, Sample, Tables, TwoScale,
+    exp_and_one_minus_over, finite_or_zero,
 };
 use crate::fresnel::{Complex, fresnel};
 use crate::math;
@@ -51,6 +58,51 @@ fn cell(nodes: &[f32], lambda: f32) -> (usize, f32) {
     let f = (lambda - a) / (b - a);
     // NaN → 0.
     (k, if f > 0.0 { f.min(1.0) } else { 0.0 })
+}
+
+/// What [`Spectral`] reads of one model at a pair of directions.
+#[derive(Clone, Copy, Default)]
+struct NodeTerms {
+    /// `σrel²/σs²`.
+    ratio_sq: f64,
+    /// Q̄ (1 for white colour terms, 0 for η = 1).
+    q: f64,
+    /// F(θd) from the model's direction bake (1 for white colour terms).
+    fresnel: f64,
+    /// `ρ_base + k_d/π + ρ_ms`.
+    plain: f64,
+}
+
+impl NodeTerms {
+    /// The terms of `node` at `pair`.
+    fn new<B: Borrow<ChannelBake>>(node: &TwoScale<'_, B>, pair: &Pair, white: bool) -> Self {
+        let direction = &node.bake().direction;
+        let (at_i, at_o) = (
+            direction.at_cell(pair.cells[0]),
+            direction.at_cell(pair.cells[1]),
+        );
+        let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
+        let q = match (&node.q, white) {
+            (_, true) => 1.0,
+            (Some(q), false) => q
+                .combine(
+                    &at_i.q_factors(),
+                    &at_o.q_factors(),
+                    pair.along,
+                    pair.across,
+                )
+                .max(0.0),
+            (None, false) => 0.0,
+        };
+        let multiple = node.multiple_value(&at_i, &at_o);
+        NodeTerms {
+            ratio_sq: node.sigma_ratio_sq(&at_i, &at_o),
+            q,
+            fresnel: node.fresnel_at(pair.cells[2]),
+            plain: f64::from(finite_or_zero(node.base_value(&at_i, &at_o, cos_i, cos_o)))
+                + f64::from(finite_or_zero(multiple)),
+        }
+    }
 }
 
 /// The two-scale BRDF at any wavelength of [0.36, 0.83] µm (module
@@ -145,39 +197,86 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         self.eval_at(i, o, lambdas)
     }
 
-    /// ρ(i, o) at `N` wavelengths.
+    /// ρ(i, o) at `N` wavelengths: the pair's geometry, D and G once, then
+    /// per wavelength its two models' terms ([`NodeTerms`]; not shared
+    /// between wavelengths: a renderer's wavelengths rarely share a model,
+    /// and a cache cost more than it saved) and [`Spectral::at_lambda`].
     fn eval_at<const N: usize>(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; N]) -> [f32; N] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; N];
         };
-        let cos_d = pair.geometry.cos_d as f32;
-        // Each model's lobes and F(θd), computed when first needed.
-        let mut done: [Option<(Lobes, f64)>; SPECTRAL_COUNT] = [None; SPECTRAL_COUNT];
-        let mut at = |k: usize| -> (Lobes, f64) {
-            *done[k].get_or_insert_with(|| {
-                let node = &self.nodes[k];
-                (node.lobes(&pair), node.fresnel_at(pair.cells[2]))
-            })
-        };
         lambdas.map(|lambda| {
             let lambda = Self::clamped(lambda);
             let (k, f) = cell(&SPECTRAL_WAVELENGTHS, lambda);
-            let (a, fa) = at(k);
-            let (b, fb) = at(k + 1);
-            let f = f64::from(f);
-            let surface = |l: &Lobes| f64::from(l.specular) + f64::from(l.diffraction);
-            let value = if self.white || !(fa > 0.0 && fb > 0.0) {
-                (1.0 - f) * f64::from(a.total()) + f * f64::from(b.total())
-            } else {
-                let fl = f64::from(fresnel(self.eta_at(lambda), cos_d));
-                // The base and the compensation lobe (F_avg's colour): linear in λ.
-                let plain = |l: &Lobes| f64::from(l.base) + f64::from(l.multiple);
-                fl * ((1.0 - f) * surface(&a) / fa + f * surface(&b) / fb)
-                    + (1.0 - f) * plain(&a)
-                    + f * plain(&b)
-            };
-            finite_or_zero(value.max(0.0))
+            let a = NodeTerms::new(&self.nodes[k], &pair, self.white);
+            let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white);
+            self.at_lambda(&pair, lambda, k, f64::from(f), &a, &b)
         })
+    }
+
+    /// ρ at `lambda` (clamped) between the models `k` and `k + 1` (terms `a`,
+    /// `b`, fraction `f`; docs/model.md §2.12): the surface lobes at λ itself
+    /// (F(θd) of η(λ), A_spec, (1 − A)/σrel² and the halo's constant at λ, C
+    /// at `u = b cos θd/λ` from model `k`'s bake, which covers `[0, b/λ_k]`),
+    /// σrel/σs and Q̄/F(θd) linear in λ between the models; the base lobes
+    /// linear in λ.
+    fn at_lambda(
+        &self,
+        pair: &Pair,
+        lambda: f32,
+        k: usize,
+        f: f64,
+        a: &NodeTerms,
+        b: &NodeTerms,
+    ) -> f32 {
+        let lerp = |x: f64, y: f64| (1.0 - f) * x + f * y;
+        let node = &self.nodes[k];
+        let geometry = &pair.geometry;
+        let (cos_i, cos_o, cos_d) = (geometry.wi[2], geometry.wo[2], geometry.cos_d);
+        let fl = if self.white {
+            1.0
+        } else {
+            f64::from(fresnel(self.eta_at(lambda), cos_d as f32))
+        };
+        // λ_k/λ: B, the exponents' (4π/λ)² and the halo's 1/λ² from model k's.
+        let ratio = node.lambda / f64::from(lambda);
+        let x_scale = node.x_scale * ratio * ratio;
+        let s = &node.surface;
+        let sigma_rel_sq = if s.sigma_s > 0.0 {
+            node.sigma_s_sq * lerp(a.ratio_sq, b.ratio_sq)
+        } else {
+            0.0
+        };
+        // A_spec = exp(−x σrel²), x = (4π cos θd / λ)²                (HP17 25)
+        let (a_spec, one_minus_a_over) =
+            exp_and_one_minus_over(x_scale * cos_d * cos_d, sigma_rel_sq);
+        // ρ_CT = F D G / (4 cos θi cos θo)                              (HP17 26)
+        let specular = a_spec * fl * pair.g / (4.0 * cos_i * cos_o) * geometry.d;
+        // ρ_CTD = Q̄ G (1 − A)/σrel² (c−1) σs² b² / (2π λ²) C(θh; b cos θd/λ)   (HP17 32-33)
+        let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && pair.g > 0.0 {
+            let q = if self.white {
+                1.0
+            } else if a.fresnel > 0.0 && b.fresnel > 0.0 {
+                fl * lerp(a.q / a.fresnel, b.q / b.fresnel)
+            } else {
+                lerp(a.q, b.q)
+            };
+            let one_minus_a_over = match node.options.halo_weight {
+                HaloWeight::Printed => one_minus_a_over,
+                HaloWeight::Incident => {
+                    exp_and_one_minus_over(x_scale * cos_i * cos_i, sigma_rel_sq).1
+                }
+            };
+            let halo = node.halo_scale * ratio * ratio * one_minus_a_over;
+            let u = (node.big_b * ratio * cos_d) as f32;
+            q * pair.g * halo * node.conv_at(geometry.sin_h, geometry.cos_h, u)
+        } else {
+            0.0
+        };
+        let value = f64::from(finite_or_zero(specular))
+            + f64::from(finite_or_zero(diffraction))
+            + lerp(a.plain, b.plain);
+        finite_or_zero(value.max(0.0))
     }
 
     /// The model whose sampler serves `lambda`: the nearest of
