@@ -271,7 +271,13 @@ fn solve_azimuth(a: f64, b: f64, big_h: f64, target: f64) -> f64 {
         }
         let slope = a * math::cos(psi) + b;
         let next = psi - f / slope;
-        let next = if slope > 0.0 && next > lo && next < hi {
+        let newton = slope > 0.0 && next >= lo && next <= hi;
+        // A converged step is taken even where it rounds onto the bracket's
+        // end (bisecting there would leave the root).
+        if newton && (next - psi).abs() < 1e-12 {
+            return next;
+        }
+        let next = if newton && next > lo && next < hi {
             next
         } else {
             0.5 * (lo + hi)

@@ -421,11 +421,17 @@ fn solve_cell(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau_max: f64, rest: f64)
             hi = t;
         }
         let d = density(t);
+        let tolerance = 1e-13 * (x0.abs() + tau_max);
         let mut next = if d > 0.0 { t - f / d } else { 0.5 * (lo + hi) };
+        // A converged step is taken even where it rounds onto the bracket's
+        // end (bisecting there would leave the root).
+        if d > 0.0 && next >= lo && next <= hi && (next - t).abs() <= tolerance {
+            return next;
+        }
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
-        if (next - t).abs() <= 1e-13 * (x0.abs() + tau_max) {
+        if (next - t).abs() <= tolerance {
             return next;
         }
         t = next;
