@@ -506,23 +506,26 @@ impl<'a> SurfaceBakes<'a> {
 }
 
 /// What one pair of directions gives, independent of the wavelength: the
-/// geometry and D (shared by `pdf` and `eval`, and by the channels of [`Rgb`]).
+/// geometry (shared by `pdf` and `eval`, and by the channels of [`Rgb`];
+/// `pdf` needs no D, [`Pair`] adds it).
 #[derive(Clone, Copy, Debug)]
 struct Geometry {
     wi: [f64; 3],
     wo: [f64; 3],
+    /// The half-vector in f32, as D reads it.
+    h: [f32; 3],
     cos_d: f64,
     cos_h: f64,
     sin_h: f64,
-    /// D(h).
-    d: f64,
 }
 
-/// [`Geometry`] and G(i, o): what `eval` needs of a pair of directions
-/// before the wavelength.
+/// [`Geometry`], D(h) and G(i, o): what `eval` needs of a pair of
+/// directions before the wavelength.
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     geometry: Geometry,
+    /// D(h).
+    d: f64,
     g: f64,
     /// The direction bake's cells of `cos θi`, `cos θo` and `cos θd`.
     cells: [DirectionCell; 3],
@@ -942,7 +945,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         }
     }
 
-    /// The geometry of `(i, o)` and D(h); `None` below the horizon.
+    /// The geometry of `(i, o)`; `None` below the horizon.
     fn geometry(&self, i: [f32; 3], o: [f32; 3]) -> Option<Geometry> {
         let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -957,10 +960,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(Geometry {
             wi,
             wo,
+            h: to_f32(h),
             cos_d,
             cos_h,
             sin_h,
-            d: f64::from(self.ndf.d(to_f32(h))),
         })
     }
 
@@ -970,7 +973,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(self.with_masking(self.geometry(i, o)?))
     }
 
-    /// G(i, o) added to `geometry`.
+    /// D(h) and G(i, o) added to `geometry`.
     fn with_masking(&self, geometry: Geometry) -> Pair {
         let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
@@ -988,6 +991,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         let cos = |x: f64| DirectionCell::new(x as f32);
         Pair {
             geometry,
+            d: f64::from(self.ndf.d(geometry.h)),
             g,
             cells: [cos(wi[2]), cos(wo[2]), cos(geometry.cos_d)],
             along: -(wi[0] * wo[0] + wi[1] * wo[1]),
@@ -1034,8 +1038,9 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                     cos_d,
                     cos_h,
                     sin_h,
-                    d,
+                    ..
                 },
+            d,
             g,
             cells,
             along,
