@@ -70,7 +70,7 @@ use crate::halo::HaloBake;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
-use crate::visible::VisibleSlopeBake;
+use crate::visible::{VisibleIncidence, VisibleSlopeBake};
 use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
@@ -1274,7 +1274,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         }
     }
 
-    /// [`TwoScale::pdf`] at a pair's geometry (the specular density from its D).
+    /// [`TwoScale::pdf`] at a pair's geometry.
     fn pdf_at(&self, geometry: &Geometry) -> f64 {
         self.pdf_with_specular(geometry, self.specular_pdf(geometry))
     }
@@ -1288,7 +1288,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// [`TwoScale::pdf_at`] given the specular lobe's density `specular`
     /// (which [`Rgb`] computes once for its channels).
     fn pdf_with_specular(&self, geometry: &Geometry, specular: f64) -> f64 {
-        let w = self.weights(geometry.wi[2]);
+        self.pdf_with(geometry, &self.weights(geometry.wi[2]), specular)
+    }
+
+    /// [`TwoScale::pdf_at`] given the lobe weights `w` at θi and the
+    /// specular lobe's density `specular` (which [`TwoScale::sample`] has from
+    /// its draw).
+    fn pdf_with(&self, geometry: &Geometry, w: &[f64; 4], specular: f64) -> f64 {
         let mut total = 0.0;
         if w[0] > 0.0 {
             total += w[0] * specular;
@@ -1428,10 +1434,27 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * base and multiple: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
+        let visible = match lobe {
+            Lobe::Specular => Some(self.bake().visible.incidence(wi)),
+            _ => None,
+        };
+        self.draw_lobe(lobe, wi, visible.as_ref(), u)
+    }
+
+    /// [`TwoScale::sample_lobe`] for the unit incidence `wi`, with the
+    /// visible-normal sampler's incidence `visible` (needed for the specular
+    /// lobe only).
+    fn draw_lobe(
+        &self,
+        lobe: Lobe,
+        wi: [f64; 3],
+        visible: Option<&VisibleIncidence>,
+        u: [f32; 2],
+    ) -> Option<[f32; 3]> {
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
-                let m = self.bake().visible.sample(wi, u)?;
+                let m = self.bake().visible.sample_at(visible?, u)?;
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
@@ -1505,10 +1528,20 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// lobe draws visible normals from the material's tabulated visible-slope
     /// density, which `pdf` evaluates (docs/model.md §2.1).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
-        let (o, lobe) = self.sample_direction(i, u)?;
+        let wi = upper_unit(i)?;
+        // The lobe weights and the visible-normal sampler's incidence serve
+        // the draw and the pdf: the same values `pdf(i, o)` computes from `i`.
+        let w = self.weights(wi[2]);
+        let lobe = pick_lobe(f64::from(u[0].max(0.0).min(BELOW_ONE)), w);
+        let visible = (w[0] > 0.0).then(|| self.bake().visible.incidence(wi));
+        let o = self.draw_lobe(lobe, wi, visible.as_ref(), [u[1], u[2]])?;
         // pdf(i, o) and eval(i, o) from one geometry.
         let geometry = self.geometry(i, o)?;
-        let pdf = finite_or_zero(self.pdf_at(&geometry));
+        let specular = match &visible {
+            Some(inc) => self.bake().visible.pdf_at(inc, geometry.wi, geometry.wo),
+            None => 0.0,
+        };
+        let pdf = finite_or_zero(self.pdf_with(&geometry, &w, specular));
         if !(pdf > 0.0) {
             return None;
         }
