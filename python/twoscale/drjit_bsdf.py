@@ -308,7 +308,7 @@ class _Channel:
         """`halo::half_range`: `(H, sin H)`."""
         x = b / a
         wide = b >= a
-        return (dr.select(wide, math.pi, dr.acos(dr.clip(-x, -1.0, 1.0))),
+        return (dr.select(wide, math.pi, _acos_approx(-x)),
                 dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0))))
 
     def _row_pdf(self, row, z):

@@ -70,7 +70,7 @@ use crate::halo::HaloBake;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
-use crate::visible::VisibleSlopeBake;
+use crate::visible::{VisibleIncidence, VisibleSlopeBake};
 use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
@@ -506,23 +506,26 @@ impl<'a> SurfaceBakes<'a> {
 }
 
 /// What one pair of directions gives, independent of the wavelength: the
-/// geometry and D (shared by `pdf` and `eval`, and by the channels of [`Rgb`]).
+/// geometry (shared by `pdf` and `eval`, and by the channels of [`Rgb`];
+/// `pdf` needs no D, [`Pair`] adds it).
 #[derive(Clone, Copy, Debug)]
 struct Geometry {
     wi: [f64; 3],
     wo: [f64; 3],
+    /// The half-vector in f32, as D reads it.
+    h: [f32; 3],
     cos_d: f64,
     cos_h: f64,
     sin_h: f64,
-    /// D(h).
-    d: f64,
 }
 
-/// [`Geometry`] and G(i, o): what `eval` needs of a pair of directions
-/// before the wavelength.
+/// [`Geometry`], D(h) and G(i, o): what `eval` needs of a pair of
+/// directions before the wavelength.
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     geometry: Geometry,
+    /// D(h).
+    d: f64,
     g: f64,
     /// The direction bake's cells of `cos θi`, `cos θo` and `cos θd`.
     cells: [DirectionCell; 3],
@@ -942,7 +945,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         }
     }
 
-    /// The geometry of `(i, o)` and D(h); `None` below the horizon.
+    /// The geometry of `(i, o)`; `None` below the horizon.
     fn geometry(&self, i: [f32; 3], o: [f32; 3]) -> Option<Geometry> {
         let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -957,10 +960,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(Geometry {
             wi,
             wo,
+            h: to_f32(h),
             cos_d,
             cos_h,
             sin_h,
-            d: f64::from(self.ndf.d(to_f32(h))),
         })
     }
 
@@ -970,7 +973,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(self.with_masking(self.geometry(i, o)?))
     }
 
-    /// G(i, o) added to `geometry`.
+    /// D(h) and G(i, o) added to `geometry`.
     fn with_masking(&self, geometry: Geometry) -> Pair {
         let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
@@ -988,6 +991,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         let cos = |x: f64| DirectionCell::new(x as f32);
         Pair {
             geometry,
+            d: f64::from(self.ndf.d(geometry.h)),
             g,
             cells: [cos(wi[2]), cos(wo[2]), cos(geometry.cos_d)],
             along: -(wi[0] * wo[0] + wi[1] * wo[1]),
@@ -1034,8 +1038,9 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                     cos_d,
                     cos_h,
                     sin_h,
-                    d,
+                    ..
                 },
+            d,
             g,
             cells,
             along,
@@ -1269,7 +1274,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         }
     }
 
-    /// [`TwoScale::pdf`] at a pair's geometry (the specular density from its D).
+    /// [`TwoScale::pdf`] at a pair's geometry.
     fn pdf_at(&self, geometry: &Geometry) -> f64 {
         self.pdf_with_specular(geometry, self.specular_pdf(geometry))
     }
@@ -1283,7 +1288,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// [`TwoScale::pdf_at`] given the specular lobe's density `specular`
     /// (which [`Rgb`] computes once for its channels).
     fn pdf_with_specular(&self, geometry: &Geometry, specular: f64) -> f64 {
-        let w = self.weights(geometry.wi[2]);
+        self.pdf_with(geometry, &self.weights(geometry.wi[2]), specular)
+    }
+
+    /// [`TwoScale::pdf_at`] given the lobe weights `w` at θi and the
+    /// specular lobe's density `specular` (which [`TwoScale::sample`] has from
+    /// its draw).
+    fn pdf_with(&self, geometry: &Geometry, w: &[f64; 4], specular: f64) -> f64 {
         let mut total = 0.0;
         if w[0] > 0.0 {
             total += w[0] * specular;
@@ -1423,10 +1434,27 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * base and multiple: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
+        let visible = match lobe {
+            Lobe::Specular => Some(self.bake().visible.incidence(wi)),
+            _ => None,
+        };
+        self.draw_lobe(lobe, wi, visible.as_ref(), u)
+    }
+
+    /// [`TwoScale::sample_lobe`] for the unit incidence `wi`, with the
+    /// visible-normal sampler's incidence `visible` (needed for the specular
+    /// lobe only).
+    fn draw_lobe(
+        &self,
+        lobe: Lobe,
+        wi: [f64; 3],
+        visible: Option<&VisibleIncidence>,
+        u: [f32; 2],
+    ) -> Option<[f32; 3]> {
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
-                let m = self.bake().visible.sample(wi, u)?;
+                let m = self.bake().visible.sample_at(visible?, u)?;
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
@@ -1500,10 +1528,20 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// lobe draws visible normals from the material's tabulated visible-slope
     /// density, which `pdf` evaluates (docs/model.md §2.1).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
-        let (o, lobe) = self.sample_direction(i, u)?;
+        let wi = upper_unit(i)?;
+        // The lobe weights and the visible-normal sampler's incidence serve
+        // the draw and the pdf: the same values `pdf(i, o)` computes from `i`.
+        let w = self.weights(wi[2]);
+        let lobe = pick_lobe(f64::from(u[0].max(0.0).min(BELOW_ONE)), w);
+        let visible = (w[0] > 0.0).then(|| self.bake().visible.incidence(wi));
+        let o = self.draw_lobe(lobe, wi, visible.as_ref(), [u[1], u[2]])?;
         // pdf(i, o) and eval(i, o) from one geometry.
         let geometry = self.geometry(i, o)?;
-        let pdf = finite_or_zero(self.pdf_at(&geometry));
+        let specular = match &visible {
+            Some(inc) => self.bake().visible.pdf_at(inc, geometry.wi, geometry.wo),
+            None => 0.0,
+        };
+        let pdf = finite_or_zero(self.pdf_with(&geometry, &w, specular));
         if !(pdf > 0.0) {
             return None;
         }
