@@ -181,6 +181,53 @@ def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
 
+class _PerLane:
+    """Per-channel f64 constants read at a per-lane channel index."""
+
+    def __init__(self, channels, names):
+        self.values = {k: mi.Float64([ch.s[k] for ch in channels]) for k in names}
+        self.index = None
+
+    def __getitem__(self, name):
+        return dr.gather(mi.Float64, self.values[name], self.index)
+
+
+class _ChannelStack:
+    """The diffraction sampler's bakes of several channels in one set of
+    arrays (rows stacked channel after channel), so that a lane draws from
+    its own channel's law with one `_Channel.diffraction_sample` (rather
+    than one per channel and a select). None unless every channel has the
+    diffraction lobe with the same shapes and shared constants."""
+
+    TABLES = ("halo_u", "halo_zeta", "halo_dens", "halo_cum", "radial_inv_m")
+
+    @classmethod
+    def of(cls, channels):
+        first = channels[0]
+        same = all(ch.diffraction and all(ch.shapes[k] == first.shapes[k] for k in cls.TABLES)
+                   and all(ch.s[k] == first.s[k] for k in ("sigma_s", "halo_spectrum_share"))
+                   for ch in channels)
+        return cls(channels) if len(channels) > 1 and same else None
+
+    def __init__(self, channels):
+        self.channels = channels
+        self.t = {k: dr.concat([ch.t[k] for ch in channels]) for k in self.TABLES}
+        self.tops = mi.Float64([ch.halo_top for ch in channels])
+
+    def at(self, k):
+        """A `_Channel` view whose diffraction sampler is channel `k`'s (per lane)."""
+        first = self.channels[0]
+        view = object.__new__(_Channel)
+        view.s, view.shapes, view.t = first.s, first.shapes, self.t
+        view.d = _PerLane(self.channels, ("big_b", "c"))
+        view.d.index = k
+        view.diffraction = True
+        view.halo_row0 = k * first.shapes["halo_u"][0]
+        view.radial0 = k * first.shapes["radial_inv_m"][0]
+        view.halo_top = dr.gather(mi.Float64, self.tops, k)
+        return view
+
+
 class _Channel:
     """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
 
@@ -208,6 +255,9 @@ class _Channel:
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
+        # Where this channel's rows start in `t` (not 0 in a `_ChannelStack` view).
+        self.halo_row0, self.radial0 = 0, 0
+        self.halo_top = float(bakes["halo_u"][-1])
 
     # -- the 1-D bakes -------------------------------------------------
     def direction_cell(self, cos):
@@ -289,15 +339,15 @@ class _Channel:
         """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
         fraction, linear in `u` (f64)."""
         n_u = self.shapes["halo_u"][0]
-        top = float(self.t["halo_u"][n_u - 1])
-        u = dr.clip(self.d["big_b"] * wi.z, 0.0, top)
+        u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_top)
 
         def node(j):
-            return dr.gather(mi.Float64, self.t["halo_u"], j)
+            return dr.gather(mi.Float64, self.t["halo_u"], self.halo_row0 + j)
 
         j = _last_at_most(n_u - 1, lambda j: node(j) <= u, 6)
         u0, u1 = node(j), node(j + 1)
-        return j, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0), 0.0)
+        return self.halo_row0 + j, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0),
+                                             0.0)
 
     def _halo_node(self, name, row, k):
         n_s = self.shapes["halo_zeta"][1]
@@ -384,15 +434,19 @@ class _Channel:
                                   lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h),
                                   _NEWTON_TOL)
 
+    def _radial_inv_m(self, sin_i):
+        """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self.radial0 + i, frac))
+
     def spectrum_pdf(self, wi, wo):
         """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
         s = self.s
         if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
             return mi.Float64(0.0)
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        inv_m = self._radial_inv_m(sin_i)
         dx, dy = wo.x + wi.x, wo.y + wi.y
         r = dr.sqrt(dx * dx + dy * dy)
         x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
@@ -616,9 +670,7 @@ class _Channel:
         whether it exists (f64)."""
         s = self.s
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, i, frac))
+        inv_m = self._radial_inv_m(sin_i)
         b, c = self.d["big_b"], self.d["c"]
         m = 1.0 / inv_m
         # ln_1pf and exp_m1f of the runtime, in f64.
@@ -775,6 +827,7 @@ class Model:
         self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
         self.height_correlated = first["height_correlated"] != 0.0
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
+        self.diffraction_stack = _ChannelStack.of(self.channels)
 
     def d(self, h):
         """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
@@ -892,12 +945,21 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
     lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
     m, ok = model.channels[0].visible_sample(wi, u1, u2)
     o = 2.0 * dr.dot(wi, m) * m - wi
-    for n, channel in enumerate(model.channels):
-        if channel.diffraction:
-            od, ok_d = channel.diffraction_sample(wi, u1, u2)
-            here = (lobe == 1) & selected[n]
-            o = dr.select(here, od, o)
-            ok = dr.select(here, ok_d, ok)
+    if model.diffraction_stack is not None:
+        # One draw from each lane's own channel.
+        k = mi.UInt32(0)
+        for n in range(1, len(selected)):
+            k = dr.select(selected[n], n, k)
+        od, ok_d = model.diffraction_stack.at(k).diffraction_sample(wi, u1, u2)
+        o = dr.select(lobe == 1, od, o)
+        ok = dr.select(lobe == 1, ok_d, ok)
+    else:
+        for n, channel in enumerate(model.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & selected[n]
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
     r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
     ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
     o = dr.select(lobe >= 2, ob, o)
