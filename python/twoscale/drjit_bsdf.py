@@ -255,6 +255,9 @@ class _Channel:
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
+        # The lobe weights' columns that are positive somewhere (`lobe_weights`).
+        weights = bakes["direction_weights"]
+        self.weight_columns = [k for k in range(4) if np.any(weights[:, k] > 0.0)]
         # Where this channel's rows start in `t` (not 0 in a `_ChannelStack` view).
         self.halo_row0, self.radial0 = 0, 0
         self.halo_top = float(bakes["halo_u"][-1])
@@ -320,12 +323,20 @@ class _Channel:
     def lobe_weights(self, cos_i):
         """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
         sum 1 (f64)."""
+        columns = self.weight_columns
+        if columns in ([], [0]):
+            # The specular lobe alone (or no lobe): weights [1, 0, 0, 0] everywhere.
+            return [mi.Float64(1.0)] + [mi.Float64(0.0)] * 3
         i, frac = self.direction_cell(mi.Float(cos_i))
-        w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
-             for k in range(4)]
-        total = w[0] + w[1] + w[2] + w[3]
+        a = _gather4(self.t["direction_weights"], i)
+        b = _gather4(self.t["direction_weights"], i + 1)
+        # Columns that are 0 at every node contribute exact zeros.
+        w = [mi.Float64(dr.maximum(dr.fma(frac, b[k] - a[k], a[k]), 0.0)) if k in columns
+             else mi.Float64(0.0) for k in range(4)]
+        total = sum(w[k] for k in columns)
         ok = total > 0.0
-        return [dr.select(ok, w[0] / total, 1.0)] + [dr.select(ok, x / total, 0.0) for x in w[1:]]
+        return [dr.select(ok, w[0] / total, 1.0)] + [
+            dr.select(ok, w[k] / total, 0.0) if k in columns else w[k] for k in range(1, 4)]
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
@@ -792,7 +803,8 @@ class _Channel:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if s["multiple_scale"] != 0.0
+                    else mi.Float64(0.0))
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
