@@ -972,10 +972,12 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
                 here = (lobe == 1) & selected[n]
                 o = dr.select(here, od, o)
                 ok = dr.select(here, ok_d, ok)
-    r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-    ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-    o = dr.select(lobe >= 2, ob, o)
-    ok = dr.select(lobe >= 2, True, ok)
+    if any(n in ch.weight_columns for ch in model.channels for n in (2, 3)):
+        # The cosine lobe (traced only when some channel can pick lobe 2 or 3).
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe >= 2, ob, o)
+        ok = dr.select(lobe >= 2, True, ok)
     ok &= ~((lobe == 1) & ~model.channels_have_diffraction)
     o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
     ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
