@@ -3,8 +3,8 @@
 
     python python/examples/benchmark_render.py [--size 64] [--spp 64] [--variant V] [--evaluated]
 
-Renders the sphere of the Beckmann-limit check (constant emitter and a
-directional light, path tracer of depth 2) with each BSDF, once to warm up
+Renders the sphere of the Beckmann-limit check (`sphere_scene`: a constant
+emitter and a directional light, path tracer of depth 2) with each BSDF, once to warm up
 (JIT compilation, plugin construction) and then ``--repeat`` times, and
 prints the process CPU time (user + system, all threads) per sample
 (pixels × spp) of the timed renders, and the ratio to ``roughconductor`` in
@@ -24,6 +24,45 @@ import time
 LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 
 
+#: Gold's (η, k) per RGB channel.
+GOLD = ([0.163, 0.584, 1.403], [3.56, 2.15, 1.925])
+
+
+def sphere_scene(bsdf, size=64, spp=64):
+    """A unit sphere of `bsdf` seen from 4.5 units (field of view 30°)
+    under a constant emitter of radiance 0.5 and a directional light of
+    irradiance 5 from (−1, −1, −2); a path tracer of depth 2 and a box
+    pixel filter, so that the pixels are independent estimates."""
+    import mitsuba as mi
+
+    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 2},
+        "sensor": {"type": "perspective", "fov": 30, "to_world": look,
+                   "film": {"type": "hdrfilm", "width": size, "height": size, "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": spp}},
+        "sphere": {"type": "sphere", "bsdf": bsdf},
+        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
+        "sun": {"type": "directional", "direction": [-1, -1, -2],
+                "irradiance": {"type": "rgb", "value": 5.0}},
+    })
+
+
+def roughconductor(alpha, eta, k):
+    """Mitsuba's `roughconductor`: Beckmann, visible normals (its default), α, η, k per channel."""
+    return {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha,
+            "eta": {"type": "rgb", "value": list(eta)}, "k": {"type": "rgb", "value": list(k)}}
+
+
+def beckmann_pair(alpha, eta=GOLD[0], k=GOLD[1], plugin="twoscale"):
+    """The Beckmann limit: the plugin `plugin` at β = α, p = 1, σs = 0, and
+    `roughconductor` with the same α, η, k."""
+    twoscale_bsdf = {"type": plugin, "beta": alpha, "p": 1.0, "sigma_s": 0.0,
+                     "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))}
+    return twoscale_bsdf, roughconductor(alpha, eta, k)
+
+
 def measure(variant, size, spp, repeat, evaluated):
     import drjit as dr
     import mitsuba as mi
@@ -36,31 +75,19 @@ def measure(variant, size, spp, repeat, evaluated):
     import twoscale.mitsuba as tm
 
     tm.register()
-    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
+    eta, k = GOLD
     if mi.is_spectral:
         # an explicit material needs one index for every channel in spectral variants
         eta, k = [0.584] * 3, [2.15] * 3
+    beckmann, rough = beckmann_pair(0.1, eta, k)
     bsdfs = {
         "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
-        "twoscale Beckmann (p=1, σs=0)": {"type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
-                                          "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))},
-        "roughconductor beckmann": {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.1,
-                                    "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}},
+        "twoscale Beckmann (p=1, σs=0)": beckmann,
+        "roughconductor beckmann": rough,
     }
-    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
     cost = {}
     for name, bsdf in bsdfs.items():
-        scene = mi.load_dict({
-            "type": "scene",
-            "integrator": {"type": "path", "max_depth": 2},
-            "sensor": {"type": "perspective", "fov": 30, "to_world": look,
-                       "film": {"type": "hdrfilm", "width": size, "height": size},
-                       "sampler": {"type": "independent", "sample_count": spp}},
-            "sphere": {"type": "sphere", "bsdf": bsdf},
-            "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
-            "sun": {"type": "directional", "direction": [-1, -1, -2],
-                    "irradiance": {"type": "rgb", "value": 5.0}},
-        })
+        scene = sphere_scene(bsdf, size, spp)
         mi.render(scene, spp=spp)  # warm-up
         start = time.process_time()
         for seed in range(repeat):

@@ -706,10 +706,13 @@ impl Material {
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
     /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),
-    /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, and
-    /// `models`, a list of 19 dicts as `bakes()` gives them (not a stable
-    /// interface). Raises `ValueError` as `eval_spectral` does for a
-    /// material without an index over the spectrum.
+    /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, `models`
+    /// (one dict with the names of `bakes()`: a quantity equal in the 19
+    /// models once, as `bakes()` gives it; the others stacked along a
+    /// leading node axis of 19, scalars as float64 arrays of 19) and
+    /// `per_node` (the names of the stacked ones). Not a stable interface.
+    /// Raises `ValueError` as `eval_spectral` does for a material without
+    /// an index over the spectrum.
     fn spectral_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let Some(spectral) = &self.spectral else {
             return Err(value_error(
@@ -718,12 +721,18 @@ impl Material {
         };
         let model = self.spectral_model(spectral);
         let dict = bake_dict(py, |v| model.visit_index(v))?;
-        let models = model
+        let nodes: Vec<Collected> = model
             .nodes()
             .iter()
-            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
-            .collect::<PyResult<Vec<_>>>()?;
+            .map(|node| {
+                let mut c = Collected::default();
+                node.visit_bakes(&mut c);
+                c
+            })
+            .collect();
+        let (models, per_node) = stacked(py, &nodes)?;
         dict.set_item("models", models)?;
+        dict.set_item("per_node", per_node)?;
         Ok(dict)
     }
 
@@ -910,6 +919,87 @@ impl BakeVisitor for DictVisitor<'_> {
         let result = self.dict.set_item(name, value);
         self.keep(result);
     }
+}
+
+/// One quantity as `TwoScale::visit_bakes` hands it.
+#[derive(PartialEq)]
+enum Quantity {
+    F32(Vec<usize>, Vec<f32>),
+    F64(Vec<usize>, Vec<f64>),
+    Scalar(f64),
+}
+
+/// One model's quantities in the order visited.
+#[derive(Default)]
+struct Collected(Vec<(&'static str, Quantity)>);
+
+impl BakeVisitor for Collected {
+    fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]) {
+        self.0
+            .push((name, Quantity::F32(shape.to_vec(), data.to_vec())));
+    }
+
+    fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]) {
+        self.0
+            .push((name, Quantity::F64(shape.to_vec(), data.to_vec())));
+    }
+
+    fn scalar(&mut self, name: &'static str, value: f64) {
+        self.0.push((name, Quantity::Scalar(value)));
+    }
+}
+
+/// The models' quantities in one dict (`spectral_bakes`' `models`): one
+/// equal in every model once, the others stacked along a leading node axis
+/// (scalars as an f64 array); and the names of the stacked ones.
+fn stacked<'py>(
+    py: Python<'py>,
+    nodes: &[Collected],
+) -> PyResult<(Bound<'py, PyDict>, Vec<&'static str>)> {
+    let dict = PyDict::new(py);
+    let mut per_node = Vec::new();
+    let n = nodes.len();
+    for (j, (name, first)) in nodes[0].0.iter().enumerate() {
+        let all = || nodes.iter().map(move |node| &node.0[j].1);
+        if all().all(|q| q == first) {
+            match first {
+                Quantity::F32(shape, data) => {
+                    dict.set_item(name, shaped(py, shape, data.clone()))?
+                }
+                Quantity::F64(shape, data) => {
+                    dict.set_item(name, shaped(py, shape, data.clone()))?
+                }
+                Quantity::Scalar(value) => dict.set_item(name, *value)?,
+            }
+            continue;
+        }
+        per_node.push(*name);
+        let full = |shape: &[usize]| [&[n][..], shape].concat();
+        match first {
+            Quantity::F32(shape, _) => {
+                let data = all().flat_map(|q| match q {
+                    Quantity::F32(_, d) => d.clone(),
+                    _ => unreachable!("every model visits the same quantities"),
+                });
+                dict.set_item(name, shaped(py, &full(shape), data.collect()))?;
+            }
+            Quantity::F64(shape, _) => {
+                let data = all().flat_map(|q| match q {
+                    Quantity::F64(_, d) => d.clone(),
+                    _ => unreachable!("every model visits the same quantities"),
+                });
+                dict.set_item(name, shaped(py, &full(shape), data.collect()))?;
+            }
+            Quantity::Scalar(_) => {
+                let data = all().map(|q| match q {
+                    Quantity::Scalar(v) => *v,
+                    _ => unreachable!("every model visits the same quantities"),
+                });
+                dict.set_item(name, shaped(py, &[n], data.collect()))?;
+            }
+        }
+    }
+    Ok((dict, per_node))
 }
 
 /// Evaluates `f` on every row without the GIL; the first failing row's error

@@ -3,8 +3,25 @@ test_drjit_spectral.py): the χ² test, the white furnace (a material's albedo b
 over the runtime's eval, and a render that estimates it in every pixel) and
 the Beckmann limit against Mitsuba's roughconductor."""
 
+import importlib
+import pathlib
+import sys
+
 import mitsuba as mi
 import numpy as np
+
+
+def example(name):
+    """The module python/examples/`name`.py (the directory joins the path,
+    as when the example runs, so that examples import each other)."""
+    examples = str(pathlib.Path(__file__).resolve().parents[1] / "examples")
+    if examples not in sys.path:
+        sys.path.append(examples)
+    return importlib.import_module(name)
+
+
+#: The sphere scene and the Beckmann-limit pair of BSDFs.
+benchmark_render = example("benchmark_render")
 
 
 def direction(theta_deg):
@@ -61,35 +78,14 @@ def furnace_render(bsdf, theta_deg, seed):
     return np.asarray(mi.render(scene, seed=seed, spp=64)).reshape(-1, 3)
 
 
-def sphere_scene(bsdf):
-    look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
-    return mi.load_dict({
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": 2},
-        "sensor": {
-            "type": "perspective", "fov": 30, "to_world": look,
-            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": {"type": "box"}},
-            "sampler": {"type": "independent", "sample_count": 64},
-        },
-        "sphere": {"type": "sphere", "bsdf": bsdf},
-        "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.5}},
-        "sun": {"type": "directional", "direction": [-1, -1, -2],
-                "irradiance": {"type": "rgb", "value": 5.0}},
-    })
-
-
 def beckmann_limit(alpha, plugin="twoscale"):
     """Mean |difference| between the plugin `plugin` (p = 1, σs = 0) and
     roughconductor (beckmann, same α, η, k) renders, over the noise level
     expected for two independent renders, from two seeds of each."""
-    eta, k = [0.163, 0.584, 1.403], [3.56, 2.15, 1.925]
-    twoscale_bsdf = {"type": plugin, "beta": alpha, "p": 1.0, "sigma_s": 0.0,
-                     "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))}
-    rough = {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha,
-             "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}}
+    twoscale_bsdf, rough = benchmark_render.beckmann_pair(alpha, plugin=plugin)
     img = {}
     for name, bsdf in (("twoscale", twoscale_bsdf), ("rough", rough)):
-        scene = sphere_scene(bsdf)
+        scene = benchmark_render.sphere_scene(bsdf)
         for seed in (0, 1):
             img[name, seed] = np.asarray(mi.render(scene, seed=seed, spp=64))
     mad = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731

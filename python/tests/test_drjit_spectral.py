@@ -68,6 +68,31 @@ def test_eval_equals_the_runtime(name):
     assert small_ok
 
 
+@pytest.mark.parametrize("base", ["plastic", "subsurface"])
+def test_a_dispersive_base_equals_the_runtime(base):
+    """With η varying over λ the base layer's constants differ between the
+    models (per-model `eta_re`, `f_dr_int`): `eval_spectral` and
+    `pdf_spectral` equal the runtime's as in `test_eval_equals_the_runtime`."""
+    lam_eta = np.linspace(0.36, 0.83, 30)
+    material = twoscale.Material(beta=0.2, p=1.5, sigma_s=0.05, b=2.0, c=1.5,
+                                 eta=(lam_eta, 1.6 - 0.2 * (lam_eta - 0.36), 0.0 * lam_eta),
+                                 base=base, albedo=0.7, lambertian=0.1)
+    assert {"eta_re", "f_dr_int"} <= set(material.spectral_bakes()["per_node"])
+    model = tb.SpectralModel(material)
+    light, camera = pairs(seed(base, "dispersive"))
+    lam = np.random.default_rng(seed(base, "lam")).uniform(0.36, 0.83, (4, len(light)))
+    lam = lam.astype(np.float32)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+    ref = np.stack([material.eval_spectral(light, camera, row) for row in lam], axis=1)
+    got = np.array(mi.Spectrum(*model.eval_spectral(wi, wo, [mi.Float(x) for x in lam]))).T
+    worst, small_ok = relative_error(got.reshape(-1, 1), ref.reshape(-1, 1))
+    assert worst < TOLERANCE and small_ok, f"{base}: eval worst relative error {worst:.2e}"
+    got = np.array(model.pdf_spectral(wi, wo, mi.Float(lam[0])))
+    worst, small_ok = relative_error(got[:, None],
+                                     material.pdf_spectral(light, camera, lam[0])[:, None])
+    assert worst < TOLERANCE and small_ok, f"{base}: pdf worst relative error {worst:.2e}"
+
+
 @pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble", "silver", "white-plastic/white",
                                   "gold-rough/kulla-conty"])
 def test_pdf_and_sample_equal_the_runtime(name):
@@ -91,6 +116,54 @@ def test_pdf_and_sample_equal_the_runtime(name):
     o, ok = np.array(o).T, np.array(ok).astype(bool)
     assert np.array_equal(ok, ref_pdf > 0)
     assert np.abs(o - ref_o)[ok].max() <= 1e-4
+
+
+class _Poisoned:
+    """`material` whose `spectral_bakes()` has NaN in every stacked quantity
+    of the models not in `keep`."""
+
+    def __init__(self, material, keep):
+        self.material, self.keep = material, keep
+
+    def __getattr__(self, name):
+        return getattr(self.material, name)
+
+    def spectral_bakes(self):
+        bakes = self.material.spectral_bakes()
+        for name in bakes["per_node"]:
+            value = np.array(bakes["models"][name], copy=True)
+            value[[k for k in range(len(value)) if k not in self.keep]] = np.nan
+            bakes["models"][name] = value
+        return bakes
+
+
+@pytest.mark.parametrize("name", ["gold-hp17-geometry", "marble"])
+def test_each_wavelength_reads_its_models_only(name):
+    """With every model but those around the path's four wavelengths (and
+    model 0, the shared surface's source) made NaN, `eval_spectral` is
+    unchanged bit for bit; with every model but the hero wavelength's
+    nearest, `pdf_spectral` and `sample_spectral` are."""
+    material = preset_with(name)
+    light, camera = pairs(seed(name, "poison"), 1000)
+    wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
+    u = mi.Vector3f(np.random.default_rng(seed(name, "poison u")).random((3, len(light))))
+    # Cells 1, 7, 10 and 17 (from the nodes 0.40, 0.54, 0.60 and 0.795 µm).
+    lams = [mi.Float(x) for x in (0.41, 0.545, 0.61, 0.80)]
+    model = tb.SpectralModel(material)
+    poisoned = tb.SpectralModel(_Poisoned(material, {0, 1, 2, 7, 8, 10, 11, 17, 18}))
+    for a, b in zip(model.eval_spectral(wi, wo, lams), poisoned.eval_spectral(wi, wo, lams)):
+        assert np.array_equal(np.array(a), np.array(b))
+    assert np.array(model.eval_spectral(wi, wo, lams)[1]).max() > 0.0
+    hero = mi.Float(0.545)
+    nearest = tb.SpectralModel(_Poisoned(material, {0, 7}))
+    assert np.array_equal(np.array(model.pdf_spectral(wi, wo, hero)),
+                          np.array(nearest.pdf_spectral(wi, wo, hero)))
+    (o, ok), (o_p, ok_p) = (m.sample_spectral(wi, u, hero) for m in (model, nearest))
+    assert np.array_equal(np.array(ok), np.array(ok_p)) and np.array(ok).any()
+    assert np.array_equal(np.array(o), np.array(o_p))
+    # The poison is seen where it is read: the pdf at a model made NaN.
+    assert not np.array_equal(np.array(model.pdf_spectral(wi, wo, mi.Float(0.6))),
+                              np.array(nearest.pdf_spectral(wi, wo, mi.Float(0.6))))
 
 
 def adapter(props, wi, nm):

@@ -6,9 +6,7 @@ variance of exact visible-normal sampling (quadrature), every channel; and
 for presets and the issue's strong halo (docs/design/halo-sampling.md),
 ≤ 0.1 at θi ≤ 70° and ≤ 0.5 at 85°, every channel."""
 
-import importlib.util
 import os
-import pathlib
 
 import numpy as np
 import pytest
@@ -21,10 +19,9 @@ import mitsuba as mi  # noqa: E402
 
 mi.set_variant("llvm_ad_rgb")
 
-_PATH = pathlib.Path(__file__).resolve().parents[1] / "examples" / "sampler_variance.py"
-_SPEC = importlib.util.spec_from_file_location("sampler_variance", _PATH)
-sv = importlib.util.module_from_spec(_SPEC)
-_SPEC.loader.exec_module(sv)
+from render_checks import example  # noqa: E402
+
+sv = example("sampler_variance")
 
 N = 200_000
 

@@ -22,9 +22,10 @@ the cosine lobe). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
-:meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes, interpolated
-in λ, with F(θd) at each of the path's four wavelengths in closed form;
-``pdf`` and ``sample`` those of the model nearest the hero wavelength).
+:meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes stacked along
+a node axis, the two models around each of the path's four wavelengths
+interpolated in λ, with F(θd) at λ in closed form; ``pdf`` and ``sample``
+those of the model nearest the hero wavelength).
 
 **Gradients.** The bakes are fixed per material (the runtime interprets the
 tables; a lookup's node positions have no useful derivative), so
@@ -51,7 +52,9 @@ differentiated).
 incident one.
 """
 
+import copy
 import math
+import types
 
 import drjit as dr
 import mitsuba as mi
@@ -181,53 +184,6 @@ def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
 
-class _PerLane:
-    """Per-channel f64 constants read at a per-lane channel index."""
-
-    def __init__(self, channels, names):
-        self.values = {k: mi.Float64([ch.s[k] for ch in channels]) for k in names}
-        self.index = None
-
-    def __getitem__(self, name):
-        return dr.gather(mi.Float64, self.values[name], self.index)
-
-
-class _ChannelStack:
-    """The diffraction sampler's bakes of several channels in one set of
-    arrays (rows stacked channel after channel), so that a lane draws from
-    its own channel's law with one `_Channel.diffraction_sample` (rather
-    than one per channel and a select). None unless every channel has the
-    diffraction lobe with the same shapes and shared constants."""
-
-    TABLES = ("halo_u", "halo_zeta", "halo_dens", "halo_cum", "radial_inv_m")
-
-    @classmethod
-    def of(cls, channels):
-        first = channels[0]
-        same = all(ch.diffraction and all(ch.shapes[k] == first.shapes[k] for k in cls.TABLES)
-                   and all(ch.s[k] == first.s[k] for k in ("sigma_s", "halo_spectrum_share"))
-                   for ch in channels)
-        return cls(channels) if len(channels) > 1 and same else None
-
-    def __init__(self, channels):
-        self.channels = channels
-        self.t = {k: dr.concat([ch.t[k] for ch in channels]) for k in self.TABLES}
-        self.tops = mi.Float64([ch.halo_top for ch in channels])
-
-    def at(self, k):
-        """A `_Channel` view whose diffraction sampler is channel `k`'s (per lane)."""
-        first = self.channels[0]
-        view = object.__new__(_Channel)
-        view.s, view.shapes, view.t = first.s, first.shapes, self.t
-        view.d = _PerLane(self.channels, ("big_b", "c"))
-        view.d.index = k
-        view.diffraction = True
-        view.halo_row0 = k * first.shapes["halo_u"][0]
-        view.radial0 = k * first.shapes["radial_inv_m"][0]
-        view.halo_top = dr.gather(mi.Float64, self.tops, k)
-        return view
-
-
 class _Channel:
     """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
 
@@ -239,6 +195,7 @@ class _Channel:
                   for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
+        self.halo_u_top = float(bakes["halo_u"][-1])
         s["visible_r_max"] = self.r_max
         # Constants of the base layer (`TwoScale::base_value`; the albedo
         # and k_d are the plugin's parameters, `Model.params`).
@@ -255,17 +212,27 @@ class _Channel:
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
-        # The lobe weights' columns that are positive somewhere (`lobe_weights`).
-        weights = bakes["direction_weights"]
-        self.weight_columns = [k for k in range(4) if np.any(weights[:, k] > 0.0)]
-        # Where this channel's rows start in `t` (not 0 in a `_ChannelStack` view).
-        self.halo_row0, self.radial0 = 0, 0
-        self.halo_top = float(bakes["halo_u"][-1])
+        self.specialise(bakes)
+
+    def specialise(self, bakes):
+        """What the traced code leaves out (Python-level branches, as
+        Mitsuba's own plugins): the lobe weights' columns that are 0 at every
+        node of `bakes` (any model's, stacked), the compensation lobe when
+        its scale is 0."""
+        weights = np.asarray(bakes["direction_weights"])
+        self.weight_columns = [k for k in range(4) if np.any(weights[..., k] > 0.0)]
+        self.has_multiple = bool(np.any(np.asarray(bakes["multiple_scale"]) != 0.0))
+
+    def _node_row(self, i, n):
+        """Row `i` of a per-wavelength table of `n` rows (:class:`_NodeChannel`
+        offsets it to its lane's model); one channel's own row here."""
+        return i
 
     # -- the 1-D bakes -------------------------------------------------
     def direction_cell(self, cos):
         n = self.shapes["direction_rows"][0]
-        return _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+        i, frac = _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+        return self._node_row(i, n), frac
 
     def direction(self, cell, columns):
         """The direction bake's `columns` at `cell`, linear between its rows
@@ -306,6 +273,7 @@ class _Channel:
         span = _log2_axis((1.0 + inv_w) * float(np.float32(1.0 / s["conv_cos_h_min"])))
         x_s = _log2_axis(x_h) * (float(nodes_s - 1) / span)
         ju, tu = _cell_at(x_u, nodes_u)
+        ju = self._node_row(ju, n_u)
         ks, ts = _cell_at(x_s, nodes_s)
         wu, ws = _catmull_rom_weights(tu), _catmull_rom_weights(ts)
         ln_c = mi.Float(0.0)
@@ -350,15 +318,15 @@ class _Channel:
         """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
         fraction, linear in `u` (f64)."""
         n_u = self.shapes["halo_u"][0]
-        u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_top)
+        u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_u_top)
 
         def node(j):
-            return dr.gather(mi.Float64, self.t["halo_u"], self.halo_row0 + j)
+            return dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u))
 
         j = _last_at_most(n_u - 1, lambda j: node(j) <= u, 6)
         u0, u1 = node(j), node(j + 1)
-        return self.halo_row0 + j, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0),
-                                             0.0)
+        row = self._node_row(j, n_u)
+        return row, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0), 0.0)
 
     def _halo_node(self, name, row, k):
         n_s = self.shapes["halo_zeta"][1]
@@ -449,7 +417,7 @@ class _Channel:
         """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""
         n = self.shapes["radial_inv_m"][0]
         i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self.radial0 + i, frac))
+        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
 
     def spectrum_pdf(self, wi, wo):
         """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
@@ -803,7 +771,7 @@ class _Channel:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if s["multiple_scale"] != 0.0
+        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
                     else mi.Float64(0.0))
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
@@ -832,14 +800,15 @@ class Model:
     def __init__(self, material: twoscale.Material, params=None, bakes=None):
         self.material = material
         self.params = default_params(material) if params is None else params
-        self.channels = [_Channel(b) for b in (material.bakes() if bakes is None else bakes)]
+        bakes = material.bakes() if bakes is None else bakes
+        self.channels = [_Channel(b) for b in bakes]
         first = self.channels[0].s
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
         self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
         self.height_correlated = first["height_correlated"] != 0.0
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
-        self.diffraction_stack = _ChannelStack.of(self.channels)
+        self.diffraction_stack = _diffraction_stack(self.channels, bakes)
 
     def d(self, h):
         """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
@@ -957,7 +926,7 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
     lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
     m, ok = model.channels[0].visible_sample(wi, u1, u2)
     o = 2.0 * dr.dot(wi, m) * m - wi
-    if model.diffraction_stack is not None:
+    if getattr(model, "diffraction_stack", None) is not None:
         # One draw from each lane's own channel.
         k = mi.UInt32(0)
         for n in range(1, len(selected)):
@@ -1010,6 +979,100 @@ def _fresnel(n, k, cos):
     return dr.clip(mi.Float(f), 0.0, 1.0)
 
 
+class _NodeScalars:
+    """A stack's scalars at per-lane model `k`: a quantity of `arrays` (one
+    value per model) gathered at `k` (once per view), the others those of
+    `shared`."""
+
+    def __init__(self, shared, arrays, dtype, k):
+        self.shared, self.arrays, self.dtype, self.k, self.cache = shared, arrays, dtype, k, {}
+
+    def __getitem__(self, name):
+        if name not in self.arrays:
+            return self.shared[name]
+        if name not in self.cache:
+            self.cache[name] = dr.gather(self.dtype, self.arrays[name], self.k)
+        return self.cache[name]
+
+
+class _NodeChannel(_Channel):
+    """The 19 models of ``Material.spectral_bakes()`` as one channel: each
+    quantity that differs between the models (``per_node``) uploaded once,
+    stacked along a node axis; :meth:`at` gives the channel of a per-lane
+    model `k` (its rows offset by `k` models, its scalars gathered at `k`),
+    so that a lane reads the models it needs and no other."""
+
+    # Read as Python floats (branches, literals), by `Model` from model 0
+    # (D, G) or from the shared tables: one value for every model.
+    SHARED = {"sigma_s", "b", "white", "has_q", "symmetrised", "halo_incident", "base",
+              "conv_baked", "height_correlated", "halo_spectrum_share", "conv_u0",
+              "conv_cos_h_min", "masking_beta", "masking_g1", "beta", "p", "epd_norm",
+              "epd_inv_beta_sq"}
+
+    # The tables read through `_node_row`: stacked even where the models agree.
+    ROWS = ("direction_rows", "direction_weights", "conv_ln_c", "radial_inv_m", "halo_u",
+            "halo_zeta", "halo_dens", "halo_cum")
+
+    def __init__(self, models, per_node, count):
+        clash = sorted(n for n in per_node if n in self.SHARED or n.startswith("visible_"))
+        if clash:
+            raise ValueError(f"twoscale: the spectral models differ in {clash}")
+        super().__init__({k: (v[0] if k in per_node else v) for k, v in models.items()})
+        self.specialise(models)
+        stacked = {k: models[k] for k in per_node}
+        stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
+        arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
+        for name, v in arrays.items():
+            self.t[name] = (mi.Float64 if v.dtype == np.float64 else mi.Float)(
+                np.ascontiguousarray(v).ravel())
+        # As `_Channel`'s packets, over the stacked grids (a packet never
+        # crosses a row, so never a model).
+        ln_c = np.ascontiguousarray(arrays["conv_ln_c"], dtype=np.float32).ravel()
+        ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
+        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        scalars = {k: np.asarray(v, np.float64) for k, v in stacked.items() if k not in arrays}
+        if "eta_re" in scalars or "f_dr_int" in scalars:
+            # The base layer's constants per model (as `_Channel`'s).
+            n = np.maximum(np.abs(np.broadcast_to(models["eta_re"], count)), 1e-3)
+            f_dr = np.broadcast_to(models["f_dr_int"], count).astype(np.float64)
+            scalars["base_inv_n_sq"] = 1.0 / (n * n)
+            scalars["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
+        self.node_f = {k: mi.Float(v) for k, v in scalars.items()}
+        self.node_d = {k: mi.Float64(v) for k, v in scalars.items()}
+        self.halo_u_nodes = self.shapes["halo_u"][0]
+
+    def at(self, k):
+        """This stack at the per-lane model `k` (``mi.UInt32``)."""
+        view = copy.copy(self)
+        view.k = k
+        view.f = _NodeScalars(self.f, self.node_f, mi.Float, k)
+        view.d = _NodeScalars(self.d, self.node_d, mi.Float64, k)
+        n_u = self.halo_u_nodes
+        view.halo_u_top = dr.gather(mi.Float64, self.t["halo_u"], view._node_row(n_u - 1, n_u))
+        return view
+
+    def _node_row(self, i, n):
+        return i + self.k * n
+
+
+def _diffraction_stack(channels, bakes):
+    """The channels' bakes as one :class:`_NodeChannel` (channel `k` at a
+    lane's `k`), so that `_draw` runs one diffraction draw per lane, from its
+    own channel, rather than one per channel; None with fewer than two
+    channels, one without the lobe, or channels that differ in what
+    `_NodeChannel` shares."""
+    if len(channels) < 2 or not all(ch.diffraction for ch in channels):
+        return None
+    per_node = [k for k, v in bakes[0].items()
+                if any(not np.array_equal(v, b[k]) for b in bakes[1:])]
+    models = {k: (np.stack([b[k] for b in bakes]) if k in per_node else v)
+              for k, v in bakes[0].items()}
+    try:
+        return _NodeChannel(models, per_node, len(bakes))
+    except ValueError:
+        return None
+
+
 class SpectralModel(Model):
     """The model at any wavelength of a :class:`twoscale.Material`
     (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 19
@@ -1017,11 +1080,20 @@ class SpectralModel(Model):
     surface lobes divided by F(θd) and interpolated linearly in λ, times
     F(θd) at λ in closed form (η linear between 1 nm nodes); the base lobes
     interpolated in λ. ``pdf`` and ``sample_direction`` at λ are those of
-    the nearest model (``Spectral::pdf``, ``Spectral::sample``)."""
+    the nearest model (``Spectral::pdf``, ``Spectral::sample``).
+
+    As ``Spectral::eval4``, the pair's geometry, D and G are computed once
+    per path and each wavelength reads the two models around it (of the
+    stacked bakes, :class:`_NodeChannel`); ``pdf`` and ``sample`` read the
+    nearest model only."""
 
     def __init__(self, material: twoscale.Material, params=None):
         spectral = material.spectral_bakes()
-        super().__init__(material, params, spectral["models"])
+        models, per_node = spectral["models"], set(spectral["per_node"])
+        # The shared surface (geometry, G, the visible-slope sampler): model 0's.
+        first = {k: (v[0] if k in per_node else v) for k, v in models.items()}
+        super().__init__(material, params, [first])
+        self.stack = _NodeChannel(models, per_node, len(spectral["wavelengths"]))
         self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
         self.node_table = mi.Float(spectral["wavelengths"])
         self.eta = mi.Float(np.ascontiguousarray(spectral["eta"]).ravel())
@@ -1057,38 +1129,37 @@ class SpectralModel(Model):
 
         return at(0), at(1)
 
+    def node_terms(self, k, g, geo):
+        """Model `k`'s (per lane) surface lobes, base lobes, their total and
+        F(θd) at a pair (`Spectral::eval_at`'s `at(k)`), f64."""
+        node = self.stack.at(k)
+        spec, diff, b, mult = node.lobes(g, geo, self.params)
+        spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
+        total = mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult)))
+        fresnel = mi.Float64(1.0) if self.white else mi.Float64(
+            node.direction(node.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
+        # The base and the compensation lobe: linear in λ.
+        return spec + diff, b + mult, total, fresnel
+
     def eval_spectral(self, wi, wo, lams):
         """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
         ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``)."""
         valid, geo = self.geometry(wi, wo)
         g = self.masking(geo)
         cos_d = mi.Float(geo["cos_d"])
-        surface, base, total, fresnel = [], [], [], []
-        for channel in self.channels:
-            spec, diff, b, mult = channel.lobes(g, geo, self.params)
-            spec, diff, b, mult = (mi.Float64(mi.Float(x)) for x in (spec, diff, b, mult))
-            surface.append(spec + diff)
-            base.append(b + mult)  # the base and the compensation lobe: linear in λ
-            total.append(mi.Float64(_finite_or_zero(mi.Float(spec + diff + b + mult))))
-            fresnel.append(mi.Float64(1.0) if self.white else mi.Float64(
-                channel.direction(channel.direction_cell(cos_d), [6])[0]))
         out = []
         for lam in lams:
             lam = self.clamped(mi.Float(lam))
             k, f = self.cell(lam)
-
-            def at(values, m):
-                return sum(dr.select(m == j, v, 0.0) for j, v in enumerate(values))
-
-            fa, fb = at(fresnel, k), at(fresnel, k + 1)
+            surface_a, base_a, total_a, fa = self.node_terms(k, g, geo)
+            surface_b, base_b, total_b, fb = self.node_terms(k + 1, g, geo)
             f = mi.Float64(f)
-            plain = (1.0 - f) * at(total, k) + f * at(total, k + 1)
+            plain = (1.0 - f) * total_a + f * total_b
             fl = mi.Float64(_fresnel(*self.eta_at(lam), cos_d))
             fa_safe = dr.select(fa > 0.0, fa, 1.0)
             fb_safe = dr.select(fb > 0.0, fb, 1.0)
-            coloured = (fl * ((1.0 - f) * at(surface, k) / fa_safe
-                              + f * at(surface, k + 1) / fb_safe)
-                        + (1.0 - f) * at(base, k) + f * at(base, k + 1))
+            coloured = (fl * ((1.0 - f) * surface_a / fa_safe + f * surface_b / fb_safe)
+                        + (1.0 - f) * base_a + f * base_b)
             use_plain = (fa <= 0.0) | (fb <= 0.0) if not self.white else True
             value = dr.select(use_plain, plain, coloured)
             out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
@@ -1103,18 +1174,15 @@ class SpectralModel(Model):
         """`Spectral::pdf`: `TwoScale::pdf` of the model nearest λ."""
         valid, geo = self.geometry(wi, wo)
         wi, wo = geo["wi"], geo["wo"]
-        nearest = self.nearest(lam)
+        node = self.stack.at(self.nearest(lam))
         specular = self.channels[0].visible_pdf(wi, wo)
         base = wo.z / math.pi
-        total = mi.Float64(0.0)
-        for m, channel in enumerate(self.channels):
-            w = channel.lobe_weights(wi.z)
-            value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
-            if channel.diffraction:
-                value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo, geo), 0.0)
-            value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
-            total = dr.select(nearest == m, value, total)
-        return dr.select(valid, _finite_or_zero(mi.Float(total)), 0.0)
+        w = node.lobe_weights(wi.z)
+        value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
+        if node.diffraction:
+            value += dr.select(w[1] > 0.0, w[1] * node.diffraction_pdf(wi, wo, geo), 0.0)
+        value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
+        return dr.select(valid, _finite_or_zero(mi.Float(value)), 0.0)
 
     def sample_spectral(self, wi, u, lam):
         """`Spectral::sample`'s direction: `TwoScale::sample_direction` of
@@ -1125,16 +1193,15 @@ class SpectralModel(Model):
         valid = dr.all(dr.isfinite(wi_f))
         wi = dr.normalize(mi.Vector3d(wi_f))
         valid &= wi.z > 0.0
-        nearest = self.nearest(lam)
+        node = self.stack.at(self.nearest(lam))
         pick = mi.Float64(dr.clip(u.x, 0.0, below_one))
         u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
         u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
-        w = [mi.Float64(0.0)] * 4
-        for m, channel in enumerate(self.channels):
-            wm = channel.lobe_weights(wi.z)
-            w = [dr.select(nearest == m, wm[n], w[n]) for n in range(4)]
-        return _draw(self, [nearest == m for m in range(len(self.channels))], w, pick,
-                     wi, u1, u2, valid)
+        # The nearest model as the one channel `_draw` reads (the visible
+        # slopes are shared by the models).
+        one = types.SimpleNamespace(channels=[node],
+                                    channels_have_diffraction=self.channels_have_diffraction)
+        return _draw(one, [mi.Bool(True)], node.lobe_weights(wi.z), pick, wi, u1, u2, valid)
 
 
 def _scalar_bsdf_class():
