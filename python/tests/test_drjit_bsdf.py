@@ -101,7 +101,32 @@ MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
     ("white-plastic", {"colour": "white"}),
     ("gold-rough", {"multiple_scattering": "kulla-conty"}),
     ("white-plastic", {"multiple_scattering": "kulla-conty"}),
+    ("beckmann-limit", {}),
 ]
+
+
+def material_of(name, options):
+    """The preset `name` with `options`; "beckmann-limit" is the render
+    benchmark's p = 1, σs = 0 gold conductor (the specular lobe alone: the
+    port's specialised code without the diffraction, base and compensation
+    lobes)."""
+    if name == "beckmann-limit":
+        return twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0,
+                                 eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)], **options)
+    return twoscale.Material.preset(name, **options)
+
+
+def test_specular_only_material_is_specialised():
+    """The Beckmann-limit material traces the specular lobe alone: constant
+    lobe weights [1, 0, 0, 0], no diffraction, no compensation lobe (the
+    agreement tests below check it against the runtime)."""
+    model = tb.Model(material_of("beckmann-limit", {}))
+    assert all(ch.weight_columns == [0] and not ch.diffraction and ch.s["multiple_scale"] == 0.0
+               for ch in model.channels)
+    assert model.diffraction_stack is None
+    gold = tb.Model(twoscale.Material.preset("gold-hp17-geometry"))
+    assert all(ch.weight_columns == [0, 1] for ch in gold.channels)
+    assert gold.diffraction_stack is not None
 
 
 @pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
@@ -111,7 +136,7 @@ def test_eval_equals_the_runtime(name, options):
     loop (symbolic mode on: nothing in eval may be evaluated eagerly)."""
     for key, value in options.items():
         assert value in twoscale.OPTIONS[key], (key, twoscale.OPTIONS[key])
-    material = twoscale.Material.preset(name, **options)
+    material = material_of(name, options)
     model = tb.Model(material)
     light, camera = pairs(seed(name, "eval", options))
     ref = material.eval(light, camera)
@@ -134,7 +159,7 @@ def test_pdf_equals_the_runtime(name, options):
     weights, averaged over the channels) equals `Material.pdf` within 2e-4
     relative where it exceeds 1e-6 of its peak, on 10⁴ pairs, inside a
     symbolic loop."""
-    material = twoscale.Material.preset(name, **options)
+    material = material_of(name, options)
     model = tb.Model(material)
     light, camera = pairs(seed(name, "pdf", options))
     ref = material.pdf(light, camera)[:, None]
@@ -160,7 +185,7 @@ def test_sample_equals_the_runtime(name, options):
     Measured on 2·10⁵ uniform incidences per preset: 0.01–1.9% of the
     directions differ, 0.03% at most by more than 1e-6, none by more than
     4.7e-5."""
-    material = twoscale.Material.preset(name, **options)
+    material = material_of(name, options)
     model = tb.Model(material)
     rng = np.random.default_rng(seed(name, "sample", options))
     light, _ = pairs(int(rng.integers(2**31)))

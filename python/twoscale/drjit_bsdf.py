@@ -109,6 +109,17 @@ def _catmull_rom_weights(t):
     )
 
 
+#: The Newton solves' stopping step (relative to `|x0| + τmax` in the
+#: visible sampler's cell, in radians for the halo's azimuth). The
+#: runtime stops at 1e-13 (visible) and 1e-12 (halo), which sits at or below
+#: the f64 noise of the residuals: where it does, Newton's step never gets
+#: that small, and the lane bisects in the noise band for 20–30 more steps
+#: (≈40% of the visible sampler's lanes). Once a step is ≤ 1e-9, Newton's
+#: error after it is ~1e-18 (quadratic convergence), so stopping there gives
+#: the runtime's root to f64 noise, far below the f32 direction returned.
+_NEWTON_TOL = 1e-9
+
+
 def _newton_in_bracket(residual, slope, t, hi, tol):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
@@ -201,6 +212,16 @@ class _Channel:
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
+        self.specialise(bakes)
+
+    def specialise(self, bakes):
+        """What the traced code leaves out (Python-level branches, as
+        Mitsuba's own plugins): the lobe weights' columns that are 0 at every
+        node of `bakes` (any model's, stacked), the compensation lobe when
+        its scale is 0."""
+        weights = np.asarray(bakes["direction_weights"])
+        self.weight_columns = [k for k in range(4) if np.any(weights[..., k] > 0.0)]
+        self.has_multiple = bool(np.any(np.asarray(bakes["multiple_scale"]) != 0.0))
 
     def _node_row(self, i, n):
         """Row `i` of a per-wavelength table of `n` rows (:class:`_NodeChannel`
@@ -270,12 +291,20 @@ class _Channel:
     def lobe_weights(self, cos_i):
         """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
         sum 1 (f64)."""
+        columns = self.weight_columns
+        if columns in ([], [0]):
+            # The specular lobe alone (or no lobe): weights [1, 0, 0, 0] everywhere.
+            return [mi.Float64(1.0)] + [mi.Float64(0.0)] * 3
         i, frac = self.direction_cell(mi.Float(cos_i))
-        w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
-             for k in range(4)]
-        total = w[0] + w[1] + w[2] + w[3]
+        a = _gather4(self.t["direction_weights"], i)
+        b = _gather4(self.t["direction_weights"], i + 1)
+        # Columns that are 0 at every node contribute exact zeros.
+        w = [mi.Float64(dr.maximum(dr.fma(frac, b[k] - a[k], a[k]), 0.0)) if k in columns
+             else mi.Float64(0.0) for k in range(4)]
+        total = sum(w[k] for k in columns)
         ok = total > 0.0
-        return [dr.select(ok, w[0] / total, 1.0)] + [dr.select(ok, x / total, 0.0) for x in w[1:]]
+        return [dr.select(ok, w[0] / total, 1.0)] + [
+            dr.select(ok, w[k] / total, 0.0) if k in columns else w[k] for k in range(1, 4)]
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
@@ -376,11 +405,19 @@ class _Channel:
     @staticmethod
     def _solve_azimuth(a, b, big_h, target):
         """`halo::solve_azimuth`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until it converges, at most 40 steps)."""
+        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL`, at most 40
+        steps)."""
         total = a * dr.sin(big_h) + b * big_h
         psi = dr.select(total > 0.0, big_h * dr.clip(target / total, 0.0, 1.0), 0.0)
         return _newton_in_bracket(lambda psi: a * dr.sin(psi) + b * psi - target,
-                                  lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h), 1e-12)
+                                  lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h),
+                                  _NEWTON_TOL)
+
+    def _radial_inv_m(self, sin_i):
+        """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
 
     def spectrum_pdf(self, wi, wo):
         """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
@@ -388,9 +425,7 @@ class _Channel:
         if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
             return mi.Float64(0.0)
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
+        inv_m = self._radial_inv_m(sin_i)
         dx, dy = wo.x + wi.x, wo.y + wi.y
         r = dr.sqrt(dx * dx + dy * dy)
         x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
@@ -578,7 +613,8 @@ class _Channel:
     @staticmethod
     def _solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral):
         """`visible::solve_cell`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until it converges, at most 40 steps)."""
+        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL` of the
+        cell's scale, at most 40 steps)."""
         a = c - sn * x0
 
         def density(t):
@@ -589,7 +625,7 @@ class _Channel:
         disc = f0 * f0 + 2.0 * b * rest
         denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
         t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
-        tol = 1e-13 * (dr.abs(x0) + tau_max)
+        tol = _NEWTON_TOL * (dr.abs(x0) + tau_max)
         return _newton_in_bracket(lambda t: cell_integral(x0, p0, k, t) - rest, density,
                                   t, mi.Float64(tau_max), tol)
 
@@ -613,9 +649,7 @@ class _Channel:
         whether it exists (f64)."""
         s = self.s
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
+        inv_m = self._radial_inv_m(sin_i)
         b, c = self.d["big_b"], self.d["c"]
         m = 1.0 / inv_m
         # ln_1pf and exp_m1f of the runtime, in f64.
@@ -737,7 +771,8 @@ class _Channel:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float64(0.0))
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
@@ -765,13 +800,15 @@ class Model:
     def __init__(self, material: twoscale.Material, params=None, bakes=None):
         self.material = material
         self.params = default_params(material) if params is None else params
-        self.channels = [_Channel(b) for b in (material.bakes() if bakes is None else bakes)]
+        bakes = material.bakes() if bakes is None else bakes
+        self.channels = [_Channel(b) for b in bakes]
         first = self.channels[0].s
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
         self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
         self.height_correlated = first["height_correlated"] != 0.0
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
+        self.diffraction_stack = _diffraction_stack(self.channels, bakes)
 
     def d(self, h):
         """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
@@ -889,16 +926,27 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
     lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
     m, ok = model.channels[0].visible_sample(wi, u1, u2)
     o = 2.0 * dr.dot(wi, m) * m - wi
-    for n, channel in enumerate(model.channels):
-        if channel.diffraction:
-            od, ok_d = channel.diffraction_sample(wi, u1, u2)
-            here = (lobe == 1) & selected[n]
-            o = dr.select(here, od, o)
-            ok = dr.select(here, ok_d, ok)
-    r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-    ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-    o = dr.select(lobe >= 2, ob, o)
-    ok = dr.select(lobe >= 2, True, ok)
+    if getattr(model, "diffraction_stack", None) is not None:
+        # One draw from each lane's own channel.
+        k = mi.UInt32(0)
+        for n in range(1, len(selected)):
+            k = dr.select(selected[n], n, k)
+        od, ok_d = model.diffraction_stack.at(k).diffraction_sample(wi, u1, u2)
+        o = dr.select(lobe == 1, od, o)
+        ok = dr.select(lobe == 1, ok_d, ok)
+    else:
+        for n, channel in enumerate(model.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & selected[n]
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+    if any(n in ch.weight_columns for ch in model.channels for n in (2, 3)):
+        # The cosine lobe (traced only when some channel can pick lobe 2 or 3).
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe >= 2, ob, o)
+        ok = dr.select(lobe >= 2, True, ok)
     ok &= ~((lobe == 1) & ~model.channels_have_diffraction)
     o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
     ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
@@ -970,6 +1018,7 @@ class _NodeChannel(_Channel):
         if clash:
             raise ValueError(f"twoscale: the spectral models differ in {clash}")
         super().__init__({k: (v[0] if k in per_node else v) for k, v in models.items()})
+        self.specialise(models)
         stacked = {k: models[k] for k in per_node}
         stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
         arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
@@ -1004,6 +1053,24 @@ class _NodeChannel(_Channel):
 
     def _node_row(self, i, n):
         return i + self.k * n
+
+
+def _diffraction_stack(channels, bakes):
+    """The channels' bakes as one :class:`_NodeChannel` (channel `k` at a
+    lane's `k`), so that `_draw` runs one diffraction draw per lane, from its
+    own channel, rather than one per channel; None with fewer than two
+    channels, one without the lobe, or channels that differ in what
+    `_NodeChannel` shares."""
+    if len(channels) < 2 or not all(ch.diffraction for ch in channels):
+        return None
+    per_node = [k for k, v in bakes[0].items()
+                if any(not np.array_equal(v, b[k]) for b in bakes[1:])]
+    models = {k: (np.stack([b[k] for b in bakes]) if k in per_node else v)
+              for k, v in bakes[0].items()}
+    try:
+        return _NodeChannel(models, per_node, len(bakes))
+    except ValueError:
+        return None
 
 
 class SpectralModel(Model):
