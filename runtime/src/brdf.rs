@@ -693,8 +693,16 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             let (x_scale, sigma_s_sq, options) = (self.x_scale, self.sigma_s_sq, self.options);
             let (direction, masking) = (&bake.direction, &bake.masking);
             // The halo's factors besides C and the projections: Q̄ G (1 − A)/σrel².
+            let g1 =
+                |z: f64| f64::from(masking.g1(math::sqrt((1.0 - z * z).max(0.0)) as f32, z as f32));
+            // The incidence's values, computed once per row.
+            let row = core::cell::Cell::new((f64::NAN, direction.at(1.0), 1.0));
             let weight = |cos_i: f64, cos_d: f64, cos_o: f64, along: f64, across: f64| {
-                let (at_i, at_o) = (direction.at(cos_i as f32), direction.at(cos_o as f32));
+                if row.get().0 != cos_i {
+                    row.set((cos_i, direction.at(cos_i as f32), g1(cos_i)));
+                }
+                let (_, at_i, g1_i) = row.get();
+                let at_o = direction.at(cos_o as f32);
                 let q = if white {
                     1.0
                 } else {
@@ -711,12 +719,9 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
                     HaloWeight::Incident => cos_i,
                 };
                 let halo = exp_and_one_minus_over(x_scale * cos_a * cos_a, sigma_rel_sq).1;
-                let g1 = |z: f64| {
-                    f64::from(masking.g1(math::sqrt((1.0 - z * z).max(0.0)) as f32, z as f32))
-                };
                 let g = match options.masking {
-                    Masking::Separable => g1(cos_i) * g1(cos_o),
-                    Masking::HeightCorrelated => 1.0 / (1.0 / g1(cos_i) + 1.0 / g1(cos_o) - 1.0),
+                    Masking::Separable => g1_i * g1(cos_o),
+                    Masking::HeightCorrelated => 1.0 / (1.0 / g1_i + 1.0 / g1(cos_o) - 1.0),
                 };
                 q * halo * g
             };

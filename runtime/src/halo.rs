@@ -12,7 +12,7 @@
 //! `∝ (i·h) (cos θo)₊`, which holds two of the halo's factors exactly; the
 //! row's node values are the ζ density that minimises the weight's second
 //! moment given that law, `√(N(θh) ∫ (i·h)(cos θo)₊ (C(θh; B i·h) W)² dψ)`
-//! with `W = Q̄ G (1 − A)/σrel²` at the row's incidence (6-point
+//! with `W = Q̄ G (1 − A)/σrel²` at the row's incidence (4-point
 //! Gauss–Legendre in ψ):
 //!
 //! ```text
@@ -368,21 +368,17 @@ fn row_value(
 }
 
 /// Gauss–Legendre nodes and weights on [−1, 1] for [`row_value`].
-const GL_X: [f64; 6] = [
-    -0.932469514203152,
-    -0.661209386466265,
-    -0.238619186083197,
-    0.238619186083197,
-    0.661209386466265,
-    0.932469514203152,
+const GL_X: [f64; 4] = [
+    -0.861136311594053,
+    -0.339981043584856,
+    0.339981043584856,
+    0.861136311594053,
 ];
-const GL_W: [f64; 6] = [
-    0.171324492379170,
-    0.360761573048139,
-    0.467913934889696,
-    0.467913934889696,
-    0.360761573048139,
-    0.171324492379170,
+const GL_W: [f64; 4] = [
+    0.347854845137454,
+    0.652145154862546,
+    0.652145154862546,
+    0.347854845137454,
 ];
 
 /// At most this many Newton steps for the azimuth (bisection alone would
