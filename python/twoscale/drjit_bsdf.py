@@ -124,7 +124,7 @@ def _newton_in_bracket(residual, slope, t, hi, tol):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
-    steps (`visible::solve_cell`, `halo::solve_azimuth`)."""
+    steps (`visible::solve_cell`, `halo::Azimuth::solve`)."""
     lo = dr.zeros(mi.Float64, dr.width(t))
 
     def body(step, done, t, lo, hi):
@@ -311,7 +311,7 @@ class _Channel:
         and the half-vector draw (`HaloBake::pdf`), f64."""
         share = self.s["halo_spectrum_share"]
         spectrum = self.spectrum_pdf(wi, wo)
-        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"]), 0.0)
+        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z), 0.0)
         return share * spectrum + (1.0 - share) * half
 
     def _row_cell(self, wi):
@@ -333,12 +333,23 @@ class _Channel:
         return mi.Float64(dr.gather(mi.Float, self.t[name], row * n_s + k))
 
     @staticmethod
-    def _half_range(a, b):
-        """`halo::half_range`: `(H, sin H)`."""
-        x = b / a
-        wide = b >= a
-        return (dr.select(wide, math.pi, _acos_approx(-x)),
-                dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0))))
+    def _azimuth(sin_i, cos_i, sin_h, cos_h):
+        """`halo::Azimuth::new`: `(H, [A₂, A₁, A₀], F(H))` of the azimuth law
+        `∝ (i·h)(cos θo)₊` and whether it exists (f64)."""
+        a, b = sin_i * sin_h, cos_i * cos_h
+        kappa = cos_i / (2.0 * cos_h)
+        wide = b - a >= kappa
+        exists = (cos_h > 0.0) & (wide | (b + a > kappa))
+        big_h = dr.select(wide, math.pi, _acos_approx(dr.clip((kappa - b) / a, -1.0, 1.0)))
+        coef = (2.0 * cos_h * a * a, (4.0 * cos_h * b - cos_i) * a, (2.0 * cos_h * b - cos_i) * b)
+        half = _Channel._azimuth_cdf(coef, big_h)
+        return big_h, coef, half, exists & (half > 0.0)
+
+    @staticmethod
+    def _azimuth_cdf(coef, psi):
+        """`halo::cdf`: `A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ`."""
+        s, c = dr.sin(psi), dr.cos(psi)
+        return 0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
 
     def _row_pdf(self, row, z):
         """`HaloBake::row_pdf`."""
@@ -354,17 +365,15 @@ class _Channel:
         ok = (total > 0.0) & (z <= self._halo_node("halo_zeta", row, n_s - 1)) & (cell > 0.0)
         return dr.select(ok, mass / total * d / cell, 0.0)
 
-    def halo_pdf(self, wi, sin_h, cos_h):
-        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) / (4 N(θh))`, f64."""
+    def halo_pdf(self, wi, sin_h, cos_h, cos_o):
+        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`, f64."""
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        a, b = sin_i * sin_h, wi.z * cos_h
-        big_h, sin_big_h = self._half_range(a, b)
-        norm = 2.0 * (a * sin_big_h + b * big_h)
+        _, _, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
         zeta = sin_h * sin_h / (1.0 + cos_h)
         j, t = self._row_cell(wi)
         p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta), 0.0)
         p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta), 0.0)
-        return dr.select(norm > 0.0, p / (4.0 * norm), 0.0)
+        return dr.select(exists, p * dr.maximum(cos_o, 0.0) / (8.0 * half), 0.0)
 
     def halo_sample(self, wi, pick, along):
         """`HaloBake::sample_h`: a half-vector (f64) and whether the row had mass."""
@@ -389,29 +398,27 @@ class _Channel:
         cos_h = 1.0 - z
         sin_h = dr.sqrt(dr.maximum(z * (2.0 - z), 0.0))
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        a, b = sin_i * sin_h, wi.z * cos_h
         side = dr.select(azimuth < 0.5, -1.0, 1.0)
         rest = dr.select(azimuth < 0.5, 2.0 * azimuth, 2.0 * azimuth - 1.0)
-        big_h, sin_big_h = self._half_range(a, b)
-        psi = side * self._solve_azimuth(a, b, big_h, rest * (a * sin_big_h + b * big_h))
+        big_h, coef, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
+        psi = side * self._solve_azimuth(coef, big_h, half, rest * half)
         has = sin_i > 0.0
         cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
         sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
         cp, sp = dr.cos(psi), dr.sin(psi)
         h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
                         sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
-        return h, total > 0.0
+        return h, (total > 0.0) & exists
 
     @staticmethod
-    def _solve_azimuth(a, b, big_h, target):
-        """`halo::solve_azimuth`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL`, at most 40
-        steps)."""
-        total = a * dr.sin(big_h) + b * big_h
-        psi = dr.select(total > 0.0, big_h * dr.clip(target / total, 0.0, 1.0), 0.0)
-        return _newton_in_bracket(lambda psi: a * dr.sin(psi) + b * psi - target,
-                                  lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h),
-                                  _NEWTON_TOL)
+    def _solve_azimuth(coef, big_h, half, target):
+        """`Azimuth::solve`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL`, at most 40 steps)."""
+        psi = dr.select(half > 0.0, big_h * dr.clip(target / half, 0.0, 1.0), 0.0)
+        return _newton_in_bracket(
+            lambda psi: _Channel._azimuth_cdf(coef, psi) - target,
+            lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
+            psi, mi.Float64(big_h), _NEWTON_TOL)
 
     def _radial_inv_m(self, sin_i):
         """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""

@@ -672,6 +672,7 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
     /// [`SurfaceBakes::bake_into`]'s).
     fn bake_wavelength(&mut self, tables: &Tables<'a>, shared: &SurfaceBakes<'a>, eta: Complex) {
         let (surface, big_b, q) = (self.surface, self.big_b, self.q);
+        let white = self.white();
         let sigma_s = f64::from(surface.sigma_s);
         let bake = self.bake.borrow_mut();
         bake.direction.init(
@@ -692,7 +693,42 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             None => false,
         };
         if bake.conv_baked {
-            bake.halo.init(&bake.conv);
+            let (x_scale, sigma_s_sq, options) = (self.x_scale, self.sigma_s_sq, self.options);
+            let (direction, masking) = (&bake.direction, &bake.masking);
+            // The halo's factors besides C and the projections: Q̄ G (1 − A)/σrel².
+            let g1 =
+                |z: f64| f64::from(masking.g1(math::sqrt((1.0 - z * z).max(0.0)) as f32, z as f32));
+            // The incidence's values, computed once per row.
+            let row = core::cell::Cell::new((f64::NAN, direction.at(1.0), 1.0));
+            let weight = |cos_i: f64, cos_d: f64, cos_o: f64, along: f64, across: f64| {
+                if row.get().0 != cos_i {
+                    row.set((cos_i, direction.at(cos_i as f32), g1(cos_i)));
+                }
+                let (_, at_i, g1_i) = row.get();
+                let at_o = direction.at(cos_o as f32);
+                let q = if white {
+                    1.0
+                } else {
+                    match &q {
+                        Some(q) => q
+                            .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
+                            .max(0.0),
+                        None => 0.0,
+                    }
+                };
+                let sigma_rel_sq = sigma_s_sq * sigma_ratio_sq(options.sigma_rel, &at_i, &at_o);
+                let cos_a = match options.halo_weight {
+                    HaloWeight::Printed => cos_d,
+                    HaloWeight::Incident => cos_i,
+                };
+                let halo = exp_and_one_minus_over(x_scale * cos_a * cos_a, sigma_rel_sq).1;
+                let g = match options.masking {
+                    Masking::Separable => g1_i * g1(cos_o),
+                    Masking::HeightCorrelated => 1.0 / (1.0 / g1_i + 1.0 / g1(cos_o) - 1.0),
+                };
+                q * halo * g
+            };
+            bake.halo.init(&bake.conv, &weight);
         }
         let specular = tables
             .albedo
@@ -933,16 +969,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
     fn sigma_ratio_sq(&self, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
-        match self.options.sigma_rel {
-            SigmaRelMode::Incident => {
-                let r = at_i.sigma_ratio();
-                r * r
-            }
-            SigmaRelMode::Symmetrised => {
-                let (a, b) = (at_i.sigma_ratio(), at_o.sigma_ratio());
-                0.5 * (a * a + b * b)
-            }
-        }
+        sigma_ratio_sq(self.options.sigma_rel, at_i, at_o)
     }
 
     /// The geometry of `(i, o)`; `None` below the horizon.
@@ -1315,13 +1342,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * specular: the density of reflecting `i` about a visible EPD normal
     ///   (the tabulated `D_vis`, `crate::visible`: `P2_tab g_tab / (8 N_tab β²
     ///   |i'| cos⁴θh)`, docs/model.md §2.1), 0 where `i·h ≤ 0`;
-    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (`SPECTRUM_SHARE` = 0.1
-    ///   ε; the spectrum's alone when C is not baked). The spectrum's
+    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (ε =
+    ///   `SPECTRUM_SHARE`, 0: the half-vector draw alone; the spectrum's
+    ///   alone when C is not baked). The spectrum's
     ///   (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
     ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`; the
-    ///   half-vector draw's `Σ_j w_j p_j(ζ) / (4 N(θh))` (`crate::halo`);
+    ///   half-vector draw's `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))` (`crate::halo`);
     /// * base and multiple: `cos θo / π`.
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
@@ -1380,17 +1408,21 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             sin_h,
             ..
         } = *geometry;
-        let spectrum = self.spectrum_pdf(wi, wo);
         match self.bake().halo() {
             Some(halo) => {
                 let half = if cos_d > 0.0 {
-                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h)
+                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h, wo[2])
+                } else {
+                    0.0
+                };
+                let spectrum = if SPECTRUM_SHARE > 0.0 {
+                    self.spectrum_pdf(wi, wo)
                 } else {
                     0.0
                 };
                 SPECTRUM_SHARE * spectrum + (1.0 - SPECTRUM_SHARE) * half
             }
-            None => spectrum,
+            None => self.spectrum_pdf(wi, wo),
         }
     }
 
@@ -1422,7 +1454,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///
     /// * specular: `m` a visible normal of the EPD (the tabulated visible-slope
     ///   sampler of docs/model.md §2.1, `u` its two uniforms), `o = 2(i·m)m − i`;
-    /// * diffraction: with probability ε (`SPECTRUM_SHARE` = 0.1, picked by `u₁`,
+    /// * diffraction: with probability ε (`SPECTRUM_SHARE`, 0; picked by `u₁`,
     ///   rescaled) the spectrum's draw, else the half-vector draw of
     ///   `crate::halo` reflected; the spectrum's draw
     ///   (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
@@ -1591,8 +1623,24 @@ fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
 }
 
 /// The share of the spectrum's draw (HP17 51-55) in the diffraction lobe's
-/// mixture with the half-vector draw (docs/design/halo-sampling.md).
-const SPECTRUM_SHARE: f64 = 0.1;
+/// mixture with the half-vector draw where C is baked: 0, the half-vector
+/// draw follows the halo closer everywhere measured
+/// (docs/design/halo-sampling.md).
+const SPECTRUM_SHARE: f64 = 0.0;
+
+/// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
+fn sigma_ratio_sq(mode: SigmaRelMode, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
+    match mode {
+        SigmaRelMode::Incident => {
+            let r = at_i.sigma_ratio();
+            r * r
+        }
+        SigmaRelMode::Symmetrised => {
+            let (a, b) = (at_i.sigma_ratio(), at_o.sigma_ratio());
+            0.5 * (a * a + b * b)
+        }
+    }
+}
 
 /// Nodes of [`TwoScale::halo_deficit`] over `√cos θi` (linear between).
 const DEFICIT_NODES: usize = 17;
