@@ -47,6 +47,9 @@ def measure(variant, size, spp, repeat, evaluated):
         "roughconductor beckmann": {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.1,
                                     "eta": {"type": "rgb", "value": eta}, "k": {"type": "rgb", "value": k}},
     }
+    if mi.is_rgb:
+        bsdfs["twoscale gold-hp17-geometry, integrated RGB"] = {
+            "type": "twoscale", "material": "gold-hp17-geometry", "rgb_mode": "integrated"}
     look = mi.ScalarTransform4f().look_at(origin=[0, 0, 4.5], target=[0, 0, 0], up=[0, 1, 0])
     cost = {}
     for name, bsdf in bsdfs.items():

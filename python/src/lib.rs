@@ -703,6 +703,29 @@ impl Material {
             .collect()
     }
 
+    /// integrated_bakes(): the colour weights and bakes of the integrated
+    /// RGB model (`rgb_mode="integrated"`), for ports of `eval`, `pdf` and
+    /// `sample` (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 8
+    /// models', µm), `surface` (`[nodes, 8, 3]`: the surface lobes' weights
+    /// over `√cos θd`), `plain` (`[8, 3]`), `sampler_nodes` (the 3 models the
+    /// sampler mixes) and `models`, a list of 8 dicts as `bakes()` gives
+    /// them (not a stable interface). For `rgb_mode="integrated"` only.
+    fn integrated_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let RgbModel::Integrated(model) = &*self.model else {
+            return Err(value_error(
+                "integrated_bakes() gives the integrated RGB model: build the material with rgb_mode='integrated'",
+            ));
+        };
+        let dict = bake_dict(py, |v| model.visit_colour(v))?;
+        let models = model
+            .nodes()
+            .iter()
+            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
+            .collect::<PyResult<Vec<_>>>()?;
+        dict.set_item("models", models)?;
+        Ok(dict)
+    }
+
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
     /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),

@@ -19,8 +19,8 @@
 //! out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
 use super::{
-    ChannelBake, ColourTerms, Geometry, Options, RgbSample, SurfaceBakes, Tables, TwoScale,
-    finite_or_zero,
+    BakeVisitor, ChannelBake, ColourTerms, Geometry, Options, RgbSample, SurfaceBakes, Tables,
+    TwoScale, finite_or_zero,
 };
 use crate::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use crate::fresnel::fresnel;
@@ -202,6 +202,30 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     /// The one-wavelength models, at [`INTEGRATED_WAVELENGTHS`].
     pub fn nodes(&self) -> &[TwoScale<'_, B>; INTEGRATED_COUNT] {
         &self.nodes
+    }
+
+    /// Hands the colour weights to `v`, for ports of [`IntegratedRgb::eval`]
+    /// and [`IntegratedRgb::sample`] (the Python package's
+    /// `Material.integrated_bakes()`): `wavelengths` ([`INTEGRATED_WAVELENGTHS`],
+    /// µm), `surface` (`R_kc` at the `√cos θd` nodes, `[nodes, 8, 3]`),
+    /// `plain` (`P_kc`, `[8, 3]`) and `sampler_nodes` (the nodes whose
+    /// samplers [`IntegratedRgb::sample`] mixes, as numbers). Each node's
+    /// bakes are its [`TwoScale::visit_bakes`].
+    #[doc(hidden)]
+    pub fn visit_colour(&self, v: &mut dyn BakeVisitor) {
+        v.array("wavelengths", &[INTEGRATED_COUNT], &INTEGRATED_WAVELENGTHS);
+        let surface = self.colour.surface.as_flattened().as_flattened();
+        v.array("surface", &[COLOUR_NODES, INTEGRATED_COUNT, 3], surface);
+        v.array(
+            "plain",
+            &[INTEGRATED_COUNT, 3],
+            self.colour.plain.as_flattened(),
+        );
+        v.array(
+            "sampler_nodes",
+            &[SAMPLER_NODES.len()],
+            &SAMPLER_NODES.map(|k| k as f32),
+        );
     }
 
     /// ρ(i, o) per linear-sRGB channel (module documentation).
