@@ -258,9 +258,10 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 /// 0.444 µm), or the index over the spectrum `(lam, n, k)`, three 1-D arrays
 /// of one length (λ in µm, increasing; linear in 1/λ between rows; three
 /// arrays of two values are read as (n, k) pairs); `rgb_mode`: one of
-/// `RGB_MODES`, "paper-wavelengths" (the default: ρ at `RGB_WAVELENGTHS`) or
-/// "integrated" (the integral over the spectrum, docs/model.md §2.12; needs
-/// a spectrum, or one (n, k) for every channel); `base`: one of `BASES`;
+/// `RGB_MODES`, "paper-wavelengths" (ρ at `RGB_WAVELENGTHS`; the default for
+/// (n, k) pairs) or "integrated" (the integral over the spectrum,
+/// docs/model.md §2.12; the default for a spectrum; needs a spectrum, or one
+/// (n, k) for every channel); `base`: one of `BASES`;
 /// `albedo`: the base layer's, in [0, 1]
 /// (plastic or subsurface only); `lambertian`: the weight k_d in [0, 1] of a
 /// Lambertian term. A keyword left out (None) takes the runtime's default:
@@ -483,7 +484,9 @@ impl Material {
     /// halo_weight=None, multiple_scattering=None, rgb_mode=None): the shipped
     /// preset `name` (`Material.presets()` lists them; its measured index
     /// over the spectrum) with the given options (names as in `OPTIONS` and
-    /// `RGB_MODES`; None: the runtime's default, the paper's wavelengths).
+    /// `RGB_MODES`; None: the runtime's default: the paper's model, and the
+    /// RGB by integration over the spectrum; `rgb_mode="paper-wavelengths"`
+    /// reproduces HP15/HP17's RGB).
     #[staticmethod]
     #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None,
         multiple_scattering=None, rgb_mode=None))]
@@ -499,7 +502,8 @@ impl Material {
         let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
         let options = options(masking, sigma_rel, colour, halo_weight, multiple_scattering)?;
-        let desc = MaterialDesc::spectral(spectral, options, named(rgb_mode)?)
+        let rgb_mode = validate::named_or_none(rgb_mode).map_err(|e| value_error(e.to_string()))?;
+        let desc = MaterialDesc::spectral(spectral, options, rgb_mode)
             .map_err(|e| value_error(e.to_string()))?;
         Ok(Material::build(&desc))
     }
@@ -773,7 +777,7 @@ impl Material {
                     ..spectral.get()
                 },
                 self.options,
-                self.rgb_mode,
+                Some(self.rgb_mode),
             ),
             None => MaterialDesc::rgb(
                 twoscale::brdf::Material {
@@ -781,7 +785,7 @@ impl Material {
                     ..self.material
                 },
                 self.options,
-                self.rgb_mode,
+                Some(self.rgb_mode),
             ),
         }
         .map_err(|e| value_error(e.to_string()))?;

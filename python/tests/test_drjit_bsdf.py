@@ -76,7 +76,7 @@ def relative_error(got, ref):
 def test_bakes_are_the_runtime_bakes():
     """Material.bakes(): three channels of named scalars and float32 arrays,
     at the channels' wavelengths, with the layouts the port reads."""
-    m = twoscale.Material.preset("gold-hp17-geometry")
+    m = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths")
     bakes = m.bakes()
     assert len(bakes) == 3
     assert [round(b["lambda"], 3) for b in bakes] == [0.645, 0.526, 0.444]
@@ -102,12 +102,13 @@ MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
     ("gold-rough", {"multiple_scattering": "kulla-conty"}),
     ("white-plastic", {"multiple_scattering": "kulla-conty"}),
 ] + [
-    # The integrated RGB (`tb.IntegratedModel`): a halo, a polished lobe, a
+    # The paper's wavelengths (`tb.Model`; the presets' default is the
+    # integrated RGB, `tb.IntegratedModel`): a halo, a polished lobe, a
     # plastic and a subsurface base, compensation, white colour terms.
-    (name, {"rgb_mode": "integrated", **options}) for name, options in [
+    (name, {"rgb_mode": "paper-wavelengths", **options}) for name, options in [
         ("gold-hp17-geometry", {}), ("gold-polished", {}), ("silver", {}), ("white-plastic", {}),
         ("marble", {}), ("gold-rough", {"multiple_scattering": "kulla-conty"}),
-        ("white-plastic", {"colour": "white"}),
+        ("white-plastic", {"colour": "white"}), ("gold-hp17-geometry", {"masking": "height-correlated"}),
     ]
 ]
 
@@ -242,9 +243,9 @@ CHI2_CASES = [
     ("strong halo, grazing 80°", STRONG_HALO, 80.0),
     ("compensated gold-rough, 60°",
      dict(material="gold-rough", multiple_scattering="kulla-conty"), 60.0),
-    ("integrated gold-hp17-geometry, 40°",
-     dict(material="gold-hp17-geometry", rgb_mode="integrated"), 40.0),
-    ("integrated silver, grazing 80°", dict(material="silver", rgb_mode="integrated"), 80.0),
+    ("paper's wavelengths gold-hp17-geometry, 40°",
+     dict(material="gold-hp17-geometry", rgb_mode="paper-wavelengths"), 40.0),
+    ("silver, grazing 80°", dict(material="silver"), 80.0),
 ]
 
 
@@ -257,9 +258,9 @@ def test_chi2(label, props, theta):
     assert test.passed, test.messages
 
 
-@pytest.mark.parametrize("name,theta,rgb_mode", [("gold-rough", 30, "paper-wavelengths"),
-                                                  ("gold-hp17-geometry", 60, "paper-wavelengths"),
-                                                  ("gold-rough", 45, "integrated")])
+@pytest.mark.parametrize("name,theta,rgb_mode", [("gold-rough", 30, "integrated"),
+                                                  ("gold-hp17-geometry", 60, "integrated"),
+                                                  ("gold-rough", 45, "paper-wavelengths")])
 def test_white_furnace(name, theta, rgb_mode):
     """A render with the plugin (symbolic mode on) estimates the albedo of
     the white-colour material, ∫ ρ cos θi dωi by quadrature over the

@@ -293,17 +293,33 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
 }
 
 /// Which RGB a material's model gives: the paper's three wavelengths
-/// ([`super::Rgb`], HP15 §5.5; the default, which the Dr.Jit plugin, T4
-/// and the docs' figures mirror) or the integral over the spectrum
-/// ([`IntegratedRgb`], docs/model.md §2.12). Named `rgb_mode` in material
-/// files and Python, `ts_material_desc.rgb_mode` in C.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// ([`super::Rgb`], HP15 §5.5; what reproduces HP15/HP17) or the integral
+/// over the spectrum ([`IntegratedRgb`], docs/model.md §2.12). Named
+/// `rgb_mode` in material files and Python, `ts_material_desc.rgb_mode` in
+/// C. When none is given, [`RgbMode::default_for`] decides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RgbMode {
     /// ρ at 0.645, 0.526, 0.444 µm as red, green, blue.
-    #[default]
     PaperWavelengths,
     /// `ρ_c = ∫ ρ(λ) w_c(λ) dλ` (needs the index over the spectrum).
     Integrated,
+}
+
+impl RgbMode {
+    /// The mode of a material that names none: [`RgbMode::Integrated`] for
+    /// a material given over the spectrum (every preset; `eta = (lambda,
+    /// n, k)`), [`RgbMode::PaperWavelengths`] for one given by its index at
+    /// the paper's three wavelengths (or one constant index), which
+    /// integration would only interpolate. The one place that decides it
+    /// ([`crate::desc::MaterialDesc::rgb`] and
+    /// [`crate::desc::MaterialDesc::spectral`] call it).
+    pub const fn default_for(over_spectrum: bool) -> RgbMode {
+        if over_spectrum {
+            RgbMode::Integrated
+        } else {
+            RgbMode::PaperWavelengths
+        }
+    }
 }
 
 /// The RGB model of [`RgbMode`]: [`super::Rgb`] or [`IntegratedRgb`].
