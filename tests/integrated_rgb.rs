@@ -3,7 +3,7 @@
 //! one-wavelength models, and its sampler against its pdf.
 
 use generator::rng::SplitMix64;
-use generator::spectral_accuracy::{direction, five_nm, five_nm_models as spectral_models};
+use generator::spectral_accuracy::{direction, integrated_errors};
 use suite::brdf::chi_square_sampler;
 use twoscale::TableSet;
 use twoscale::brdf::{BaseLayer, ColourTerms, IntegratedRgb, Layer, Options, Surface, TwoScale};
@@ -20,34 +20,9 @@ fn errors(
     options: Options,
     seed: u64,
 ) -> (f64, f64, usize) {
-    let model = IntegratedRgb::boxed(tables, material, options);
-    let reference = spectral_models(tables, material, options);
-    let mut rng = SplitMix64::new(seed);
-    let mut rows = Vec::new();
-    for k in 0..600 {
-        let i = direction(&mut rng);
-        let o = if k % 2 == 0 {
-            direction(&mut rng)
-        } else {
-            let u = [0, 1, 2].map(|_| rng.uniform() as f32);
-            match model.sample(i, u) {
-                Some(s) => s.o,
-                None => continue,
-            }
-        };
-        rows.push((five_nm(&reference, i, o), model.eval(i, o)));
-    }
-    let peak = rows
-        .iter()
-        .flat_map(|(r, _)| r.iter().copied())
-        .fold(0.0, f64::max);
-    let mut errors: Vec<f64> = rows
-        .iter()
-        .flat_map(|(r, v)| {
-            (0..3)
-                .filter(move |&c| r[c] > 1e-3 * peak)
-                .map(move |c| (f64::from(v[c]) - r[c]).abs() / r[c])
-        })
+    let mut errors: Vec<f64> = integrated_errors(tables, material, options, 600, seed)
+        .into_iter()
+        .map(|(e, _)| e)
         .collect();
     let p99 = suite::brdf::percentile(&mut errors, 0.99);
     (p99, *errors.last().unwrap(), errors.len())

@@ -40,6 +40,20 @@ pub fn direction(rng: &mut SplitMix64) -> [f32; 3] {
     [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
 }
 
+/// The exit direction of pair `k`: [`direction`] for even `k`, else
+/// `sample`'s draw from three uniforms (`None`: it drew none).
+fn exit(
+    k: usize,
+    rng: &mut SplitMix64,
+    sample: impl FnOnce([f32; 3]) -> Option<[f32; 3]>,
+) -> Option<[f32; 3]> {
+    if k.is_multiple_of(2) {
+        Some(direction(rng))
+    } else {
+        sample([0, 1, 2].map(|_| rng.uniform() as f32))
+    }
+}
+
 /// The 85 one-wavelength models of the CIE 5 nm sum of `material`.
 pub fn five_nm_models<'a>(
     tables: &Tables<'a>,
@@ -91,14 +105,8 @@ pub fn integrated_errors(
     let mut rows = Vec::new();
     for k in 0..pairs {
         let i = direction(&mut rng);
-        let o = if k % 2 == 0 {
-            direction(&mut rng)
-        } else {
-            let u = [0, 1, 2].map(|_| rng.uniform() as f32);
-            match model.sample(i, u) {
-                Some(s) => s.o,
-                None => continue,
-            }
+        let Some(o) = exit(k, &mut rng, |u| model.sample(i, u).map(|s| s.o)) else {
+            continue;
         };
         let (sum, value) = (five_nm(&reference, i, o), model.eval(i, o));
         for c in 0..3 {
@@ -132,14 +140,8 @@ pub fn spectral_errors(
         );
         for k in 0..pairs {
             let i = direction(&mut rng);
-            let o = if k % 2 == 0 {
-                direction(&mut rng)
-            } else {
-                let u = [0, 1, 2].map(|_| rng.uniform() as f32);
-                match one.sample(i, u) {
-                    Some(s) => s.o,
-                    None => continue,
-                }
+            let Some(o) = exit(k, &mut rng, |u| one.sample(i, u).map(|s| s.o)) else {
+                continue;
             };
             let at = format!("λ = {lambda} µm, i = {i:?}, o = {o:?}");
             rows.push((

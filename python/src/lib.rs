@@ -721,13 +721,7 @@ impl Material {
             ));
         };
         let dict = bake_dict(py, |v| model.visit_colour(v))?;
-        let models = model
-            .nodes()
-            .iter()
-            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
-            .collect::<PyResult<Vec<_>>>()?;
-        dict.set_item("models", models)?;
-        Ok(dict)
+        with_models(py, dict, model.nodes())
     }
 
     /// spectral_bakes(): the constants and bakes of the model at any
@@ -745,13 +739,7 @@ impl Material {
         };
         let model = self.spectral_model(spectral);
         let dict = bake_dict(py, |v| model.visit_index(v))?;
-        let models = model
-            .nodes()
-            .iter()
-            .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
-            .collect::<PyResult<Vec<_>>>()?;
-        dict.set_item("models", models)?;
-        Ok(dict)
+        with_models(py, dict, model.nodes())
     }
 
     /// with_layer(*, albedo=None, lambertian=None): this material with the
@@ -888,6 +876,20 @@ fn columns<const K: usize>(
         same_rows((names[0], n), (name, view.len()))?;
     }
     Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// `dict` with `models`: each of `nodes`' bakes as `bakes()` gives them.
+fn with_models<'py, B: std::borrow::Borrow<ChannelBake>>(
+    py: Python<'py>,
+    dict: Bound<'py, PyDict>,
+    nodes: &[twoscale::TwoScale<'_, B>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let models = nodes
+        .iter()
+        .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
+        .collect::<PyResult<Vec<_>>>()?;
+    dict.set_item("models", models)?;
+    Ok(dict)
 }
 
 /// The dict that `visit` fills through a [`DictVisitor`].
