@@ -41,7 +41,9 @@ def measure(variant, size, spp, repeat, evaluated):
         # an explicit material needs one index for every channel in spectral variants
         eta, k = [0.584] * 3, [2.15] * 3
     bsdfs = {
-        "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
+        # The paper's wavelengths (the presets' default is the integrated RGB, below).
+        "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry",
+                                        "rgb_mode": "paper-wavelengths"},
         "twoscale Beckmann (p=1, σs=0)": {"type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
                                           "eta": ", ".join(f"{a} {b}" for a, b in zip(eta, k))},
         "roughconductor beckmann": {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.1,
