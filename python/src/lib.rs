@@ -649,7 +649,9 @@ impl Material {
     }
 
     /// eval_reference(wi, wo): the f64 reference ρ(wi, wo) per RGB channel
-    /// in sr⁻¹ (exact Λ, σrel and C; the reference crate's `brdf`), float64 of
+    /// at the paper's wavelengths whatever `rgb_mode` is (compare it with a
+    /// material built with `rgb_mode="paper-wavelengths"`) in sr⁻¹ (exact
+    /// Λ, σrel and C; the reference crate's `brdf`), float64 of
     /// shape `(..., 3)`, for conductors without a Lambertian term. Arguments
     /// as `eval`'s. Costs 1–30 ms per row and channel (on all cores).
     fn eval_reference<'py>(
