@@ -18,7 +18,11 @@ mixture of the spectrum's law and the halo's half-vector densities, the cosine l
 :meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
 loop, the diffraction lobe with the azimuth's Newton solve as another, and
-the cosine lobe). The plugin's ``sample`` draws the
+the cosine lobe). A material with ``rgb_mode="integrated"`` gets
+:class:`IntegratedModel` (``IntegratedRgb``, from
+:meth:`twoscale.Material.integrated_bakes`: the 8 models' lobes weighted by
+the colour weights; ``pdf`` and ``sample`` :class:`Model`'s over the three
+models the runtime's sampler mixes). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
@@ -1211,6 +1215,72 @@ class SpectralModel(Model):
         return _draw(one, [mi.Bool(True)], node.lobe_weights(wi.z), pick, wi, u1, u2, valid)
 
 
+class IntegratedModel(Model):
+    """The integrated RGB model (``brdf::IntegratedRgb``, ``rgb_mode =
+    "integrated"``) of a :class:`twoscale.Material` in Dr.Jit, from
+    :meth:`twoscale.Material.integrated_bakes`: the 8 models' lobes weighted
+    by the colour weights (``R_kc`` over `√cos θd` for the surface lobes,
+    ``P_kc`` for the base and compensation lobes); :meth:`eval` is
+    ``Material.eval``. ``pdf`` and ``sample_direction`` are :class:`Model`'s
+    over the three models the runtime's sampler mixes (``channels``), which
+    is ``IntegratedRgb::pdf`` and ``IntegratedRgb::sample``. `params` as
+    :class:`Model`'s."""
+
+    def __init__(self, material: twoscale.Material, params=None):
+        integrated = material.integrated_bakes()
+        models = integrated["models"]
+        sampler = [int(k) for k in integrated["sampler_nodes"]]
+        super().__init__(material, params, [models[k] for k in sampler])
+        shared = dict(zip(sampler, self.channels))
+        self.nodes = [shared[k] if k in shared else _Channel(b) for k, b in enumerate(models)]
+        self.colour_nodes = integrated["surface"].shape[0]
+        self.surface = mi.Float(np.ascontiguousarray(integrated["surface"], np.float32).ravel())
+        self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
+
+    def surface_weights(self, cos_d):
+        """``ColourBake::surface_at``: `R_kc` at `cos θd`, linear in
+        `√cos θd` between nodes, in f32 (a list over k of three values)."""
+        n = self.colour_nodes
+        t = dr.sqrt(dr.clip(mi.Float64(cos_d), 0.0, 1.0)) * (n - 1)
+        m = dr.minimum(mi.UInt32(dr.floor(t)), n - 2)
+        f = mi.Float(t - mi.Float64(m))
+        width = 3 * len(self.nodes)
+        out = []
+        for k in range(len(self.nodes)):
+            row = []
+            for c in range(3):
+                a = dr.gather(mi.Float, self.surface, m * width + 3 * k + c)
+                b = dr.gather(mi.Float, self.surface, (m + 1) * width + 3 * k + c)
+                row.append(a + f * (b - a))
+            out.append(row)
+        return out
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) in linear sRGB (sr⁻¹) as an ``mi.Color3f``
+        (``IntegratedRgb::eval``; arguments as :meth:`Model.eval`'s)."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
+        r = self.surface_weights(geo["cos_d"])
+        out = [mi.Float64(0.0)] * 3
+        for k, node in enumerate(self.nodes):
+            spec, diff, base, multiple = node.lobes(g, geo, self.params)
+            surface = mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff))
+            # The compensation lobe's colour is F_avg's, per node: plain weights.
+            rest = mi.Float64(mi.Float(base)) + mi.Float64(mi.Float(multiple))
+            out = [out[c] + surface * mi.Float64(r[k][c]) + rest * mi.Float64(self.plain[k][c])
+                   for c in range(3)]
+        values = [mi.Float(_finite_or_zero(dr.maximum(x, 0.0))) for x in out]
+        return dr.select(valid, mi.Color3f(*values), 0.0)
+
+
+def rgb_model(material: twoscale.Material, params=None):
+    """The Dr.Jit model of `material`'s RGB (its ``rgb_mode``):
+    :class:`IntegratedModel` or :class:`Model` (the paper's wavelengths)."""
+    if material.rgb_mode == "integrated":
+        return IntegratedModel(material, params)
+    return Model(material, params)
+
+
 def _scalar_bsdf_class():
     """The BSDF in scalar RGB variants: one direction per call, handed to
     the runtime (:class:`twoscale.Material`) directly; Dr.Jit's scalar
@@ -1283,7 +1353,7 @@ def bsdf_class():
             if mi.is_polarized or not (mi.is_rgb or mi.is_spectral):
                 raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
                                    "(rgb and unpolarised spectral variants are)")
-            self.model = (SpectralModel if mi.is_spectral else Model)(_material(props))
+            self.model = (SpectralModel if mi.is_spectral else rgb_model)(_material(props))
             self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             self.m_components = [self.m_flags]
 
