@@ -954,3 +954,40 @@ fn halo_sampling_chi2() {
     }
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// `sample` shares the lobe weights and the visible-normal sampler's
+/// per-incidence quantities between its draw and its pdf (issue 24): its
+/// pdf and value must still be exactly `pdf(i, o)` and `eval(i, o)`, for
+/// T3b's halo sampler and the spectrum's alone, with and without a base.
+#[test]
+fn sample_returns_pdf_and_eval_exactly() {
+    let set = twoscale::TableSet::embedded();
+    let stub = NarrowNdfConvolution;
+    let tables = [set.brdf_tables(), set.brdf_tables_with(&stub)];
+    let layers = [
+        conductor(surface(0.0598, 1.0, 0.0273, 4.8418, 2.0)),
+        Layer {
+            surface: surface(0.3, 0.5, 0.06, 3.0, 2.2),
+            base: BaseLayer::Plastic { albedo: 0.8 },
+            lambertian: 0.05,
+        },
+    ];
+    let mut rng = SplitMix64::new(24);
+    let mut drawn = 0;
+    for tables in &tables {
+        for layer in layers {
+            let model = TwoScale::new(tables, layer, 0.526, NICKEL_LIKE, Options::default());
+            for _ in 0..2000 {
+                let i = random_direction(&mut rng);
+                let u = [0; 3].map(|_| rng.uniform() as f32);
+                let Some(s) = model.sample(i, u) else {
+                    continue;
+                };
+                drawn += 1;
+                assert_eq!(s.pdf, model.pdf(i, s.o), "pdf at {i:?} {u:?}");
+                assert_eq!(s.value, model.eval(i, s.o), "eval at {i:?} {u:?}");
+            }
+        }
+    }
+    assert!(drawn > 7000, "{drawn} of 8000 drawn");
+}

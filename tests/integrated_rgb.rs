@@ -3,49 +3,13 @@
 //! one-wavelength models, and its sampler against its pdf.
 
 use generator::rng::SplitMix64;
-use std::f64::consts::PI;
+use generator::spectral_accuracy::{direction, integrated_errors};
 use suite::brdf::chi_square_sampler;
 use twoscale::TableSet;
-use twoscale::brdf::{
-    BaseLayer, ChannelBake, ColourTerms, IntegratedRgb, Layer, Options, Surface, TwoScale,
-};
-use twoscale::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
+use twoscale::brdf::{BaseLayer, ColourTerms, IntegratedRgb, Layer, Options, Surface, TwoScale};
 use twoscale::fresnel::Complex;
 use twoscale::materials::SPECTRAL_PRESETS;
 use twoscale::optical::{Ior, SpectralMaterial};
-
-/// A direction with `cos θ` uniform over [0.02, 1].
-fn direction(rng: &mut SplitMix64) -> [f32; 3] {
-    let z = 0.02 + 0.98 * rng.uniform();
-    let phi = 2.0 * PI * rng.uniform();
-    let s = (1.0 - z * z).sqrt();
-    [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
-}
-
-/// The 5 nm sum's models of `material`.
-fn spectral_models<'a>(
-    tables: &twoscale::brdf::Tables<'a>,
-    material: &SpectralMaterial<'_>,
-    options: Options,
-) -> Vec<TwoScale<'a, Box<ChannelBake>>> {
-    (0..WAVELENGTH_COUNT)
-        .map(|j| {
-            let l = colour::wavelength(j);
-            TwoScale::boxed(tables, material.layer, l, material.eta.at(l), options)
-        })
-        .collect()
-}
-
-fn five_nm(models: &[TwoScale<'_, Box<ChannelBake>>], i: [f32; 3], o: [f32; 3]) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (j, m) in models.iter().enumerate() {
-        let v = f64::from(m.eval(i, o));
-        for c in 0..3 {
-            out[c] += f64::from(SRGB_WEIGHTS[j][c]) * v;
-        }
-    }
-    out
-}
 
 /// p99 and max of the relative error per channel of `model` against the
 /// 5 nm sum over 600 pairs, half uniform and half drawn from the model's
@@ -56,34 +20,9 @@ fn errors(
     options: Options,
     seed: u64,
 ) -> (f64, f64, usize) {
-    let model = IntegratedRgb::boxed(tables, material, options);
-    let reference = spectral_models(tables, material, options);
-    let mut rng = SplitMix64::new(seed);
-    let mut rows = Vec::new();
-    for k in 0..600 {
-        let i = direction(&mut rng);
-        let o = if k % 2 == 0 {
-            direction(&mut rng)
-        } else {
-            let u = [0, 1, 2].map(|_| rng.uniform() as f32);
-            match model.sample(i, u) {
-                Some(s) => s.o,
-                None => continue,
-            }
-        };
-        rows.push((five_nm(&reference, i, o), model.eval(i, o)));
-    }
-    let peak = rows
-        .iter()
-        .flat_map(|(r, _)| r.iter().copied())
-        .fold(0.0, f64::max);
-    let mut errors: Vec<f64> = rows
-        .iter()
-        .flat_map(|(r, v)| {
-            (0..3)
-                .filter(move |&c| r[c] > 1e-3 * peak)
-                .map(move |c| (f64::from(v[c]) - r[c]).abs() / r[c])
-        })
+    let mut errors: Vec<f64> = integrated_errors(tables, material, options, 600, seed)
+        .into_iter()
+        .map(|(e, _)| e)
         .collect();
     let p99 = suite::brdf::percentile(&mut errors, 0.99);
     (p99, *errors.last().unwrap(), errors.len())

@@ -149,23 +149,38 @@
 #define TS_MULTIPLE_KULLA_CONTY 1
 
 /**
- * `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
- * (`ts_rgb_wavelengths`) as red, green, blue (the default).
+ * `ts_material_desc.rgb_mode`: the material's default (0, so a zeroed
+ * field): `TS_RGB_MODE_INTEGRATED` for a material
+ * over the spectrum (`eta_rows`; every preset),
+ * `TS_RGB_MODE_PAPER_WAVELENGTHS` for three indices.
  */
-#define TS_RGB_MODE_PAPER_WAVELENGTHS 0
+#define TS_RGB_MODE_DEFAULT 0
+
+/**
+ * `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
+ * (`ts_rgb_wavelengths`) as red, green, blue (what reproduces HP15/HP17).
+ */
+#define TS_RGB_MODE_PAPER_WAVELENGTHS 1
 
 /**
  * `ts_material_desc.rgb_mode`: linear sRGB by integration over the
  * spectrum (docs/model.md §2.12); needs `eta_rows`, or one index for
  * every channel.
  */
-#define TS_RGB_MODE_INTEGRATED 1
+#define TS_RGB_MODE_INTEGRATED 2
 
 /**
  * An RGB material built from a `ts_tables`. Opaque; about 136 KB (360 KB
  * with `TS_RGB_MODE_INTEGRATED`), on the heap.
  */
 typedef struct ts_material ts_material;
+
+/**
+ * A material file's description that owns its index's rows (`eta = {
+ * lambda, n, k }`), from `ts_material_file_from_toml`; read it with
+ * `ts_material_file_desc`, free it with `ts_material_file_free`. Opaque.
+ */
+typedef struct ts_material_file ts_material_file;
 
 /**
  * A validated set of the four tables (T1, T2, T3, T5). Opaque.
@@ -441,7 +456,7 @@ int ts_material_desc_preset(const char *name,
  * docs/fitting.md; also `rgb_mode`). `TS_ERR_PARSE`: not TOML, or an
  * unknown, missing or mistyped key; `TS_ERR_INVALID`: a value outside its
  * domain, or `eta = { lambda, n, k }` (a spectrum: its rows would not
- * outlive the call; give them in `eta_rows` instead). The message
+ * outlive the call; `ts_material_file_from_toml` reads it). The message
  * is the one Rust and Python give for the same text. `out` is left
  * unchanged on failure.
  *
@@ -462,6 +477,42 @@ int ts_material_desc_from_toml(const char *toml,
  */
 int ts_material_desc_from_toml_file(const char *path,
                                     ts_material_desc *out);
+
+/**
+ * Reads the material file of the TOML text `toml`, any form of `eta`
+ * included (`eta = { lambda, n, k }`: the handle owns the rows), into a new
+ * handle at `*out` (free it with `ts_material_file_free`); the checks,
+ * status codes and messages are `ts_material_desc_from_toml`'s. `*out` is
+ * left unchanged on failure.
+ *
+ * # Safety
+ *
+ * `toml` is NULL or NUL-terminated; `out` is NULL or writable.
+ */
+int ts_material_file_from_toml(const char *toml,
+                               ts_material_file **out);
+
+/**
+ * Fills `out` (and `out->size`) with the description of `file`; its
+ * `eta_rows` (a spectrum's rows, or NULL) point into `file` and stay valid
+ * until `ts_material_file_free(file)` (`ts_material_new` copies them).
+ *
+ * # Safety
+ *
+ * `file` is NULL or a live handle; `out` is NULL or writable.
+ */
+int ts_material_file_desc(const ts_material_file *file,
+                          ts_material_desc *out);
+
+/**
+ * Frees a material file handle (NULL is ignored).
+ *
+ * # Safety
+ *
+ * `file` is NULL or a live handle from `ts_material_file_from_toml`, not
+ * used afterwards (nor the rows of a description read from it).
+ */
+void ts_material_file_free(ts_material_file *file);
 
 /**
  * The shipped preset `name` with the paper's options. NULL on failure

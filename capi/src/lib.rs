@@ -82,17 +82,29 @@ pub const TS_MULTIPLE_NONE: i32 = 0;
 /// `ts_material_desc.multiple_scattering`: the Kulla–Conty energy-compensation
 /// lobe (docs/model.md §2.11).
 pub const TS_MULTIPLE_KULLA_CONTY: i32 = 1;
+/// `ts_material_desc.rgb_mode`: the material's default (0, so a zeroed
+/// field): `TS_RGB_MODE_INTEGRATED` for a material
+/// over the spectrum (`eta_rows`; every preset),
+/// `TS_RGB_MODE_PAPER_WAVELENGTHS` for three indices.
+pub const TS_RGB_MODE_DEFAULT: i32 = 0;
 /// `ts_material_desc.rgb_mode`: ρ at the paper's wavelengths
-/// (`ts_rgb_wavelengths`) as red, green, blue (the default).
-pub const TS_RGB_MODE_PAPER_WAVELENGTHS: i32 = 0;
+/// (`ts_rgb_wavelengths`) as red, green, blue (what reproduces HP15/HP17).
+pub const TS_RGB_MODE_PAPER_WAVELENGTHS: i32 = 1;
 /// `ts_material_desc.rgb_mode`: linear sRGB by integration over the
 /// spectrum (docs/model.md §2.12); needs `eta_rows`, or one index for
 /// every channel.
-pub const TS_RGB_MODE_INTEGRATED: i32 = 1;
+pub const TS_RGB_MODE_INTEGRATED: i32 = 2;
 
 /// A validated set of the four tables (T1, T2, T3, T5). Opaque.
 pub struct ts_tables {
     inner: Arc<OwnedTableSet>,
+}
+
+/// A material file's description that owns its index's rows (`eta = {
+/// lambda, n, k }`), from `ts_material_file_from_toml`; read it with
+/// `ts_material_file_desc`, free it with `ts_material_file_free`. Opaque.
+pub struct ts_material_file {
+    desc: twoscale::desc::OwnedMaterialDesc,
 }
 
 /// An RGB material built from a `ts_tables`. Opaque; about 136 KB (360 KB
@@ -218,7 +230,7 @@ impl Default for ts_material_desc {
             colour: TS_COLOUR_PHYSICAL,
             halo_weight: TS_HALO_PRINTED,
             multiple_scattering: TS_MULTIPLE_NONE,
-            rgb_mode: TS_RGB_MODE_PAPER_WAVELENGTHS,
+            rgb_mode: TS_RGB_MODE_DEFAULT,
         }
     }
 }
@@ -579,15 +591,16 @@ impl ts_material_desc {
             "rgb_mode",
             self.rgb_mode,
             &[
+                ("TS_RGB_MODE_DEFAULT", TS_RGB_MODE_DEFAULT, None),
                 (
                     "TS_RGB_MODE_PAPER_WAVELENGTHS",
                     TS_RGB_MODE_PAPER_WAVELENGTHS,
-                    RgbMode::PaperWavelengths,
+                    Some(RgbMode::PaperWavelengths),
                 ),
                 (
                     "TS_RGB_MODE_INTEGRATED",
                     TS_RGB_MODE_INTEGRATED,
-                    RgbMode::Integrated,
+                    Some(RgbMode::Integrated),
                 ),
             ],
         )?;
@@ -632,8 +645,9 @@ impl ts_material_desc {
     }
 
     /// The description of `desc`; its rows (if a spectrum is tabulated)
-    /// must outlive the description: the presets' static ones.
-    fn from_model(desc: &MaterialDesc<'static>) -> ts_material_desc {
+    /// must outlive the description: the presets' static ones, or a
+    /// `ts_material_file`'s.
+    fn from_model(desc: &MaterialDesc<'_>) -> ts_material_desc {
         let (material, options) = (&desc.material, desc.options);
         let (eta_rows, eta_row_count) = match desc.spectral.map(|s| s.eta) {
             Some(Ior::Tabulated(t)) => (t.rows().as_ptr().cast::<f32>(), t.rows().len()),
@@ -899,7 +913,7 @@ pub unsafe extern "C" fn ts_material_desc_preset(
 fn preset_desc(name: &str) -> Result<MaterialDesc<'static>, Fail> {
     let spectral = twoscale::materials::spectral(name)
         .ok_or_else(|| Fail::new(TS_ERR_UNKNOWN_MATERIAL, twoscale::UnknownMaterial { name }))?;
-    MaterialDesc::spectral(spectral, Options::default(), RgbMode::default()).map_err(refused)
+    MaterialDesc::spectral(spectral, Options::default(), None).map_err(refused)
 }
 
 /// The description of a material file: refused when it gives a tabulated
@@ -910,7 +924,7 @@ fn file_desc(desc: &twoscale::desc::OwnedMaterialDesc) -> Result<MaterialDesc<'s
         Some(Ior::Tabulated(_)) => Err(Fail::new(
             TS_ERR_INVALID,
             "a material file with eta = { lambda, n, k } does not fit in a ts_material_desc \
-             (it would not own the rows): set eta_rows and eta_row_count yourself",
+             (it would not own the rows): read it with ts_material_file_from_toml",
         )),
         _ => Ok(MaterialDesc {
             spectral: None,
@@ -924,7 +938,7 @@ fn file_desc(desc: &twoscale::desc::OwnedMaterialDesc) -> Result<MaterialDesc<'s
 /// # Safety
 ///
 /// `out` is NULL or writable.
-unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc<'static>) -> Result<(), Fail> {
+unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc<'_>) -> Result<(), Fail> {
     non_null(out, "out")?;
     if !out.is_aligned() {
         return Err(Fail::new(TS_ERR_MISALIGNED, "out is misaligned"));
@@ -944,7 +958,7 @@ unsafe fn write_desc(out: *mut ts_material_desc, desc: &MaterialDesc<'static>) -
 /// docs/fitting.md; also `rgb_mode`). `TS_ERR_PARSE`: not TOML, or an
 /// unknown, missing or mistyped key; `TS_ERR_INVALID`: a value outside its
 /// domain, or `eta = { lambda, n, k }` (a spectrum: its rows would not
-/// outlive the call; give them in `eta_rows` instead). The message
+/// outlive the call; `ts_material_file_from_toml` reads it). The message
 /// is the one Rust and Python give for the same text. `out` is left
 /// unchanged on failure.
 ///
@@ -982,6 +996,69 @@ pub unsafe extern "C" fn ts_material_desc_from_toml_file(
         // SAFETY: forwarded caller contract.
         unsafe { write_desc(out, &desc) }
     })
+}
+
+/// Reads the material file of the TOML text `toml`, any form of `eta`
+/// included (`eta = { lambda, n, k }`: the handle owns the rows), into a new
+/// handle at `*out` (free it with `ts_material_file_free`); the checks,
+/// status codes and messages are `ts_material_desc_from_toml`'s. `*out` is
+/// left unchanged on failure.
+///
+/// # Safety
+///
+/// `toml` is NULL or NUL-terminated; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_material_file_from_toml(
+    toml: *const c_char,
+    out: *mut *mut ts_material_file,
+) -> c_int {
+    status(|| {
+        let text = utf8(toml, "toml")?;
+        non_null(out, "out")?;
+        if !out.is_aligned() {
+            return Err(Fail::new(TS_ERR_MISALIGNED, "out is misaligned"));
+        }
+        let desc = MaterialDesc::from_toml_str(text)?;
+        let file = Box::into_raw(Box::new(ts_material_file { desc }));
+        // SAFETY: non-null, aligned, writable by the caller's contract.
+        unsafe { out.write(file) };
+        Ok(())
+    })
+}
+
+/// Fills `out` (and `out->size`) with the description of `file`; its
+/// `eta_rows` (a spectrum's rows, or NULL) point into `file` and stay valid
+/// until `ts_material_file_free(file)` (`ts_material_new` copies them).
+///
+/// # Safety
+///
+/// `file` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_material_file_desc(
+    file: *const ts_material_file,
+    out: *mut ts_material_desc,
+) -> c_int {
+    status(|| {
+        non_null(file, "file")?;
+        // SAFETY: non-null, a live handle by the caller's contract.
+        let file = unsafe { &*file };
+        // SAFETY: forwarded caller contract.
+        unsafe { write_desc(out, &file.desc.get()) }
+    })
+}
+
+/// Frees a material file handle (NULL is ignored).
+///
+/// # Safety
+///
+/// `file` is NULL or a live handle from `ts_material_file_from_toml`, not
+/// used afterwards (nor the rows of a description read from it).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ts_material_file_free(file: *mut ts_material_file) {
+    if !file.is_null() {
+        // SAFETY: a live handle made by `Box::into_raw`, freed once.
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(file) })));
+    }
 }
 
 /// The shipped preset `name` with the paper's options. NULL on failure
@@ -1401,7 +1478,7 @@ mod tests {
     #[test]
     fn out_of_domain_descriptions_are_rejected() {
         let gold = twoscale::materials::preset("gold-rough").expect("preset");
-        let gold = MaterialDesc::rgb(gold, Options::default(), RgbMode::default()).expect("valid");
+        let gold = MaterialDesc::rgb(gold, Options::default(), None).expect("valid");
         let base = ts_material_desc::from_model(&gold);
         type Edit = fn(&mut ts_material_desc);
         let cases: [(Edit, &str); 14] = [
@@ -1538,7 +1615,7 @@ mod tests {
             // SAFETY: a live material and three-float arrays.
             let status = unsafe { ts_eval_rgb(m, i.as_ptr(), o.as_ptr(), out.as_mut_ptr()) };
             assert_eq!(status, TS_OK);
-            let expected = set.material(name).expect("preset").eval(i, o);
+            let expected = Bxdf::eval(&set.preset(name).expect("preset"), i, o);
             assert_eq!(out, expected, "{name}");
             // SAFETY: live handles, freed once.
             unsafe { ts_material_free(m) };

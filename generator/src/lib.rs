@@ -29,6 +29,7 @@ pub mod plot;
 pub mod query;
 pub mod report;
 pub mod sh;
+pub mod spectral_accuracy;
 pub mod table_source;
 pub mod tables;
 pub mod verify;

@@ -88,7 +88,9 @@ pub fn markdown(command: &str, reports: &[TableReport]) -> String {
         let _ = write!(out, "\n## {}\n\n", r.stem);
         match &r.outcome {
             Ok(rows) => {
-                let _ = writeln!(out, "{} bytes.\n", r.bytes);
+                if r.bytes > 0 {
+                    let _ = writeln!(out, "{} bytes.\n", r.bytes);
+                }
                 out.push_str(
                     "| metric | points | max | median | p90 | p99 | target | result | worst at |\n\
                      |---|---:|---:|---:|---:|---:|---|---|---|\n",

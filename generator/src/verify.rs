@@ -11,8 +11,10 @@ use twoscale::format::write::write_atomic;
 
 use crate::error::{Error, FileAction};
 use crate::report::{self, TableReport};
+use crate::spectral_accuracy;
 use crate::table_source::TableSource;
 use crate::tables::TableKind;
+use crate::tables::t4::ModelInputs;
 
 /// What `verify` measures.
 pub struct VerifyArgs<'a> {
@@ -27,8 +29,35 @@ pub struct VerifyArgs<'a> {
     pub markdown: Option<&'a Path>,
 }
 
-/// Verifies each of `kinds` read from `source`; exit status 1 if a file is
-/// unreadable or a gated figure misses its target.
+/// The spectral bakes' accuracy ([`spectral_accuracy`]) on the model tables
+/// of `source` (its directory's if it holds them all, else the embedded
+/// ones, as T4 reads them).
+fn spectral_report(source: &TableSource, seed: u64) -> TableReport {
+    let start = Instant::now();
+    let inputs = match source.dir() {
+        Some(dir) => ModelInputs::for_dir(dir),
+        None => ModelInputs::embedded(),
+    };
+    let outcome = inputs
+        .and_then(|inputs| {
+            let set = inputs.parse()?;
+            Ok(spectral_accuracy::accuracy(&set.brdf_tables(), seed))
+        })
+        .map_err(Error::table(spectral_accuracy::STEM));
+    eprintln!(
+        "verified the spectral bakes in {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    TableReport {
+        stem: spectral_accuracy::STEM.to_string(),
+        bytes: 0,
+        outcome,
+    }
+}
+
+/// Verifies each of `kinds` read from `source`, then (when no table is
+/// named) the spectral bakes; exit status 1 if a file is unreadable or a
+/// gated figure misses its target.
 pub fn verify(
     kinds: &[&dyn TableKind],
     source: &TableSource,
@@ -74,6 +103,9 @@ pub fn verify(
                 outcome: Err(e),
             },
         });
+    }
+    if args.names.is_empty() {
+        reports.push(spectral_report(source, seed));
     }
     print!("{}", report::text(&reports));
     if let Some(file) = args.markdown {

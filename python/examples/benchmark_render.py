@@ -81,10 +81,15 @@ def measure(variant, size, spp, repeat, evaluated):
         eta, k = [0.584] * 3, [2.15] * 3
     beckmann, rough = beckmann_pair(0.1, eta, k)
     bsdfs = {
-        "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
+        # The paper's wavelengths (the presets' default is the integrated RGB, below).
+        "twoscale gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry",
+                                        "rgb_mode": "paper-wavelengths"},
         "twoscale Beckmann (p=1, σs=0)": beckmann,
         "roughconductor beckmann": rough,
     }
+    if mi.is_rgb:
+        bsdfs["twoscale gold-hp17-geometry, integrated RGB"] = {
+            "type": "twoscale", "material": "gold-hp17-geometry", "rgb_mode": "integrated"}
     cost = {}
     for name, bsdf in bsdfs.items():
         scene = sphere_scene(bsdf, size, spp)

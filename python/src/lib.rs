@@ -258,9 +258,10 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 /// 0.444 µm), or the index over the spectrum `(lam, n, k)`, three 1-D arrays
 /// of one length (λ in µm, increasing; linear in 1/λ between rows; three
 /// arrays of two values are read as (n, k) pairs); `rgb_mode`: one of
-/// `RGB_MODES`, "paper-wavelengths" (the default: ρ at `RGB_WAVELENGTHS`) or
-/// "integrated" (the integral over the spectrum, docs/model.md §2.12; needs
-/// a spectrum, or one (n, k) for every channel); `base`: one of `BASES`;
+/// `RGB_MODES`, "paper-wavelengths" (ρ at `RGB_WAVELENGTHS`; the default for
+/// (n, k) pairs) or "integrated" (the integral over the spectrum,
+/// docs/model.md §2.12; the default for a spectrum; needs a spectrum, or one
+/// (n, k) for every channel); `base`: one of `BASES`;
 /// `albedo`: the base layer's, in [0, 1]
 /// (plastic or subsurface only); `lambertian`: the weight k_d in [0, 1] of a
 /// Lambertian term. A keyword left out (None) takes the runtime's default:
@@ -483,7 +484,9 @@ impl Material {
     /// halo_weight=None, multiple_scattering=None, rgb_mode=None): the shipped
     /// preset `name` (`Material.presets()` lists them; its measured index
     /// over the spectrum) with the given options (names as in `OPTIONS` and
-    /// `RGB_MODES`; None: the runtime's default, the paper's wavelengths).
+    /// `RGB_MODES`; None: the runtime's default: the paper's model, and the
+    /// RGB by integration over the spectrum; `rgb_mode="paper-wavelengths"`
+    /// reproduces HP15/HP17's RGB).
     #[staticmethod]
     #[pyo3(signature = (name, *, masking=None, sigma_rel=None, colour=None, halo_weight=None,
         multiple_scattering=None, rgb_mode=None))]
@@ -499,7 +502,8 @@ impl Material {
         let spectral = twoscale::materials::spectral(name)
             .ok_or_else(|| value_error(twoscale::UnknownMaterial { name }.to_string()))?;
         let options = options(masking, sigma_rel, colour, halo_weight, multiple_scattering)?;
-        let desc = MaterialDesc::spectral(spectral, options, named(rgb_mode)?)
+        let rgb_mode = validate::named_or_none(rgb_mode).map_err(|e| value_error(e.to_string()))?;
+        let desc = MaterialDesc::spectral(spectral, options, rgb_mode)
             .map_err(|e| value_error(e.to_string()))?;
         Ok(Material::build(&desc))
     }
@@ -645,7 +649,9 @@ impl Material {
     }
 
     /// eval_reference(wi, wo): the f64 reference ρ(wi, wo) per RGB channel
-    /// in sr⁻¹ (exact Λ, σrel and C; the reference crate's `brdf`), float64 of
+    /// at the paper's wavelengths whatever `rgb_mode` is (compare it with a
+    /// material built with `rgb_mode="paper-wavelengths"`) in sr⁻¹ (exact
+    /// Λ, σrel and C; the reference crate's `brdf`), float64 of
     /// shape `(..., 3)`, for conductors without a Lambertian term. Arguments
     /// as `eval`'s. Costs 1–30 ms per row and channel (on all cores).
     fn eval_reference<'py>(
@@ -701,6 +707,23 @@ impl Material {
             .iter()
             .map(|channel| bake_dict(py, |v| channel.visit_bakes(v)))
             .collect()
+    }
+
+    /// integrated_bakes(): the colour weights and bakes of the integrated
+    /// RGB model (`rgb_mode="integrated"`), for ports of `eval`, `pdf` and
+    /// `sample` (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 8
+    /// models', µm), `surface` (`[nodes, 8, 3]`: the surface lobes' weights
+    /// over `√cos θd`), `plain` (`[8, 3]`), `sampler_nodes` (the 3 models the
+    /// sampler mixes) and `models`, a list of 8 dicts as `bakes()` gives
+    /// them (not a stable interface). For `rgb_mode="integrated"` only.
+    fn integrated_bakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let RgbModel::Integrated(model) = &*self.model else {
+            return Err(value_error(
+                "integrated_bakes() gives the integrated RGB model: build the material with rgb_mode='integrated'",
+            ));
+        };
+        let dict = bake_dict(py, |v| model.visit_colour(v))?;
+        with_models(py, dict, model.nodes())
     }
 
     /// spectral_bakes(): the constants and bakes of the model at any
@@ -759,7 +782,7 @@ impl Material {
                     ..spectral.get()
                 },
                 self.options,
-                self.rgb_mode,
+                Some(self.rgb_mode),
             ),
             None => MaterialDesc::rgb(
                 twoscale::brdf::Material {
@@ -767,7 +790,7 @@ impl Material {
                     ..self.material
                 },
                 self.options,
-                self.rgb_mode,
+                Some(self.rgb_mode),
             ),
         }
         .map_err(|e| value_error(e.to_string()))?;
@@ -870,6 +893,20 @@ fn columns<const K: usize>(
         same_rows((names[0], n), (name, view.len()))?;
     }
     Ok((0..n).map(|k| views.each_ref().map(|v| v[k])).collect())
+}
+
+/// `dict` with `models`: each of `nodes`' bakes as `bakes()` gives them.
+fn with_models<'py, B: std::borrow::Borrow<ChannelBake>>(
+    py: Python<'py>,
+    dict: Bound<'py, PyDict>,
+    nodes: &[twoscale::TwoScale<'_, B>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let models = nodes
+        .iter()
+        .map(|node| bake_dict(py, |v| node.visit_bakes(v)))
+        .collect::<PyResult<Vec<_>>>()?;
+    dict.set_item("models", models)?;
+    Ok(dict)
 }
 
 /// The dict that `visit` fills through a [`DictVisitor`].

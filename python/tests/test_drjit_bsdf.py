@@ -76,7 +76,7 @@ def relative_error(got, ref):
 def test_bakes_are_the_runtime_bakes():
     """Material.bakes(): three channels of named scalars and float32 arrays,
     at the channels' wavelengths, with the layouts the port reads."""
-    m = twoscale.Material.preset("gold-hp17-geometry")
+    m = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths")
     bakes = m.bakes()
     assert len(bakes) == 3
     assert [round(b["lambda"], 3) for b in bakes] == [0.645, 0.526, 0.444]
@@ -101,7 +101,41 @@ MATERIALS = [(name, {}) for name in twoscale.Material.presets()] + [
     ("white-plastic", {"colour": "white"}),
     ("gold-rough", {"multiple_scattering": "kulla-conty"}),
     ("white-plastic", {"multiple_scattering": "kulla-conty"}),
+    ("beckmann-limit", {}),
+] + [
+    # The paper's wavelengths (`tb.Model`; the presets' default is the
+    # integrated RGB, `tb.IntegratedModel`): a halo, a polished lobe, a
+    # plastic and a subsurface base, compensation, white colour terms.
+    (name, {"rgb_mode": "paper-wavelengths", **options}) for name, options in [
+        ("gold-hp17-geometry", {}), ("gold-polished", {}), ("silver", {}), ("white-plastic", {}),
+        ("marble", {}), ("gold-rough", {"multiple_scattering": "kulla-conty"}),
+        ("white-plastic", {"colour": "white"}), ("gold-hp17-geometry", {"masking": "height-correlated"}),
+    ]
 ]
+
+
+def material_of(name, options):
+    """The preset `name` with `options`; "beckmann-limit" is the render
+    benchmark's p = 1, σs = 0 gold conductor (the specular lobe alone: the
+    port's specialised code without the diffraction, base and compensation
+    lobes)."""
+    if name == "beckmann-limit":
+        return twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0,
+                                 eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)], **options)
+    return twoscale.Material.preset(name, **options)
+
+
+def test_specular_only_material_is_specialised():
+    """The Beckmann-limit material traces the specular lobe alone: constant
+    lobe weights [1, 0, 0, 0], no diffraction, no compensation lobe (the
+    agreement tests below check it against the runtime)."""
+    model = tb.Model(material_of("beckmann-limit", {}))
+    assert all(ch.weight_columns == [0] and not ch.diffraction and ch.s["multiple_scale"] == 0.0
+               for ch in model.channels)
+    assert model.diffraction_stack is None
+    gold = tb.Model(twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths"))
+    assert all(ch.weight_columns == [0, 1] for ch in gold.channels)
+    assert gold.diffraction_stack is not None
 
 
 @pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
@@ -110,9 +144,9 @@ def test_eval_equals_the_runtime(name, options):
     1e-6 of the channel's peak, on 10⁴ pairs, evaluated inside a symbolic
     loop (symbolic mode on: nothing in eval may be evaluated eagerly)."""
     for key, value in options.items():
-        assert value in twoscale.OPTIONS[key], (key, twoscale.OPTIONS[key])
-    material = twoscale.Material.preset(name, **options)
-    model = tb.Model(material)
+        assert value in twoscale.OPTIONS.get(key, twoscale.RGB_MODES), key
+    material = material_of(name, options)
+    model = tb.rgb_model(material)
     light, camera = pairs(seed(name, "eval", options))
     ref = material.eval(light, camera)
     wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
@@ -134,8 +168,8 @@ def test_pdf_equals_the_runtime(name, options):
     weights, averaged over the channels) equals `Material.pdf` within 2e-4
     relative where it exceeds 1e-6 of its peak, on 10⁴ pairs, inside a
     symbolic loop."""
-    material = twoscale.Material.preset(name, **options)
-    model = tb.Model(material)
+    material = material_of(name, options)
+    model = tb.rgb_model(material)
     light, camera = pairs(seed(name, "pdf", options))
     ref = material.pdf(light, camera)[:, None]
     wi, wo = mi.Vector3f(light.T), mi.Vector3f(camera.T)
@@ -160,8 +194,8 @@ def test_sample_equals_the_runtime(name, options):
     Measured on 2·10⁵ uniform incidences per preset: 0.01–1.9% of the
     directions differ, 0.03% at most by more than 1e-6, none by more than
     4.7e-5."""
-    material = twoscale.Material.preset(name, **options)
-    model = tb.Model(material)
+    material = material_of(name, options)
+    model = tb.rgb_model(material)
     rng = np.random.default_rng(seed(name, "sample", options))
     light, _ = pairs(int(rng.integers(2**31)))
     u = rng.random((len(light), 3)).astype(np.float32)
@@ -234,6 +268,9 @@ CHI2_CASES = [
     ("strong halo, grazing 80°", STRONG_HALO, 80.0),
     ("compensated gold-rough, 60°",
      dict(material="gold-rough", multiple_scattering="kulla-conty"), 60.0),
+    ("paper's wavelengths gold-hp17-geometry, 40°",
+     dict(material="gold-hp17-geometry", rgb_mode="paper-wavelengths"), 40.0),
+    ("silver, grazing 80°", dict(material="silver"), 80.0),
 ]
 
 
@@ -246,14 +283,17 @@ def test_chi2(label, props, theta):
     assert test.passed, test.messages
 
 
-@pytest.mark.parametrize("name,theta", [("gold-rough", 30), ("gold-hp17-geometry", 60)])
-def test_white_furnace(name, theta):
+@pytest.mark.parametrize("name,theta,rgb_mode", [("gold-rough", 30, "integrated"),
+                                                  ("gold-hp17-geometry", 60, "integrated"),
+                                                  ("gold-rough", 45, "paper-wavelengths")])
+def test_white_furnace(name, theta, rgb_mode):
     """A render with the plugin (symbolic mode on) estimates the albedo of
     the white-colour material, ∫ ρ cos θi dωi by quadrature over the
     runtime's eval."""
-    material = twoscale.Material.preset(name, colour="white")
+    material = twoscale.Material.preset(name, colour="white", rgb_mode=rgb_mode)
     expected = furnace_albedo(material, theta)
-    pixels = furnace_render({"type": tm.NAME, "material": name, "colour": "white"}, theta, seed=0)
+    props = {"type": tm.NAME, "material": name, "colour": "white", "rgb_mode": rgb_mode}
+    pixels = furnace_render(props, theta, seed=0)
     mean = pixels.mean(axis=0)
     standard_error = pixels.std(axis=0) / np.sqrt(len(pixels))
     print(f"furnace {name} θo={theta}: render {mean}, quadrature {expected}, SE {standard_error}")

@@ -88,8 +88,9 @@ def test_brdf_matches_query(generator_query, params):
 
 def test_material_channels_match_query(generator_query):
     """Material.eval and eval_reference are the one-wavelength model of each
-    channel at RGB_WAVELENGTHS with the channel's index."""
-    m = twoscale.Material.preset("gold-hp17-geometry")
+    channel at RGB_WAVELENGTHS with the channel's index
+    (rgb_mode="paper-wavelengths")."""
+    m = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths")
     n = 10
     wi, wo = hemisphere(n).astype(np.float32), hemisphere(n).astype(np.float32)
     wo[:5] = wi[:5] * [-1, -1, 1]
@@ -303,6 +304,7 @@ def test_explicit_material_equals_preset():
     m = twoscale.Material(
         beta=ref.beta, p=ref.p, sigma_s=ref.sigma_s, b=ref.b, c=ref.c, eta=ref.eta,
         base=ref.base, albedo=ref.albedo, lambertian=ref.lambertian, **ref.options,
+        rgb_mode=ref.rgb_mode,
     )
     assert m.options["sigma_rel"] == "symmetrised"
     wi, wo = hemisphere(100), hemisphere(100)
@@ -313,7 +315,7 @@ def test_eval_spectral_matches_the_rgb_channels_at_their_wavelengths():
     """At the paper's wavelengths the spectral model of a preset is its RGB
     model's channel (the spectral model interpolates between models 0.04 µm
     apart, docs/model.md §2.12: within 0.5%)."""
-    gold = twoscale.Material.preset("gold-rough")
+    gold = twoscale.Material.preset("gold-rough", rgb_mode="paper-wavelengths")
     n = 2000
     wi = hemisphere(n)
     wo, pdf, _ = gold.sample(wi, RNG.random((n, 3)))
@@ -371,13 +373,17 @@ def test_a_spectral_eta_is_the_preset_it_copies():
         assert given.rgb_mode == preset.rgb_mode == mode
         np.testing.assert_array_equal(given.eval(wi, wo), preset.eval(wi, wo))
         np.testing.assert_array_equal(given.pdf(wi, wo), preset.pdf(wi, wo))
+    # The default of a material over the spectrum (a preset, eta=(lam, n, k))
+    # is the integrated RGB; of (n, k) pairs, the paper's wavelengths.
+    assert twoscale.Material.preset("gold-rough").rgb_mode == "integrated"
+    assert twoscale.Material(eta=(rows[:, 0], rows[:, 1], rows[:, 2]), **geometry).rgb_mode == "integrated"
+    assert twoscale.Material(eta=[(1.5, 3.0)] * 3, **geometry).rgb_mode == "paper-wavelengths"
     lam = np.linspace(0.36, 0.83, 64)
     np.testing.assert_array_equal(given.eval_spectral(wi, wo, lam), preset.eval_spectral(wi, wo, lam))
     # A list of three arrays and a (3, N) array are the same spectrum.
     for eta in ([rows[:, 0], rows[:, 1], rows[:, 2]], rows.T):
         again = twoscale.Material(eta=eta, rgb_mode=mode, **geometry)
         np.testing.assert_array_equal(again.eval(wi, wo), preset.eval(wi, wo))
-    assert twoscale.Material.preset("gold-rough").rgb_mode == "paper-wavelengths"
 
 
 def test_integrated_rgb_differs_from_the_paper_wavelengths_for_gold():
@@ -385,8 +391,8 @@ def test_integrated_rgb_differs_from_the_paper_wavelengths_for_gold():
     (docs/design/rgb-integration.md: 8-14% at p99 over pairs)."""
     wi = np.array([0.5, 0.0, 0.866])
     wo = np.array([-0.5, 0.0, 0.866])
-    paper = twoscale.Material.preset("gold-hp17-geometry").eval(wi, wo)
-    integrated = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="integrated").eval(wi, wo)
+    paper = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths").eval(wi, wo)
+    integrated = twoscale.Material.preset("gold-hp17-geometry").eval(wi, wo)
     assert paper[2] / paper[0] > 1.1 * integrated[2] / integrated[0]
     with pytest.raises(ValueError, match="bakes"):
         twoscale.Material.preset("gold-rough", rgb_mode="integrated").bakes()

@@ -13,7 +13,8 @@ the light and ``wo`` towards the viewer. Lengths are in µm.
 ``OPTIONS`` maps each option keyword of ``Material`` to the names of its
 values (the default first), ``BASES`` lists the base layers and
 ``RGB_MODES`` the RGB models (``rgb_mode``: the paper's wavelengths, the
-default, or the integral over the spectrum): the runtime's one list of each
+default of (n, k) pairs, or the integral over the spectrum, the default of
+a preset and of a spectrum): the runtime's one list of each
 (``twoscale::validate::Named``).
 """
 

@@ -18,7 +18,11 @@ mixture of the spectrum's law and the halo's half-vector densities, the cosine l
 :meth:`Model.sample_direction` (``Rgb::sample``'s direction: the channel and
 lobe picks, the visible-slope sampler with its Newton solve as a symbolic
 loop, the diffraction lobe with the azimuth's Newton solve as another, and
-the cosine lobe). The plugin's ``sample`` draws the
+the cosine lobe). A material with ``rgb_mode="integrated"`` gets
+:class:`IntegratedModel` (``IntegratedRgb``, from
+:meth:`twoscale.Material.integrated_bakes`: the 8 models' lobes weighted by
+the colour weights; ``pdf`` and ``sample`` :class:`Model`'s over the three
+models the runtime's sampler mixes). The plugin's ``sample`` draws the
 light direction given the camera's (as ``twoscale.mitsuba``), with ``pdf``
 its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
@@ -109,11 +113,22 @@ def _catmull_rom_weights(t):
     )
 
 
+#: The Newton solves' stopping step (relative to `|x0| + τmax` in the
+#: visible sampler's cell, in radians for the halo's azimuth). The
+#: runtime stops at 1e-13 (visible) and 1e-12 (halo), which sits at or below
+#: the f64 noise of the residuals: where it does, Newton's step never gets
+#: that small, and the lane bisects in the noise band for 20–30 more steps
+#: (≈40% of the visible sampler's lanes). Once a step is ≤ 1e-9, Newton's
+#: error after it is ~1e-18 (quadratic convergence), so stopping there gives
+#: the runtime's root to f64 noise, far below the f32 direction returned.
+_NEWTON_TOL = 1e-9
+
+
 def _newton_in_bracket(residual, slope, t, hi, tol):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
-    steps (`visible::solve_cell`, `halo::solve_azimuth`)."""
+    steps (`visible::solve_cell`, `halo::Azimuth::solve`)."""
     lo = dr.zeros(mi.Float64, dr.width(t))
 
     def body(step, done, t, lo, hi):
@@ -210,6 +225,16 @@ class _Channel:
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
+        self.specialise(bakes)
+
+    def specialise(self, bakes):
+        """What the traced code leaves out (Python-level branches, as
+        Mitsuba's own plugins): the lobe weights' columns that are 0 at every
+        node of `bakes` (any model's, stacked), the compensation lobe when
+        its scale is 0."""
+        weights = np.asarray(bakes["direction_weights"])
+        self.weight_columns = [k for k in range(4) if np.any(weights[..., k] > 0.0)]
+        self.has_multiple = bool(np.any(np.asarray(bakes["multiple_scale"]) != 0.0))
 
     def _node_row(self, i, n):
         """Row `i` of a per-wavelength table of `n` rows (:class:`_NodeChannel`
@@ -279,19 +304,27 @@ class _Channel:
     def lobe_weights(self, cos_i):
         """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
         sum 1 (f64)."""
+        columns = self.weight_columns
+        if columns in ([], [0]):
+            # The specular lobe alone (or no lobe): weights [1, 0, 0, 0] everywhere.
+            return [mi.Float64(1.0)] + [mi.Float64(0.0)] * 3
         i, frac = self.direction_cell(mi.Float(cos_i))
-        w = [mi.Float64(dr.maximum(_lerp_gather(self.t["direction_weights"], 4, k, i, frac), 0.0))
-             for k in range(4)]
-        total = w[0] + w[1] + w[2] + w[3]
+        a = _gather4(self.t["direction_weights"], i)
+        b = _gather4(self.t["direction_weights"], i + 1)
+        # Columns that are 0 at every node contribute exact zeros.
+        w = [mi.Float64(dr.maximum(dr.fma(frac, b[k] - a[k], a[k]), 0.0)) if k in columns
+             else mi.Float64(0.0) for k in range(4)]
+        total = sum(w[k] for k in columns)
         ok = total > 0.0
-        return [dr.select(ok, w[0] / total, 1.0)] + [dr.select(ok, x / total, 0.0) for x in w[1:]]
+        return [dr.select(ok, w[0] / total, 1.0)] + [
+            dr.select(ok, w[k] / total, 0.0) if k in columns else w[k] for k in range(1, 4)]
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
         and the half-vector draw (`HaloBake::pdf`), f64."""
         share = self.s["halo_spectrum_share"]
         spectrum = self.spectrum_pdf(wi, wo)
-        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"]), 0.0)
+        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z), 0.0)
         return share * spectrum + (1.0 - share) * half
 
     def _row_cell(self, wi):
@@ -313,12 +346,23 @@ class _Channel:
         return mi.Float64(dr.gather(mi.Float, self.t[name], row * n_s + k))
 
     @staticmethod
-    def _half_range(a, b):
-        """`halo::half_range`: `(H, sin H)`."""
-        x = b / a
-        wide = b >= a
-        return (dr.select(wide, math.pi, dr.acos(dr.clip(-x, -1.0, 1.0))),
-                dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0))))
+    def _azimuth(sin_i, cos_i, sin_h, cos_h):
+        """`halo::Azimuth::new`: `(H, [A₂, A₁, A₀], F(H))` of the azimuth law
+        `∝ (i·h)(cos θo)₊` and whether it exists (f64)."""
+        a, b = sin_i * sin_h, cos_i * cos_h
+        kappa = cos_i / (2.0 * cos_h)
+        wide = b - a >= kappa
+        exists = (cos_h > 0.0) & (wide | (b + a > kappa))
+        big_h = dr.select(wide, math.pi, _acos_approx(dr.clip((kappa - b) / a, -1.0, 1.0)))
+        coef = (2.0 * cos_h * a * a, (4.0 * cos_h * b - cos_i) * a, (2.0 * cos_h * b - cos_i) * b)
+        half = _Channel._azimuth_cdf(coef, big_h)
+        return big_h, coef, half, exists & (half > 0.0)
+
+    @staticmethod
+    def _azimuth_cdf(coef, psi):
+        """`halo::cdf`: `A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ`."""
+        s, c = dr.sin(psi), dr.cos(psi)
+        return 0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
 
     def _row_pdf(self, row, z):
         """`HaloBake::row_pdf`."""
@@ -334,17 +378,15 @@ class _Channel:
         ok = (total > 0.0) & (z <= self._halo_node("halo_zeta", row, n_s - 1)) & (cell > 0.0)
         return dr.select(ok, mass / total * d / cell, 0.0)
 
-    def halo_pdf(self, wi, sin_h, cos_h):
-        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) / (4 N(θh))`, f64."""
+    def halo_pdf(self, wi, sin_h, cos_h, cos_o):
+        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`, f64."""
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        a, b = sin_i * sin_h, wi.z * cos_h
-        big_h, sin_big_h = self._half_range(a, b)
-        norm = 2.0 * (a * sin_big_h + b * big_h)
+        _, _, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
         zeta = sin_h * sin_h / (1.0 + cos_h)
         j, t = self._row_cell(wi)
         p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta), 0.0)
         p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta), 0.0)
-        return dr.select(norm > 0.0, p / (4.0 * norm), 0.0)
+        return dr.select(exists, p * dr.maximum(cos_o, 0.0) / (8.0 * half), 0.0)
 
     def halo_sample(self, wi, pick, along):
         """`HaloBake::sample_h`: a half-vector (f64) and whether the row had mass."""
@@ -369,27 +411,33 @@ class _Channel:
         cos_h = 1.0 - z
         sin_h = dr.sqrt(dr.maximum(z * (2.0 - z), 0.0))
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        a, b = sin_i * sin_h, wi.z * cos_h
         side = dr.select(azimuth < 0.5, -1.0, 1.0)
         rest = dr.select(azimuth < 0.5, 2.0 * azimuth, 2.0 * azimuth - 1.0)
-        big_h, sin_big_h = self._half_range(a, b)
-        psi = side * self._solve_azimuth(a, b, big_h, rest * (a * sin_big_h + b * big_h))
+        big_h, coef, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
+        psi = side * self._solve_azimuth(coef, big_h, half, rest * half)
         has = sin_i > 0.0
         cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
         sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
         cp, sp = dr.cos(psi), dr.sin(psi)
         h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
                         sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
-        return h, total > 0.0
+        return h, (total > 0.0) & exists
 
     @staticmethod
-    def _solve_azimuth(a, b, big_h, target):
-        """`halo::solve_azimuth`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until it converges, at most 40 steps)."""
-        total = a * dr.sin(big_h) + b * big_h
-        psi = dr.select(total > 0.0, big_h * dr.clip(target / total, 0.0, 1.0), 0.0)
-        return _newton_in_bracket(lambda psi: a * dr.sin(psi) + b * psi - target,
-                                  lambda psi: a * dr.cos(psi) + b, psi, mi.Float64(big_h), 1e-12)
+    def _solve_azimuth(coef, big_h, half, target):
+        """`Azimuth::solve`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL`, at most 40 steps)."""
+        psi = dr.select(half > 0.0, big_h * dr.clip(target / half, 0.0, 1.0), 0.0)
+        return _newton_in_bracket(
+            lambda psi: _Channel._azimuth_cdf(coef, psi) - target,
+            lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
+            psi, mi.Float64(big_h), _NEWTON_TOL)
+
+    def _radial_inv_m(self, sin_i):
+        """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""
+        n = self.shapes["radial_inv_m"][0]
+        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
+        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
 
     def spectrum_pdf(self, wi, wo):
         """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
@@ -397,9 +445,7 @@ class _Channel:
         if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
             return mi.Float64(0.0)
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
+        inv_m = self._radial_inv_m(sin_i)
         dx, dy = wo.x + wi.x, wo.y + wi.y
         r = dr.sqrt(dx * dx + dy * dy)
         x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
@@ -587,7 +633,8 @@ class _Channel:
     @staticmethod
     def _solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral):
         """`visible::solve_cell`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until it converges, at most 40 steps)."""
+        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL` of the
+        cell's scale, at most 40 steps)."""
         a = c - sn * x0
 
         def density(t):
@@ -598,7 +645,7 @@ class _Channel:
         disc = f0 * f0 + 2.0 * b * rest
         denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
         t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
-        tol = 1e-13 * (dr.abs(x0) + tau_max)
+        tol = _NEWTON_TOL * (dr.abs(x0) + tau_max)
         return _newton_in_bracket(lambda t: cell_integral(x0, p0, k, t) - rest, density,
                                   t, mi.Float64(tau_max), tol)
 
@@ -622,9 +669,7 @@ class _Channel:
         whether it exists (f64)."""
         s = self.s
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        inv_m = mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
+        inv_m = self._radial_inv_m(sin_i)
         b, c = self.d["big_b"], self.d["c"]
         m = 1.0 / inv_m
         # ln_1pf and exp_m1f of the runtime, in f64.
@@ -739,7 +784,8 @@ class _Channel:
             diffraction = mi.Float64(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float64(0.0))
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
@@ -760,7 +806,8 @@ class _Channel:
             fresnel_d = mi.Float64(
                 self.direction(self.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
         base = self.base_value(at_i[6], at_o[6], wi.z, wo.z, params)
-        multiple = self.d["multiple_scale"] * at_i[7] * at_o[7]
+        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float64(0.0))
         plain = (mi.Float64(_finite_or_zero(mi.Float(base)))
                  + mi.Float64(_finite_or_zero(mi.Float(multiple))))
         return ratio_sq, q, fresnel_d, plain
@@ -789,13 +836,15 @@ class Model:
     def __init__(self, material: twoscale.Material, params=None, bakes=None):
         self.material = material
         self.params = default_params(material) if params is None else params
-        self.channels = [_Channel(b) for b in (material.bakes() if bakes is None else bakes)]
+        bakes = material.bakes() if bakes is None else bakes
+        self.channels = [_Channel(b) for b in bakes]
         first = self.channels[0].s
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
         self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
         self.height_correlated = first["height_correlated"] != 0.0
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
+        self.diffraction_stack = _diffraction_stack(self.channels, bakes)
 
     def d(self, h):
         """`Epd::d`: `norm e^−(tan²θ/β²)^p / cos⁴θ`."""
@@ -913,16 +962,27 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
     lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
     m, ok = model.channels[0].visible_sample(wi, u1, u2)
     o = 2.0 * dr.dot(wi, m) * m - wi
-    for n, channel in enumerate(model.channels):
-        if channel.diffraction:
-            od, ok_d = channel.diffraction_sample(wi, u1, u2)
-            here = (lobe == 1) & selected[n]
-            o = dr.select(here, od, o)
-            ok = dr.select(here, ok_d, ok)
-    r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-    ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
-    o = dr.select(lobe >= 2, ob, o)
-    ok = dr.select(lobe >= 2, True, ok)
+    if getattr(model, "diffraction_stack", None) is not None:
+        # One draw from each lane's own channel.
+        k = mi.UInt32(0)
+        for n in range(1, len(selected)):
+            k = dr.select(selected[n], n, k)
+        od, ok_d = model.diffraction_stack.at(k).diffraction_sample(wi, u1, u2)
+        o = dr.select(lobe == 1, od, o)
+        ok = dr.select(lobe == 1, ok_d, ok)
+    else:
+        for n, channel in enumerate(model.channels):
+            if channel.diffraction:
+                od, ok_d = channel.diffraction_sample(wi, u1, u2)
+                here = (lobe == 1) & selected[n]
+                o = dr.select(here, od, o)
+                ok = dr.select(here, ok_d, ok)
+    if any(n in ch.weight_columns for ch in model.channels for n in (2, 3)):
+        # The cosine lobe (traced only when some channel can pick lobe 2 or 3).
+        r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
+        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        o = dr.select(lobe >= 2, ob, o)
+        ok = dr.select(lobe >= 2, True, ok)
     ok &= ~((lobe == 1) & ~model.channels_have_diffraction)
     o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
     ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
@@ -994,6 +1054,7 @@ class _NodeChannel(_Channel):
         if clash:
             raise ValueError(f"twoscale: the spectral models differ in {clash}")
         super().__init__({k: (v[0] if k in per_node else v) for k, v in models.items()})
+        self.specialise(models)
         stacked = {k: models[k] for k in per_node}
         stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
         arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
@@ -1028,6 +1089,24 @@ class _NodeChannel(_Channel):
 
     def _node_row(self, i, n):
         return i + self.k * n
+
+
+def _diffraction_stack(channels, bakes):
+    """The channels' bakes as one :class:`_NodeChannel` (channel `k` at a
+    lane's `k`), so that `_draw` runs one diffraction draw per lane, from its
+    own channel, rather than one per channel; None with fewer than two
+    channels, one without the lobe, or channels that differ in what
+    `_NodeChannel` shares."""
+    if len(channels) < 2 or not all(ch.diffraction for ch in channels):
+        return None
+    per_node = [k for k, v in bakes[0].items()
+                if any(not np.array_equal(v, b[k]) for b in bakes[1:])]
+    models = {k: (np.stack([b[k] for b in bakes]) if k in per_node else v)
+              for k, v in bakes[0].items()}
+    try:
+        return _NodeChannel(models, per_node, len(bakes))
+    except ValueError:
+        return None
 
 
 class SpectralModel(Model):
@@ -1187,6 +1266,72 @@ class SpectralModel(Model):
         return _draw(one, [mi.Bool(True)], node.lobe_weights(wi.z), pick, wi, u1, u2, valid)
 
 
+class IntegratedModel(Model):
+    """The integrated RGB model (``brdf::IntegratedRgb``, ``rgb_mode =
+    "integrated"``) of a :class:`twoscale.Material` in Dr.Jit, from
+    :meth:`twoscale.Material.integrated_bakes`: the 8 models' lobes weighted
+    by the colour weights (``R_kc`` over `√cos θd` for the surface lobes,
+    ``P_kc`` for the base and compensation lobes); :meth:`eval` is
+    ``Material.eval``. ``pdf`` and ``sample_direction`` are :class:`Model`'s
+    over the three models the runtime's sampler mixes (``channels``), which
+    is ``IntegratedRgb::pdf`` and ``IntegratedRgb::sample``. `params` as
+    :class:`Model`'s."""
+
+    def __init__(self, material: twoscale.Material, params=None):
+        integrated = material.integrated_bakes()
+        models = integrated["models"]
+        sampler = [int(k) for k in integrated["sampler_nodes"]]
+        super().__init__(material, params, [models[k] for k in sampler])
+        shared = dict(zip(sampler, self.channels))
+        self.nodes = [shared[k] if k in shared else _Channel(b) for k, b in enumerate(models)]
+        self.colour_nodes = integrated["surface"].shape[0]
+        self.surface = mi.Float(np.ascontiguousarray(integrated["surface"], np.float32).ravel())
+        self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
+
+    def surface_weights(self, cos_d):
+        """``ColourBake::surface_at``: `R_kc` at `cos θd`, linear in
+        `√cos θd` between nodes, in f32 (a list over k of three values)."""
+        n = self.colour_nodes
+        t = dr.sqrt(dr.clip(mi.Float64(cos_d), 0.0, 1.0)) * (n - 1)
+        m = dr.minimum(mi.UInt32(dr.floor(t)), n - 2)
+        f = mi.Float(t - mi.Float64(m))
+        width = 3 * len(self.nodes)
+        out = []
+        for k in range(len(self.nodes)):
+            row = []
+            for c in range(3):
+                a = dr.gather(mi.Float, self.surface, m * width + 3 * k + c)
+                b = dr.gather(mi.Float, self.surface, (m + 1) * width + 3 * k + c)
+                row.append(a + f * (b - a))
+            out.append(row)
+        return out
+
+    def eval(self, wi, wo):
+        """ρ(wi, wo) in linear sRGB (sr⁻¹) as an ``mi.Color3f``
+        (``IntegratedRgb::eval``; arguments as :meth:`Model.eval`'s)."""
+        valid, geo = self.geometry(wi, wo)
+        g = self.masking(geo)
+        r = self.surface_weights(geo["cos_d"])
+        out = [mi.Float64(0.0)] * 3
+        for k, node in enumerate(self.nodes):
+            spec, diff, base, multiple = node.lobes(g, geo, self.params)
+            surface = mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff))
+            # The compensation lobe's colour is F_avg's, per node: plain weights.
+            rest = mi.Float64(mi.Float(base)) + mi.Float64(mi.Float(multiple))
+            out = [out[c] + surface * mi.Float64(r[k][c]) + rest * mi.Float64(self.plain[k][c])
+                   for c in range(3)]
+        values = [mi.Float(_finite_or_zero(dr.maximum(x, 0.0))) for x in out]
+        return dr.select(valid, mi.Color3f(*values), 0.0)
+
+
+def rgb_model(material: twoscale.Material, params=None):
+    """The Dr.Jit model of `material`'s RGB (its ``rgb_mode``):
+    :class:`IntegratedModel` or :class:`Model` (the paper's wavelengths)."""
+    if material.rgb_mode == "integrated":
+        return IntegratedModel(material, params)
+    return Model(material, params)
+
+
 def _scalar_bsdf_class():
     """The BSDF in scalar RGB variants: one direction per call, handed to
     the runtime (:class:`twoscale.Material`) directly; Dr.Jit's scalar
@@ -1259,7 +1404,7 @@ def bsdf_class():
             if mi.is_polarized or not (mi.is_rgb or mi.is_spectral):
                 raise RuntimeError(f"twoscale: variant {mi.variant()} is not supported "
                                    "(rgb and unpolarised spectral variants are)")
-            self.model = (SpectralModel if mi.is_spectral else Model)(_material(props))
+            self.model = (SpectralModel if mi.is_spectral else rgb_model)(_material(props))
             self.m_flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             self.m_components = [self.m_flags]
 

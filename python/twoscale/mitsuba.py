@@ -30,6 +30,9 @@ name           type     meaning
 ``halo_weight``,        adds the energy-compensation lobe, docs/model.md
 ``multiple_``           §2.11)
 ``scattering``
+``rgb_mode``   string   ``integrated`` or ``paper-wavelengths``
+                        (``twoscale.RGB_MODES``; default: the material's,
+                        :attr:`twoscale.Material.rgb_mode`), RGB variants
 ============== ======== ====================================================
 
 **Direction convention.** Mitsuba's ``si.wi`` points towards the camera
@@ -77,8 +80,9 @@ import twoscale
 #: Plugin name.
 NAME = "twoscale"
 
-#: Material keywords passed through as strings (the runtime's options).
-OPTION_KEYS = tuple(twoscale.OPTIONS)
+#: Material keywords passed through as strings (the runtime's options and
+#: the RGB mode).
+OPTION_KEYS = (*twoscale.OPTIONS, "rgb_mode")
 #: Material keywords passed through as floats.
 FLOAT_KEYS = ("beta", "p", "sigma_s", "b", "c", "albedo", "lambertian")
 

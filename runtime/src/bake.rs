@@ -565,12 +565,6 @@ impl ConvBake {
         v.array("conv_ln_c", &[PADDED_U, PADDED_S], &self.ln_c);
     }
 
-    /// `ln C` at the node `k` of row `j` (no ghost nodes).
-    #[inline]
-    pub(crate) fn node(&self, j: usize, k: usize) -> f32 {
-        self.ln_c[(j + 1) * PADDED_S + k + 1]
-    }
-
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {

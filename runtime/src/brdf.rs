@@ -70,7 +70,7 @@ use crate::halo::HaloBake;
 use crate::kcorr::SigmaRatioTable;
 use crate::math::{self, BELOW_ONE, upper_unit};
 use crate::smith::SmithG1Table;
-use crate::visible::VisibleSlopeBake;
+use crate::visible::{VisibleIncidence, VisibleSlopeBake};
 use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
@@ -506,23 +506,26 @@ impl<'a> SurfaceBakes<'a> {
 }
 
 /// What one pair of directions gives, independent of the wavelength: the
-/// geometry and D (shared by `pdf` and `eval`, and by the channels of [`Rgb`]).
+/// geometry (shared by `pdf` and `eval`, and by the channels of [`Rgb`];
+/// `pdf` needs no D, [`Pair`] adds it).
 #[derive(Clone, Copy, Debug)]
 struct Geometry {
     wi: [f64; 3],
     wo: [f64; 3],
+    /// The half-vector in f32, as D reads it.
+    h: [f32; 3],
     cos_d: f64,
     cos_h: f64,
     sin_h: f64,
-    /// D(h).
-    d: f64,
 }
 
-/// [`Geometry`] and G(i, o): what `eval` needs of a pair of directions
-/// before the wavelength.
+/// [`Geometry`], D(h) and G(i, o): what `eval` needs of a pair of
+/// directions before the wavelength.
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     geometry: Geometry,
+    /// D(h).
+    d: f64,
     g: f64,
     /// The direction bake's cells of `cos θi`, `cos θo` and `cos θd`.
     cells: [DirectionCell; 3],
@@ -669,6 +672,7 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
     /// [`SurfaceBakes::bake_into`]'s).
     fn bake_wavelength(&mut self, tables: &Tables<'a>, shared: &SurfaceBakes<'a>, eta: Complex) {
         let (surface, big_b, q) = (self.surface, self.big_b, self.q);
+        let white = self.white();
         let sigma_s = f64::from(surface.sigma_s);
         let bake = self.bake.borrow_mut();
         bake.direction.init(
@@ -689,7 +693,42 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             None => false,
         };
         if bake.conv_baked {
-            bake.halo.init(&bake.conv);
+            let (x_scale, sigma_s_sq, options) = (self.x_scale, self.sigma_s_sq, self.options);
+            let (direction, masking) = (&bake.direction, &bake.masking);
+            // The halo's factors besides C and the projections: Q̄ G (1 − A)/σrel².
+            let g1 =
+                |z: f64| f64::from(masking.g1(math::sqrt((1.0 - z * z).max(0.0)) as f32, z as f32));
+            // The incidence's values, computed once per row.
+            let row = core::cell::Cell::new((f64::NAN, direction.at(1.0), 1.0));
+            let weight = |cos_i: f64, cos_d: f64, cos_o: f64, along: f64, across: f64| {
+                if row.get().0 != cos_i {
+                    row.set((cos_i, direction.at(cos_i as f32), g1(cos_i)));
+                }
+                let (_, at_i, g1_i) = row.get();
+                let at_o = direction.at(cos_o as f32);
+                let q = if white {
+                    1.0
+                } else {
+                    match &q {
+                        Some(q) => q
+                            .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
+                            .max(0.0),
+                        None => 0.0,
+                    }
+                };
+                let sigma_rel_sq = sigma_s_sq * sigma_ratio_sq(options.sigma_rel, &at_i, &at_o);
+                let cos_a = match options.halo_weight {
+                    HaloWeight::Printed => cos_d,
+                    HaloWeight::Incident => cos_i,
+                };
+                let halo = exp_and_one_minus_over(x_scale * cos_a * cos_a, sigma_rel_sq).1;
+                let g = match options.masking {
+                    Masking::Separable => g1_i * g1(cos_o),
+                    Masking::HeightCorrelated => 1.0 / (1.0 / g1_i + 1.0 / g1(cos_o) - 1.0),
+                };
+                q * halo * g
+            };
+            bake.halo.init(&bake.conv, &weight);
         }
         let specular = tables
             .albedo
@@ -930,19 +969,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
     fn sigma_ratio_sq(&self, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
-        match self.options.sigma_rel {
-            SigmaRelMode::Incident => {
-                let r = at_i.sigma_ratio();
-                r * r
-            }
-            SigmaRelMode::Symmetrised => {
-                let (a, b) = (at_i.sigma_ratio(), at_o.sigma_ratio());
-                0.5 * (a * a + b * b)
-            }
-        }
+        sigma_ratio_sq(self.options.sigma_rel, at_i, at_o)
     }
 
-    /// The geometry of `(i, o)` and D(h); `None` below the horizon.
+    /// The geometry of `(i, o)`; `None` below the horizon.
     fn geometry(&self, i: [f32; 3], o: [f32; 3]) -> Option<Geometry> {
         let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -957,10 +987,10 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(Geometry {
             wi,
             wo,
+            h: to_f32(h),
             cos_d,
             cos_h,
             sin_h,
-            d: f64::from(self.ndf.d(to_f32(h))),
         })
     }
 
@@ -970,7 +1000,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(self.with_masking(self.geometry(i, o)?))
     }
 
-    /// G(i, o) added to `geometry`.
+    /// D(h) and G(i, o) added to `geometry`.
     fn with_masking(&self, geometry: Geometry) -> Pair {
         let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
@@ -988,6 +1018,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         let cos = |x: f64| DirectionCell::new(x as f32);
         Pair {
             geometry,
+            d: f64::from(self.ndf.d(geometry.h)),
             g,
             cells: [cos(wi[2]), cos(wo[2]), cos(geometry.cos_d)],
             along: -(wi[0] * wo[0] + wi[1] * wo[1]),
@@ -1033,8 +1064,9 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                     cos_d,
                     cos_h,
                     sin_h,
-                    d,
+                    ..
                 },
+            d,
             g,
             cells,
             along,
@@ -1281,7 +1313,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         }
     }
 
-    /// [`TwoScale::pdf`] at a pair's geometry (the specular density from its D).
+    /// [`TwoScale::pdf`] at a pair's geometry.
     fn pdf_at(&self, geometry: &Geometry) -> f64 {
         self.pdf_with_specular(geometry, self.specular_pdf(geometry))
     }
@@ -1295,7 +1327,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// [`TwoScale::pdf_at`] given the specular lobe's density `specular`
     /// (which [`Rgb`] computes once for its channels).
     fn pdf_with_specular(&self, geometry: &Geometry, specular: f64) -> f64 {
-        let w = self.weights(geometry.wi[2]);
+        self.pdf_with(geometry, &self.weights(geometry.wi[2]), specular)
+    }
+
+    /// [`TwoScale::pdf_at`] given the lobe weights `w` at θi and the
+    /// specular lobe's density `specular` (which [`TwoScale::sample`] has from
+    /// its draw).
+    fn pdf_with(&self, geometry: &Geometry, w: &[f64; 4], specular: f64) -> f64 {
         let mut total = 0.0;
         if w[0] > 0.0 {
             total += w[0] * specular;
@@ -1316,13 +1354,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * specular: the density of reflecting `i` about a visible EPD normal
     ///   (the tabulated `D_vis`, `crate::visible`: `P2_tab g_tab / (8 N_tab β²
     ///   |i'| cos⁴θh)`, docs/model.md §2.1), 0 where `i·h ≤ 0`;
-    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (`SPECTRUM_SHARE` = 0.1
-    ///   ε; the spectrum's alone when C is not baked). The spectrum's
+    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (ε =
+    ///   `SPECTRUM_SHARE`, 0: the half-vector draw alone; the spectrum's
+    ///   alone when C is not baked). The spectrum's
     ///   (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
     ///   `pdf = (c−1) B² (1 + B²|d|²)^(−(c+1)/2) / (2 M φmax) · cos θo`; the
-    ///   half-vector draw's `Σ_j w_j p_j(ζ) / (4 N(θh))` (`crate::halo`);
+    ///   half-vector draw's `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))` (`crate::halo`);
     /// * base and multiple: `cos θo / π`.
     ///
     /// 0 below the horizon or where the lobe cannot produce `o`.
@@ -1381,17 +1420,21 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             sin_h,
             ..
         } = *geometry;
-        let spectrum = self.spectrum_pdf(wi, wo);
         match self.bake().halo() {
             Some(halo) => {
                 let half = if cos_d > 0.0 {
-                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h)
+                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h, wo[2])
+                } else {
+                    0.0
+                };
+                let spectrum = if SPECTRUM_SHARE > 0.0 {
+                    self.spectrum_pdf(wi, wo)
                 } else {
                     0.0
                 };
                 SPECTRUM_SHARE * spectrum + (1.0 - SPECTRUM_SHARE) * half
             }
-            None => spectrum,
+            None => self.spectrum_pdf(wi, wo),
         }
     }
 
@@ -1423,7 +1466,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///
     /// * specular: `m` a visible normal of the EPD (the tabulated visible-slope
     ///   sampler of docs/model.md §2.1, `u` its two uniforms), `o = 2(i·m)m − i`;
-    /// * diffraction: with probability ε (`SPECTRUM_SHARE` = 0.1, picked by `u₁`,
+    /// * diffraction: with probability ε (`SPECTRUM_SHARE`, 0; picked by `u₁`,
     ///   rescaled) the spectrum's draw, else the half-vector draw of
     ///   `crate::halo` reflected; the spectrum's draw
     ///   (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
@@ -1435,10 +1478,27 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * base and multiple: cosine-weighted hemisphere.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
+        let visible = match lobe {
+            Lobe::Specular => Some(self.bake().visible.incidence(wi)),
+            _ => None,
+        };
+        self.draw_lobe(lobe, wi, visible.as_ref(), u)
+    }
+
+    /// [`TwoScale::sample_lobe`] for the unit incidence `wi`, with the
+    /// visible-normal sampler's incidence `visible` (needed for the specular
+    /// lobe only).
+    fn draw_lobe(
+        &self,
+        lobe: Lobe,
+        wi: [f64; 3],
+        visible: Option<&VisibleIncidence>,
+        u: [f32; 2],
+    ) -> Option<[f32; 3]> {
         let u = u.map(|x| f64::from(x.max(0.0).min(BELOW_ONE)));
         let o = match lobe {
             Lobe::Specular => {
-                let m = self.bake().visible.sample(wi, u)?;
+                let m = self.bake().visible.sample_at(visible?, u)?;
                 let k = 2.0 * dot(wi, m);
                 [k * m[0] - wi[0], k * m[1] - wi[1], k * m[2] - wi[2]]
             }
@@ -1512,10 +1572,20 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// lobe draws visible normals from the material's tabulated visible-slope
     /// density, which `pdf` evaluates (docs/model.md §2.1).
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<Sample> {
-        let (o, lobe) = self.sample_direction(i, u)?;
+        let wi = upper_unit(i)?;
+        // The lobe weights and the visible-normal sampler's incidence serve
+        // the draw and the pdf: the same values `pdf(i, o)` computes from `i`.
+        let w = self.weights(wi[2]);
+        let lobe = pick_lobe(f64::from(u[0].max(0.0).min(BELOW_ONE)), w);
+        let visible = (w[0] > 0.0).then(|| self.bake().visible.incidence(wi));
+        let o = self.draw_lobe(lobe, wi, visible.as_ref(), [u[1], u[2]])?;
         // pdf(i, o) and eval(i, o) from one geometry.
         let geometry = self.geometry(i, o)?;
-        let pdf = finite_or_zero(self.pdf_at(&geometry));
+        let specular = match &visible {
+            Some(inc) => self.bake().visible.pdf_at(inc, geometry.wi, geometry.wo),
+            None => 0.0,
+        };
+        let pdf = finite_or_zero(self.pdf_with(&geometry, &w, specular));
         if !(pdf > 0.0) {
             return None;
         }
@@ -1565,8 +1635,24 @@ fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
 }
 
 /// The share of the spectrum's draw (HP17 51-55) in the diffraction lobe's
-/// mixture with the half-vector draw (docs/design/halo-sampling.md).
-const SPECTRUM_SHARE: f64 = 0.1;
+/// mixture with the half-vector draw where C is baked: 0, the half-vector
+/// draw follows the halo closer everywhere measured
+/// (docs/design/halo-sampling.md).
+const SPECTRUM_SHARE: f64 = 0.0;
+
+/// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
+fn sigma_ratio_sq(mode: SigmaRelMode, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
+    match mode {
+        SigmaRelMode::Incident => {
+            let r = at_i.sigma_ratio();
+            r * r
+        }
+        SigmaRelMode::Symmetrised => {
+            let (a, b) = (at_i.sigma_ratio(), at_o.sigma_ratio());
+            0.5 * (a * a + b * b)
+        }
+    }
+}
 
 /// Nodes of [`TwoScale::halo_deficit`] over `√cos θi` (linear between).
 const DEFICIT_NODES: usize = 17;

@@ -29,10 +29,11 @@
 //! [`crate::brdf::RGB_WAVELENGTHS`] for a material; one per wavelength of
 //! the file for `materials.toml`. A material may instead give its index
 //! over the spectrum, `eta = { lambda = [0.4, 0.5, 0.6], n = […], k = […] }`
-//! (λ in µm, increasing; [`crate::optical::Tabulated`]): its RGB at the
-//! paper's wavelengths is the spectrum there, and `rgb_mode = "integrated"`
-//! (default `"paper-wavelengths"`, [`RgbMode`]) makes the model's RGB the
-//! integral over the spectrum. Python's `Material(eta=(lam, n, k))` and
+//! (λ in µm, increasing; [`crate::optical::Tabulated`]): its model's RGB is
+//! then the integral over the spectrum (`rgb_mode = "integrated"`, the
+//! default of a material over the spectrum, [`RgbMode::default_for`]), or
+//! with `rgb_mode = "paper-wavelengths"` the spectrum at the paper's
+//! wavelengths (the default of three `(n, k)` pairs). Python's `Material(eta=(lam, n, k))` and
 //! the C API's `ts_material_desc.eta_rows` are the same form. Numbers are read as `f64` and rounded to
 //! the runtime's `f32`, as Python's keywords are.
 //!
@@ -112,7 +113,7 @@ pub struct Keywords<'a> {
     pub halo_weight: Option<&'a str>,
     /// [`crate::brdf::MultipleScattering`]'s name.
     pub multiple_scattering: Option<&'a str>,
-    /// [`RgbMode`]'s name (default: the paper's wavelengths).
+    /// [`RgbMode`]'s name (default: [`RgbMode::default_for`]).
     pub rgb_mode: Option<&'a str>,
 }
 
@@ -182,7 +183,7 @@ impl<'a> Keywords<'a> {
             Eta::Spectrum(_) => None,
         };
         let (layer, options) = self.checked(channels)?;
-        let rgb_mode = validate::named(self.rgb_mode)?;
+        let rgb_mode = validate::named_or_none(self.rgb_mode)?;
         match self.eta {
             Eta::Channels(pairs) => {
                 let mut eta_rgb = [Complex::new(0.0, 0.0); 3];
@@ -235,13 +236,15 @@ pub struct MaterialDesc<'a> {
 impl<'a> MaterialDesc<'a> {
     /// An RGB material (validated, [`Material::validate`]); its spectrum if
     /// every channel has the same index. [`RgbMode::Integrated`] needs one
-    /// ([`Refused::IntegratedNeedsSpectrum`]).
+    /// ([`Refused::IntegratedNeedsSpectrum`]); `None`: the paper's
+    /// wavelengths ([`RgbMode::default_for`]).
     pub fn rgb(
         material: Material,
         options: Options,
-        rgb_mode: RgbMode,
+        rgb_mode: Option<RgbMode>,
     ) -> Result<MaterialDesc<'static>, Refused<'static>> {
         material.validate()?;
+        let rgb_mode = rgb_mode.unwrap_or(RgbMode::default_for(false));
         let spectral = SpectralMaterial::with_one_index(&material);
         if rgb_mode == RgbMode::Integrated && spectral.is_none() {
             return Err(Refused::IntegratedNeedsSpectrum);
@@ -256,18 +259,19 @@ impl<'a> MaterialDesc<'a> {
 
     /// A material over the spectrum (validated,
     /// [`SpectralMaterial::validate`]); its RGB material is the spectrum at
-    /// the paper's wavelengths.
+    /// the paper's wavelengths. `None`: the integrated RGB
+    /// ([`RgbMode::default_for`]).
     pub fn spectral(
         spectral: SpectralMaterial<'a>,
         options: Options,
-        rgb_mode: RgbMode,
+        rgb_mode: Option<RgbMode>,
     ) -> Result<MaterialDesc<'a>, Refused<'a>> {
         spectral.validate()?;
         Ok(MaterialDesc {
             material: spectral.paper_rgb(),
             spectral: Some(spectral),
             options,
-            rgb_mode,
+            rgb_mode: rgb_mode.unwrap_or(RgbMode::default_for(true)),
         })
     }
 
@@ -643,7 +647,22 @@ mod tests {
         assert_eq!(s.eta, Ior::Tabulated(Tabulated::new(&rows).unwrap()));
         assert_eq!(d.material, s.paper_rgb());
         assert_eq!(d.rgb_mode, RgbMode::Integrated);
-        // One index for every channel is a spectrum too; different ones are not.
+        // A spectrum's default is the integrated RGB; the paper's on request.
+        let default = Keywords {
+            rgb_mode: None,
+            ..k
+        };
+        assert_eq!(default.material().unwrap().rgb_mode, RgbMode::Integrated);
+        let paper = Keywords {
+            rgb_mode: Some("paper-wavelengths"),
+            ..k
+        };
+        assert_eq!(
+            paper.material().unwrap().rgb_mode,
+            RgbMode::PaperWavelengths
+        );
+        // One index for every channel is a spectrum too (its default stays
+        // the paper's wavelengths); different ones are not.
         let d = Keywords {
             eta: Eta::Channels(&[[1.5, 0.0]; 3]),
             ..gold()

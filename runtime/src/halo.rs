@@ -2,34 +2,40 @@
 //! material and wavelength from the C bake (docs/model.md §2.7;
 //! docs/design/halo-sampling.md).
 //!
-//! The halo is `ρ_CTD ∝ Q̄ G (1 − A)/σrel² · C(θh; u)`, `u = B cos θd`: over
-//! the half-vector it is shaped by `C`, which depends on θh (isotropic about
-//! the normal) and on `u`. [`HaloBake`] takes each row `u_j` of the C bake
-//! ([`ConvBake`]) and makes it a density over `ζ = 1 − cos θh`
-//! (`dω_h = dζ dφ`): piecewise linear between every other of the row's own
-//! θh nodes (66 of 130; the variance is the same as with all of them), with
-//! the node values `C(θh,k; u_j)`. The sampler draws, for an incidence `i`,
-//! ζ from the rows around `u = B cos θi`, then the azimuth of `h` about the
-//! normal with a density `∝ (i·h)₊` (as visible normals are weighted):
+//! The halo is `ρ_CTD ∝ Q̄ G (1 − A)/σrel² · C(θh; u)`, `u = B cos θd`, and
+//! `ρ_CTD cos θo dωo = ρ_CTD cos θo · 4 (i·h) dζ dψ` over the half-vector
+//! (`ζ = 1 − cos θh`, `ψ = φh − φi`). [`HaloBake`] keeps, for each row `u_j`
+//! of the C bake ([`ConvBake`]), i.e. for the incidence `cos θi,j = u_j / B`,
+//! a density over ζ, piecewise linear between every other of the row's θh
+//! nodes (66 of 130). The sampler draws ζ from the rows around
+//! `u = B cos θi`, then ψ from the [`Azimuth`] law
+//! `∝ (i·h) (cos θo)₊`, which holds two of the halo's factors exactly; the
+//! row's node values are the ζ density that minimises the weight's second
+//! moment given that law, `√(N(θh) ∫ (i·h)(cos θo)₊ (C(θh; B i·h) W)² dψ)`
+//! with `W = Q̄ G (1 − A)/σrel²` at the row's incidence (4-point
+//! Gauss–Legendre in ψ):
 //!
 //! ```text
-//! p(h)   = Σ_j w_j(B cos θi) p_j(ζ) · (i·h)₊ / N(θh)
+//! p(h)   = Σ_j w_j(B cos θi) p_j(ζ) · (i·h)(cos θo)₊ / N(θh)
 //! p_j(ζ) = m_jk / M_j · d_j(ζ) / ((d_jk + d_j,k+1)/2 · Δζ_k)     ζ in cell k
-//! N(θh)  = ∫ (a cos ψ + b)₊ dψ = 2 (a sin H + b H),   a = sin θi sin θh, b = cos θi cos θh,
-//!          H = π if b ≥ a, else acos(−b/a)
-//! pdf(o) = p(h) / (4 i·h) = Σ_j w_j p_j(ζ) / (4 N(θh))
+//! N(θh)  = ∫ (i·h)(cos θo)₊ dψ = 2 F(H)              (Azimuth: i·h = a cos ψ + b,
+//!          cos θo = 2 (i·h) cos θh − cos θi, a = sin θi sin θh, b = cos θi cos θh)
+//! pdf(o) = p(h) / (4 i·h) = Σ_j w_j p_j(ζ) cos θo / (4 N(θh))
 //! ```
 //!
 //! with `w_j` the weights of the rows around `u`, linear in `u` between the
 //! rows' own `u_j` (a mixture: the row is picked with its weight; found in
-//! f64 by a binary search, so that ports reproduce the pick), `d_j` the piecewise-linear density, `m_jk` the
-//! cell's mass as stored in the row's cumulative and `M_j` the row's total.
-//! Within a cell the CDF of ζ is a quadratic, solved in closed form; the
-//! azimuth's CDF `(a sin ψ + b ψ)/(a sin H + b H)` on each side is inverted
-//! by Newton's method in a shrinking bracket. [`HaloBake::pdf`] evaluates
-//! the same expression, so the density is the one drawn (to rounding).
-//! Where `i·h ≤ 0` nothing is drawn. Beyond the C bake's last node
-//! (`cos θh = 10⁻³`) nothing is drawn.
+//! f64 by a binary search, so that ports reproduce the pick), `d_j` the
+//! piecewise-linear density, `m_jk` the cell's mass as stored in the row's
+//! cumulative and `M_j` the row's total. Within a cell the CDF of ζ is a
+//! quadratic, solved in closed form; the azimuth's CDF `F(ψ)/F(H)` on each
+//! side is inverted by Newton's method in a shrinking bracket.
+//! [`HaloBake::pdf`] evaluates the same expression, so the density is the
+//! one drawn (to rounding). Where no azimuth gives `cos θo > 0` nothing is
+//! drawn; beyond the C bake's last node (`cos θh = 10⁻³`) neither. The
+//! support covers the halo's: a row at a larger θi reaches further
+//! (`θh < 45° + θi/2`), and the lower row's weight is positive unless the
+//! incidence is the upper row's own.
 
 use crate::bake::{BakeVisitor, CONV_S_NODES, CONV_U_NODES, ConvBake, row_tans};
 
@@ -62,14 +68,20 @@ pub(crate) struct HaloBake {
 }
 
 impl HaloBake {
-    /// Tabulates the densities of `conv`'s rows in place.
-    pub fn init(&mut self, conv: &ConvBake) {
+    /// Tabulates the densities of `conv`'s rows in place; `weight(cos θi,
+    /// cos θd, cos θo, along, across)` is the halo's `Q̄ G (1 − A)/σrel²`
+    /// (`along`, `across` as [`crate::fresnel`]'s Q̄ takes them).
+    pub fn init(&mut self, conv: &ConvBake, weight: &dyn Fn(f64, f64, f64, f64, f64) -> f64) {
+        let big_b = f64::from(conv.row_u[CONV_U_NODES - 1]);
         for j in 0..CONV_U_NODES {
             self.u[j] = f64::from(conv.row_u[j]);
+            // The row's incidence, `cos θi = u_j / B`.
+            let cos_i = if big_b > 0.0 {
+                (self.u[j] / big_b).min(1.0)
+            } else {
+                1.0
+            };
             let tans = row_tans(conv.row_inv_w[j]);
-            let top = (0..NODES)
-                .map(|k| conv.node(j, conv_node(k)))
-                .fold(f32::MIN, f32::max);
             let mut f = [0.0f64; NODES];
             let mut integral = 0.0f64;
             for k in 0..NODES {
@@ -77,7 +89,7 @@ impl HaloBake {
                 let sec = math::sqrt(1.0 + t * t);
                 // ζ = 1 − cos θ = tan²θ / (1 + tan²θ + sec θ), without cancellation.
                 self.zeta[j][k] = (t * t / (1.0 + t * t + sec)) as f32;
-                f[k] = math::exp(f64::from(conv.node(j, conv_node(k)) - top));
+                f[k] = row_value(conv, big_b, cos_i, 1.0 / sec, weight);
                 if k > 0 {
                     let dz = f64::from(self.zeta[j][k]) - f64::from(self.zeta[j][k - 1]);
                     integral += 0.5 * dz * (f[k] + f[k - 1]);
@@ -115,7 +127,8 @@ impl HaloBake {
     /// Draws `h` for the incidence `wi` and `u = B cos θi` from two
     /// uniforms in [0, 1): `pick` picks the row (the lower one below
     /// `1 − t`) and, rescaled, the azimuth; `along` gives `ζ`. `None` when
-    /// the row holds no density.
+    /// the row holds no density or no azimuth at the drawn θh reflects `i`
+    /// above the horizon.
     pub fn sample_h(&self, wi: [f64; 3], u_i: f64, pick: f64, along: f64) -> Option<[f64; 3]> {
         let (j, t) = self.row_cell(u_i);
         let (row, azimuth) = if pick < 1.0 - t {
@@ -151,17 +164,16 @@ impl HaloBake {
         let z = z0 + tau * (z1 - z0);
         let cos_h = 1.0 - z;
         let sin_h = math::sqrt((z * (2.0 - z)).max(0.0));
-        // ψ = φh − φi from (a cos ψ + b)₊: the side from the azimuth's
+        // ψ = φh − φi from (i·h)(cos θo)₊: the side from the azimuth's
         // first half, the magnitude from the rest.
         let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
-        let (a, b) = (sin_i * sin_h, wi[2] * cos_h);
+        let law = Azimuth::new(sin_i, wi[2], sin_h, cos_h)?;
         let (side, rest) = if azimuth < 0.5 {
             (-1.0, 2.0 * azimuth)
         } else {
             (1.0, 2.0 * azimuth - 1.0)
         };
-        let (big_h, sin_big_h) = half_range(a, b);
-        let psi = side * solve_azimuth(a, b, big_h, rest * (a * sin_big_h + b * big_h));
+        let psi = side * law.solve(rest * law.half);
         let (cos_phi_i, sin_phi_i) = if sin_i > 0.0 {
             (wi[0] / sin_i, wi[1] / sin_i)
         } else {
@@ -177,17 +189,16 @@ impl HaloBake {
 
     /// The density over the outgoing direction of reflecting `wi` about
     /// [`HaloBake::sample_h`]'s draw for `u = B cos θi`, at a half-vector
-    /// with `sin θh`, `cos θh` (module documentation: `Σ_j w_j p_j(ζ) / (4 N(θh))`).
-    pub fn pdf(&self, wi: [f64; 3], u_i: f64, sin_h: f64, cos_h: f64) -> f64 {
+    /// with `sin θh`, `cos θh` and `cos θo` (module documentation:
+    /// `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`).
+    pub fn pdf(&self, wi: [f64; 3], u_i: f64, sin_h: f64, cos_h: f64, cos_o: f64) -> f64 {
         let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
-        let (a, b) = (sin_i * sin_h, wi[2] * cos_h);
-        let (big_h, sin_big_h) = half_range(a, b);
-        let norm = 2.0 * (a * sin_big_h + b * big_h);
-        if !(norm > 0.0) {
+        let Some(law) = Azimuth::new(sin_i, wi[2], sin_h, cos_h) else {
             return 0.0;
-        }
+        };
         let zeta = sin_h * sin_h / (1.0 + cos_h);
-        self.pdf_zeta(u_i, zeta) / (4.0 * norm)
+        // N(θh) = 2 F(H).
+        self.pdf_zeta(u_i, zeta) * cos_o.max(0.0) / (8.0 * law.half)
     }
 
     /// The density of ζ drawn for `u = B cos θi`, `Σ_j w_j p_j(ζ)`.
@@ -239,50 +250,143 @@ impl HaloBake {
     }
 }
 
-/// `(H, sin H)`: the half-width of the azimuths `ψ` where `a cos ψ + b > 0`
-/// (`a, b ≥ 0`): π when `b ≥ a`, else `acos(−b/a)`.
-#[inline]
-fn half_range(a: f64, b: f64) -> (f64, f64) {
-    if b >= a {
-        (PI, 0.0)
-    } else {
-        let x = b / a;
-        (math::acos(-x), math::sqrt((1.0 - x * x).max(0.0)))
+/// The azimuth law of `h` about the normal for the incidence
+/// `(sin θi, cos θi)` at `(sin θh, cos θh)`: with `ψ = φh − φi`,
+/// `i·h = a cos ψ + b` (`a = sin θi sin θh`, `b = cos θi cos θh`) and
+/// `cos θo = 2 (i·h) cos θh − cos θi`, the density is
+/// `∝ (i·h) (cos θo)₊ = A₂ cos²ψ + A₁ cos ψ + A₀` on `|ψ| < H`, where
+/// `cos θo > 0` (`i·h > κ = cos θi / (2 cos θh)`), with
+/// `A₂ = 2 cos θh a²`, `A₁ = (4 cos θh b − cos θi) a`, `A₀ = (2 cos θh b − cos θi) b`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Azimuth {
+    /// `H`, the half-width of the azimuths where `cos θo > 0`.
+    pub big_h: f64,
+    /// `[A₂, A₁, A₀]`.
+    coef: [f64; 3],
+    /// `F(H)` with `F(ψ) = A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ`; the
+    /// normalisation `N(θh) = ∫ (i·h)(cos θo)₊ dψ` is `2 F(H)`.
+    pub half: f64,
+}
+
+impl Azimuth {
+    /// The law at `(sin θi, cos θi)` and `(sin θh, cos θh)`; `None` where no
+    /// azimuth gives `cos θo > 0` (or `cos θh ≤ 0`).
+    pub fn new(sin_i: f64, cos_i: f64, sin_h: f64, cos_h: f64) -> Option<Self> {
+        if !(cos_h > 0.0) {
+            return None;
+        }
+        let (a, b) = (sin_i * sin_h, cos_i * cos_h);
+        let kappa = cos_i / (2.0 * cos_h);
+        let big_h = if b - a >= kappa {
+            PI
+        } else if b + a > kappa {
+            // Inlined (to 2.2e-8, as φmax): a libm call was 13% of `pdf`.
+            math::acos_approx(((kappa - b) / a).max(-1.0).min(1.0))
+        } else {
+            return None;
+        };
+        let coef = [
+            2.0 * cos_h * a * a,
+            (4.0 * cos_h * b - cos_i) * a,
+            (2.0 * cos_h * b - cos_i) * b,
+        ];
+        let half = cdf(coef, big_h);
+        (half > 0.0).then_some(Azimuth { big_h, coef, half })
+    }
+
+    /// The `ψ ∈ [0, H]` with `F(ψ) = target` (`0 ≤ target ≤ F(H)`; F
+    /// increases on [0, H]): Newton's method kept in a shrinking bracket (a
+    /// step leaving it bisects), to `1e-12` in ψ.
+    pub fn solve(&self, target: f64) -> f64 {
+        let (mut lo, mut hi) = (0.0f64, self.big_h);
+        let mut psi = self.big_h * (target / self.half).max(0.0).min(1.0);
+        for _ in 0..AZIMUTH_STEPS {
+            let f = cdf(self.coef, psi) - target;
+            if f > 0.0 {
+                hi = psi;
+            } else {
+                lo = psi;
+            }
+            let c = math::cos(psi);
+            let slope = (self.coef[0] * c + self.coef[1]) * c + self.coef[2];
+            let next = psi - f / slope;
+            let newton = slope > 0.0 && next >= lo && next <= hi;
+            // A converged step is taken even where it rounds onto the
+            // bracket's end (bisecting there would leave the root).
+            if newton && (next - psi).abs() < 1e-12 {
+                return next;
+            }
+            let next = if newton && next > lo && next < hi {
+                next
+            } else {
+                0.5 * (lo + hi)
+            };
+            if (next - psi).abs() < 1e-12 {
+                return next;
+            }
+            psi = next;
+        }
+        psi
     }
 }
 
-/// The `ψ ∈ [0, H]` with `a sin ψ + b ψ = target` (`0 ≤ target ≤ a sin H +
-/// b H`; the left side increases on [0, H]): Newton's method kept in a
-/// shrinking bracket (a step leaving it bisects), to `1e-12` in ψ.
-fn solve_azimuth(a: f64, b: f64, big_h: f64, target: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0f64, big_h);
-    let total = a * math::sin(big_h) + b * big_h;
-    let mut psi = if total > 0.0 {
-        big_h * (target / total).max(0.0).min(1.0)
-    } else {
-        0.0
-    };
-    for _ in 0..AZIMUTH_STEPS {
-        let f = a * math::sin(psi) + b * psi - target;
-        if f > 0.0 {
-            hi = psi;
-        } else {
-            lo = psi;
-        }
-        let slope = a * math::cos(psi) + b;
-        let next = psi - f / slope;
-        let next = if slope > 0.0 && next > lo && next < hi {
-            next
-        } else {
-            0.5 * (lo + hi)
-        };
-        if (next - psi).abs() < 1e-12 {
-            return next;
-        }
-        psi = next;
-    }
-    psi
+/// `F(ψ) = A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ` of [`Azimuth`].
+#[inline]
+fn cdf(coef: [f64; 3], psi: f64) -> f64 {
+    let (s, c) = (math::sin(psi), math::cos(psi));
+    0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
 }
+
+/// The row density's value at `θh` for the row's incidence: the density of
+/// ζ that minimises the halo weight's second moment under the azimuth law
+/// [`Azimuth`], `√(N(θh) ∫ (i·h)(cos θo)₊ (C(θh; B i·h) W)² dψ)` with
+/// `W = weight(cos θi, i·h, cos θo)` (the halo's factors besides C and the
+/// projections), the integral by Gauss–Legendre over `[0, H]` (symmetric).
+fn row_value(
+    conv: &ConvBake,
+    big_b: f64,
+    cos_i: f64,
+    cos_h: f64,
+    weight: &dyn Fn(f64, f64, f64, f64, f64) -> f64,
+) -> f64 {
+    let sin_i = math::sqrt((1.0 - cos_i * cos_i).max(0.0));
+    let sin_h = math::sqrt((1.0 - cos_h * cos_h).max(0.0));
+    let Some(law) = Azimuth::new(sin_i, cos_i, sin_h, cos_h) else {
+        return 0.0;
+    };
+    let (a, b) = (sin_i * sin_h, cos_i * cos_h);
+    let mut sum = 0.0;
+    for (x, w) in GL_X.iter().zip(GL_W) {
+        let psi = 0.5 * law.big_h * (1.0 + x);
+        let (cos_psi, sin_psi) = (math::cos(psi), math::sin(psi));
+        let cos_d = a * cos_psi + b;
+        let cos_o = 2.0 * cos_d * cos_h - cos_i;
+        if cos_o > 0.0 {
+            // −i_p·o_p and −(i_p × o_p)_z with o_p = 2 (i·h) h_p − i_p, φi = 0.
+            let along = -sin_i * (2.0 * cos_d * sin_h * cos_psi - sin_i);
+            let across = -2.0 * cos_d * sin_i * sin_h * sin_psi;
+            let c = f64::from(conv.at(sin_h as f32, cos_h as f32, (big_b * cos_d) as f32));
+            let g = c * weight(cos_i, cos_d, cos_o, along, across);
+            sum += w * cos_d * cos_o * g * g;
+        }
+    }
+    let value = math::sqrt((sum * law.big_h * law.half).max(0.0));
+    if value.is_finite() { value } else { 0.0 }
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] for [`row_value`].
+const GL_X: [f64; 4] = [
+    -0.861136311594053,
+    -0.339981043584856,
+    0.339981043584856,
+    0.861136311594053,
+];
+const GL_W: [f64; 4] = [
+    0.347854845137454,
+    0.652145154862546,
+    0.652145154862546,
+    0.347854845137454,
+];
 
 /// At most this many Newton steps for the azimuth (bisection alone would
 /// need ~40 for 1e-12 of π).
@@ -340,7 +444,11 @@ mod tests {
         ] {
             let slice = set.convolution.slice(c, beta, p).unwrap();
             let conv = ConvBake::new(&slice, big_b, beta, p).unwrap();
-            halo.init(&conv);
+            // Any positive weight: the identity holds for the density the
+            // rows carry; this one varies with all three cosines.
+            halo.init(&conv, &|cos_i, cos_d, cos_o, _, _| {
+                (0.5 + cos_i) * cos_d * (0.2 + cos_o.max(0.0))
+            });
             for theta in [0.0f64, 30.0, 60.0, 80.0, 85.0] {
                 let (s, co) = (theta.to_radians().sin(), theta.to_radians().cos());
                 let wi = [s * 0.7f64.cos(), s * 0.7f64.sin(), co];
@@ -370,7 +478,8 @@ mod tests {
                     ];
                     let os = hs.map(|pair| pair.map(|h| reflect(wi, h)));
                     let sin_h = (h[0] * h[0] + h[1] * h[1]).sqrt();
-                    let q = weight * halo.pdf(wi, row_u, sin_h, h[2]);
+                    let cos_o = reflect(wi, h)[2];
+                    let q = weight * halo.pdf(wi, row_u, sin_h, h[2], cos_o);
                     let i_h = wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2];
                     let err_o = (q * area(os[0], os[1], e) - 1.0).abs();
                     let err_h = (q * 4.0 * i_h * area(hs[0], hs[1], e) - 1.0).abs();

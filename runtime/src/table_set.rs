@@ -199,10 +199,33 @@ impl<'a> TableSet<'a> {
     }
 
     /// The RGB model of a shipped preset ([`crate::materials::PRESETS`]) with
-    /// the paper's options; an unknown name is an error that lists the presets.
+    /// the paper's options, at the paper's wavelengths (by value and
+    /// `no_std`; [`TableSet::preset`] gives the presets' default RGB, the
+    /// integral over the spectrum); an unknown name is an error that lists
+    /// the presets.
     pub fn material<'n>(&self, name: &'n str) -> Result<Rgb<'_>, UnknownMaterial<'n>> {
         let material = crate::materials::preset(name).ok_or(UnknownMaterial { name })?;
         Ok(self.rgb(&material, Options::default()))
+    }
+
+    /// The RGB model of a shipped preset with the paper's options and the
+    /// presets' default RGB ([`crate::brdf::RgbMode::default_for`]: the
+    /// integral over the spectrum, [`crate::brdf::IntegratedRgb`]), its
+    /// bakes on the heap (feature `std`); an unknown name is an error that
+    /// lists the presets.
+    #[cfg(feature = "std")]
+    pub fn preset<'n>(
+        &self,
+        name: &'n str,
+    ) -> Result<
+        crate::brdf::RgbModel<'_, std::boxed::Box<crate::brdf::ChannelBake>>,
+        UnknownMaterial<'n>,
+    > {
+        let spectral = crate::materials::spectral(name).ok_or(UnknownMaterial { name })?;
+        // Every preset validates (`every_preset_is_found_and_an_unknown_name_lists_them`).
+        let desc = crate::desc::MaterialDesc::spectral(spectral, Options::default(), None)
+            .map_err(|_| UnknownMaterial { name })?;
+        Ok(crate::brdf::RgbModel::boxed(&self.brdf_tables(), &desc))
     }
 }
 
@@ -420,6 +443,16 @@ mod tests {
             let v = model.eval([0.3, 0.1, 0.9], [-0.3, 0.0, 0.95]);
             assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {v:?}");
         }
+        for (name, _) in PRESETS {
+            let model = set.preset(name).expect("preset");
+            assert!(
+                matches!(model, crate::brdf::RgbModel::Integrated(_)),
+                "{name}"
+            );
+            let v = crate::bxdf::Bxdf::eval(&model, [0.3, 0.1, 0.9], [-0.3, 0.0, 0.95]);
+            assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {v:?}");
+        }
+        assert!(set.preset("gold").is_err());
         let error = set.material("gold").err().expect("unknown");
         let message = std::format!("{error}");
         assert!(message.contains("`gold`"), "{message}");

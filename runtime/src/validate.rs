@@ -328,14 +328,21 @@ impl Named for BaseKind {
 
 /// The value of option `T` called `given`; `None` is `T`'s default.
 pub fn named<T: Named + Default>(given: Option<&str>) -> Result<T, UnknownName<'_>> {
-    match given {
-        None => Ok(T::default()),
-        Some(name) => T::from_name(name).ok_or(UnknownName {
-            option: T::OPTION,
-            name,
-            choices: |f| write!(f, "{}", T::choices()),
-        }),
-    }
+    Ok(named_or_none(given)?.unwrap_or_default())
+}
+
+/// The value named `given`, `None` when none is given (an option whose
+/// default depends on the material: [`crate::brdf::RgbMode::default_for`]).
+pub fn named_or_none<T: Named>(given: Option<&str>) -> Result<Option<T>, UnknownName<'_>> {
+    given
+        .map(|name| {
+            T::from_name(name).ok_or(UnknownName {
+                option: T::OPTION,
+                name,
+                choices: |f| write!(f, "{}", T::choices()),
+            })
+        })
+        .transpose()
 }
 
 /// A name that is none of an option's values ([`named`]).

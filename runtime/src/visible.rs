@@ -81,6 +81,17 @@ struct Stretched {
     t: [f64; 2],
 }
 
+/// What the sampler and its density need of one incidence (computed once
+/// when one call does both): the stretched incidence, the last cell the
+/// visible marginal reaches, the visible length of it, and `N_tab`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct VisibleIncidence {
+    st: Stretched,
+    j_end: usize,
+    tau_end: f64,
+    norm: f64,
+}
+
 /// Axis position of `a ≥ 0` on nodes `σ (exp2_axis(k/scale) − 1)`.
 #[inline]
 fn axis(a: f64, inv_sigma: f32, scale: f32) -> f32 {
@@ -288,12 +299,36 @@ impl VisibleSlopeBake {
         locate(a, &self.rows, axis(a, self.inv_sigma, self.row_scale))
     }
 
+    /// The per-incidence part of [`VisibleSlopeBake::sample`] and
+    /// [`VisibleSlopeBake::pdf`] for the unit `wi` (`wi[2] > 0`).
+    #[inline]
+    pub fn incidence(&self, wi: [f64; 3]) -> VisibleIncidence {
+        let st = self.stretched(wi);
+        let (j_end, tau_end, norm) = self.extent(&st);
+        VisibleIncidence {
+            st,
+            j_end,
+            tau_end,
+            norm,
+        }
+    }
+
     /// Samples a microfacet normal for the unit incidence `wi` (`wi[2] > 0`)
     /// from `u ∈ [0, 1)²`; `None` where the tables give no mass.
+    #[cfg(test)]
     pub fn sample(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
-        let st = self.stretched(wi);
+        self.sample_at(&self.incidence(wi), u)
+    }
+
+    /// [`VisibleSlopeBake::sample`] at the incidence `inc` of [`VisibleSlopeBake::incidence`].
+    pub fn sample_at(&self, inc: &VisibleIncidence, u: [f64; 2]) -> Option<[f64; 3]> {
+        let VisibleIncidence {
+            st,
+            j_end,
+            tau_end,
+            norm,
+        } = *inc;
         let (c, s) = (st.c, st.s);
-        let (j_end, tau_end, norm) = self.extent(&st);
         if !(norm > 0.0) {
             return None;
         }
@@ -338,11 +373,31 @@ impl VisibleSlopeBake {
     /// from [`VisibleSlopeBake::sample`] (module documentation); both unit,
     /// upper hemisphere.
     pub fn pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        let st = self.stretched(wi);
+        // N_tab only where the density is not 0.
+        self.pdf_with(&st, wi, wo, || self.extent(&st).2)
+    }
+
+    /// [`VisibleSlopeBake::pdf`] with the incidence `inc` of `wi` from
+    /// [`VisibleSlopeBake::incidence`].
+    pub fn pdf_at(&self, inc: &VisibleIncidence, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        self.pdf_with(&inc.st, wi, wo, || inc.norm)
+    }
+
+    /// [`VisibleSlopeBake::pdf`] with the stretched incidence `st` of `wi`
+    /// and `N_tab` from `norm`.
+    #[inline(always)]
+    fn pdf_with(
+        &self,
+        st: &Stretched,
+        wi: [f64; 3],
+        wo: [f64; 3],
+        norm: impl FnOnce() -> f64,
+    ) -> f64 {
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
         if !(sum[2] > 0.0) {
             return 0.0;
         }
-        let st = self.stretched(wi);
         // Stretched slopes of h (|i + o| cancels).
         let inv_bz = 1.0 / (self.beta * sum[2]);
         let (sx, sy) = (-sum[0] * inv_bz, -sum[1] * inv_bz);
@@ -352,7 +407,7 @@ impl VisibleSlopeBake {
         if !(st.c - st.s * x > 0.0 && x.abs() <= r_max && y.abs() <= r_max) {
             return 0.0;
         }
-        let (_, _, norm) = self.extent(&st);
+        let norm = norm();
         let (i, lambda) = self.row(x.abs());
         let blend = |a: f64, b: f64| a + lambda * (b - a);
         let p2 = blend(self.p2[i], self.p2[i + 1]);
@@ -421,11 +476,17 @@ fn solve_cell(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau_max: f64, rest: f64)
             hi = t;
         }
         let d = density(t);
+        let tolerance = 1e-13 * (x0.abs() + tau_max);
         let mut next = if d > 0.0 { t - f / d } else { 0.5 * (lo + hi) };
+        // A converged step is taken even where it rounds onto the bracket's
+        // end (bisecting there would leave the root).
+        if d > 0.0 && next >= lo && next <= hi && (next - t).abs() <= tolerance {
+            return next;
+        }
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
-        if (next - t).abs() <= 1e-13 * (x0.abs() + tau_max) {
+        if (next - t).abs() <= tolerance {
             return next;
         }
         t = next;

@@ -267,7 +267,7 @@ pub fn chi_square_sampler(
     // range of each cell is split at the first and cut at the second.
     let theta_r = r[2].clamp(-1.0, 1.0).acos();
     let (alpha_full, alpha_none) = (PI / 2.0 - theta_r, PI / 2.0 + theta_r);
-    let cell = |a0: f64, a1: f64, p0: f64, p1: f64| -> f64 {
+    let piece = |a0: f64, a1: f64, p0: f64, p1: f64| -> f64 {
         let a1 = a1.min(alpha_none);
         if a1 <= a0 {
             return 0.0;
@@ -276,6 +276,22 @@ pub fn chi_square_sampler(
             return cell_part(a0, alpha_full, p0, p1) + cell_part(alpha_full, a1, p0, p1);
         }
         cell_part(a0, a1, p0, p1)
+    };
+    // Each α range is integrated as ALPHA_SPLIT equal pieces: the halo
+    // sampler's density is piecewise linear in 1 − cos θh (kinks at its
+    // nodes), and for HP17's geometry at normal incidence one 8-point rule
+    // per α cell gave ∫ pdf = 0.999677 against 0.999920 by a 2·10⁶-point
+    // midpoint rule in θo (and a success rate of 0.999920).
+    const ALPHA_SPLIT: usize = 4;
+    let cell = |a0: f64, a1: f64, p0: f64, p1: f64| -> f64 {
+        let step = (a1 - a0) / ALPHA_SPLIT as f64;
+        (0..ALPHA_SPLIT)
+            .map(|j| {
+                let b0 = a0 + j as f64 * step;
+                let b1 = if j + 1 == ALPHA_SPLIT { a1 } else { b0 + step };
+                piece(b0, b1, p0, p1)
+            })
+            .sum()
     };
     // Each sector is integrated as PHI_SPLIT sub-sectors: at grazing
     // incidence a narrow lobe is a thin ridge along the plane of incidence

@@ -19,8 +19,8 @@
 //! out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
 use super::{
-    ChannelBake, ColourTerms, Geometry, Options, RgbSample, SurfaceBakes, Tables, TwoScale,
-    finite_or_zero,
+    BakeVisitor, ChannelBake, ColourTerms, Geometry, Options, RgbSample, SurfaceBakes, Tables,
+    TwoScale, finite_or_zero,
 };
 use crate::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use crate::fresnel::fresnel;
@@ -204,6 +204,30 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
         &self.nodes
     }
 
+    /// Hands the colour weights to `v`, for ports of [`IntegratedRgb::eval`]
+    /// and [`IntegratedRgb::sample`] (the Python package's
+    /// `Material.integrated_bakes()`): `wavelengths` ([`INTEGRATED_WAVELENGTHS`],
+    /// µm), `surface` (`R_kc` at the `√cos θd` nodes, `[nodes, 8, 3]`),
+    /// `plain` (`P_kc`, `[8, 3]`) and `sampler_nodes` (the nodes whose
+    /// samplers [`IntegratedRgb::sample`] mixes, as numbers). Each node's
+    /// bakes are its [`TwoScale::visit_bakes`].
+    #[doc(hidden)]
+    pub fn visit_colour(&self, v: &mut dyn BakeVisitor) {
+        v.array("wavelengths", &[INTEGRATED_COUNT], &INTEGRATED_WAVELENGTHS);
+        let surface = self.colour.surface.as_flattened().as_flattened();
+        v.array("surface", &[COLOUR_NODES, INTEGRATED_COUNT, 3], surface);
+        v.array(
+            "plain",
+            &[INTEGRATED_COUNT, 3],
+            self.colour.plain.as_flattened(),
+        );
+        v.array(
+            "sampler_nodes",
+            &[SAMPLER_NODES.len()],
+            &SAMPLER_NODES.map(|k| k as f32),
+        );
+    }
+
     /// ρ(i, o) per linear-sRGB channel (module documentation).
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
@@ -275,17 +299,33 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
 }
 
 /// Which RGB a material's model gives: the paper's three wavelengths
-/// ([`super::Rgb`], HP15 §5.5; the default, which the Dr.Jit plugin, T4
-/// and the docs' figures mirror) or the integral over the spectrum
-/// ([`IntegratedRgb`], docs/model.md §2.12). Named `rgb_mode` in material
-/// files and Python, `ts_material_desc.rgb_mode` in C.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// ([`super::Rgb`], HP15 §5.5; what reproduces HP15/HP17) or the integral
+/// over the spectrum ([`IntegratedRgb`], docs/model.md §2.12). Named
+/// `rgb_mode` in material files and Python, `ts_material_desc.rgb_mode` in
+/// C. When none is given, [`RgbMode::default_for`] decides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RgbMode {
     /// ρ at 0.645, 0.526, 0.444 µm as red, green, blue.
-    #[default]
     PaperWavelengths,
     /// `ρ_c = ∫ ρ(λ) w_c(λ) dλ` (needs the index over the spectrum).
     Integrated,
+}
+
+impl RgbMode {
+    /// The mode of a material that names none: [`RgbMode::Integrated`] for
+    /// a material given over the spectrum (every preset; `eta = (lambda,
+    /// n, k)`), [`RgbMode::PaperWavelengths`] for one given by its index at
+    /// the paper's three wavelengths (or one constant index), which
+    /// integration would only interpolate. The one place that decides it
+    /// ([`crate::desc::MaterialDesc::rgb`] and
+    /// [`crate::desc::MaterialDesc::spectral`] call it).
+    pub const fn default_for(over_spectrum: bool) -> RgbMode {
+        if over_spectrum {
+            RgbMode::Integrated
+        } else {
+            RgbMode::PaperWavelengths
+        }
+    }
 }
 
 /// The RGB model of [`RgbMode`]: [`super::Rgb`] or [`IntegratedRgb`].

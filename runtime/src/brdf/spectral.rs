@@ -251,7 +251,7 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         let (a_spec, one_minus_a_over) =
             exp_and_one_minus_over(x_scale * cos_d * cos_d, sigma_rel_sq);
         // ρ_CT = F D G / (4 cos θi cos θo)                              (HP17 26)
-        let specular = a_spec * fl * pair.g / (4.0 * cos_i * cos_o) * geometry.d;
+        let specular = a_spec * fl * pair.g / (4.0 * cos_i * cos_o) * pair.d;
         // ρ_CTD = Q̄ G (1 − A)/σrel² (c−1) σs² b² / (2π λ²) C(θh; b cos θd/λ)   (HP17 32-33)
         let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && pair.g > 0.0 {
             let q = if self.white {

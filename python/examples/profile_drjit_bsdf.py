@@ -1,0 +1,106 @@
+"""Where the Dr.Jit plugin's time goes: ``Model.eval``, ``pdf`` and
+``sample_direction`` of ``twoscale.drjit_bsdf`` and their parts, timed on
+2^18 random pairs in ``llvm_ad_rgb``, one Dr.Jit thread, best of
+``--rounds`` (each a traced kernel, compiled once and then cached).
+
+    python python/examples/profile_drjit_bsdf.py [--against OLD.py] [--rounds 15] [MATERIAL ...]
+
+MATERIAL is a preset or ``beckmann`` (the render benchmark's p = 1, σs = 0
+gold conductor); default ``beckmann gold-hp17-geometry``. ``--against``
+times the same three calls of another copy of ``drjit_bsdf.py`` (e.g.
+``git show main:python/twoscale/drjit_bsdf.py > /tmp/old.py``) in
+alternation with this one, rounds interleaved, so that a change is
+compared under the same load. Prints ns per lane (one thread).
+"""
+
+import argparse
+import importlib.util
+import os
+import time
+
+os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+import numpy as np  # noqa: E402
+
+mi.set_variant("llvm_ad_rgb")
+import twoscale  # noqa: E402
+import twoscale.drjit_bsdf as tb  # noqa: E402
+
+LANES = 1 << 18
+GOLD = [(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)]
+
+
+def material(name):
+    if name == "beckmann":
+        return twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0, eta=GOLD)
+    return twoscale.Material.preset(name)
+
+
+def best_times(calls, rounds):
+    """The best time (s) of each call over `rounds`, calls interleaved."""
+    for f in calls.values():
+        dr.eval(f())
+        dr.sync_thread()
+    best = dict.fromkeys(calls, float("inf"))
+    for _ in range(rounds):
+        for key, f in calls.items():
+            start = time.perf_counter()
+            dr.eval(f())
+            dr.sync_thread()
+            best[key] = min(best[key], time.perf_counter() - start)
+    return best
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("materials", nargs="*", default=["beckmann", "gold-hp17-geometry"])
+    parser.add_argument("--against")
+    parser.add_argument("--rounds", type=int, default=15)
+    args = parser.parse_args()
+    dr.set_thread_count(1)
+    modules = {"this": tb}
+    if args.against:
+        spec = importlib.util.spec_from_file_location("against", args.against)
+        modules["against"] = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(modules["against"])
+    rng = np.random.default_rng(1)
+
+    def directions():
+        v = rng.normal(size=(3, LANES))
+        v[2] = np.abs(v[2])
+        return mi.Vector3f((v / np.linalg.norm(v, axis=0)).astype(np.float32))
+
+    wi, wo = directions(), directions()
+    u = mi.Vector3f(rng.random((3, LANES)).astype(np.float32))
+    wid, wod = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
+    dr.eval(wi, wo, u, wid, wod)
+    for name in args.materials:
+        m = material(name)
+        calls = {}
+        for label, module in modules.items():
+            model = module.Model(m)
+            calls[f"{label} eval"] = lambda model=model: model.eval(wo, wi)
+            calls[f"{label} pdf"] = lambda model=model: model.pdf(wi, wo)
+            calls[f"{label} sample_direction"] = lambda model=model: model.sample_direction(wi, u)
+        model = tb.Model(m)
+        ch = model.channels[0]
+        calls["  geometry + masking"] = lambda: model.masking(model.geometry(wi, wo)[1])
+        calls["  lobe_weights (one channel)"] = lambda: ch.lobe_weights(wid.z)
+        calls["  visible_pdf"] = lambda: ch.visible_pdf(wid, wod)
+        calls["  visible_sample"] = lambda: ch.visible_sample(wid, mi.Float64(u.x), mi.Float64(u.y))
+        if ch.diffraction:
+            geo = model.geometry(wi, wo)[1]
+            calls["  halo_pdf (one channel)"] = lambda: ch.halo_pdf(wid, geo["sin_h"], geo["cos_h"])
+            calls["  spectrum_pdf (one channel)"] = lambda: ch.spectrum_pdf(wid, wod)
+            calls["  diffraction_sample (one channel)"] = lambda: ch.diffraction_sample(
+                wid, mi.Float64(u.x), mi.Float64(u.y))
+            calls["  conv (one channel)"] = lambda: ch.conv(
+                mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]), mi.Float(ch.d["big_b"] * geo["cos_d"]))
+        for key, t in best_times(calls, args.rounds).items():
+            print(f"{name:20s} {key:36s} {t / LANES * 1e9:8.1f} ns/lane")
+
+
+if __name__ == "__main__":
+    main()
