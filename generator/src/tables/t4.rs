@@ -1,7 +1,7 @@
 //! T4: the spherical-harmonic BRDF matrix of each material of the materials
 //! file (\[WAT92\] §2, docs/model.md §2.9), one file `t4-<material>.tbl` per material,
-//! one channel per wavelength. Layout and conventions: `twoscale::sh`;
-//! projection: [`crate::sh`].
+//! one channel per RGB channel (at a wavelength or integrated: below).
+//! Layout and conventions: `twoscale::sh`; projection: [`crate::sh`].
 //!
 //! # What is projected
 //!
