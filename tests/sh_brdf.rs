@@ -40,7 +40,8 @@ band_limit = 10
 fn committed_t4_files_read_and_are_reciprocal() {
     let buf = suite::read_table(twoscale::TableId::ShBrdf);
     let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
-    assert_eq!(table.model(), ProjectedModel::TwoScale);
+    // The first preset: its integrated RGB (RgbMode::default_for).
+    assert_eq!(table.model(), ProjectedModel::IntegratedRgb);
     assert_eq!(table.channels(), 3);
     let pairs = generator::tables::t4::verification_pairs(500, 3);
     for (wi, wo) in pairs {
@@ -230,7 +231,7 @@ fn f_errors(
 }
 
 #[test]
-fn committed_rough_file_matches_the_two_scale_model() {
+fn committed_rough_file_matches_the_integrated_two_scale_model() {
     let buf = suite::read_table(twoscale::TableId::ShBrdf);
     let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/materials.toml");
@@ -248,7 +249,8 @@ fn committed_rough_file_matches_the_two_scale_model() {
     let tables = parsed.brdf_tables();
     let pairs = generator::tables::t4::verification_pairs(4000, 21);
     for (c, &lambda) in materials.wavelengths.iter().enumerate() {
-        let brdf = generator::tables::t4::two_scale_brdf(gold, c, lambda, &tables);
+        // The preset's default RGB: channel c of the integral over the spectrum.
+        let brdf = generator::tables::t4::material_brdf(gold, c, lambda, Some(&tables)).unwrap();
         let (rms, p99, max) = f_errors(
             &pairs,
             |i, o| brdf.eval(i, o),
@@ -291,8 +293,9 @@ fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
 
 // Bounds of `committed_rough_file_matches_the_two_scale_model`: the figures
 // measured on the committed gold-rough file (L = 24, 4000 pairs of seed 21;
-// worst channel, blue: rel RMS 3.58e-2, p99 3.43e-2, max 0.130) raised by
-// about 17%: a file projected at L = 16 (5.4e-2 RMS) or from another BRDF fails.
+// worst channel, blue: rel RMS 3.67e-2, p99 3.44e-2, max 0.134) raised by
+// about 15%: a file projected at L = 16 (5.4e-2 RMS) or from another BRDF
+// fails (the paper's three wavelengths instead of the integral: 8.0e-2 RMS).
 const RMS_BOUND: f64 = 0.042;
 const P99_BOUND: f64 = 0.040;
 const MAX_BOUND: f64 = 0.15;

@@ -33,8 +33,9 @@ use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
 use twoscale::Complex;
-use twoscale::brdf::{Layer, Options};
+use twoscale::brdf::{Layer, Options, RgbMode};
 use twoscale::desc::{EtaTable, KeywordTable};
+use twoscale::optical::SpectralMaterial;
 
 use crate::sh::BandFilter;
 
@@ -60,6 +61,10 @@ pub struct Material {
     pub layer: Layer,
     /// The index `n + ik` at each wavelength.
     pub eta: Vec<Complex>,
+    /// A preset's material over the spectrum (`twoscale::materials::spectral`;
+    /// `None` for a material given by its indices): T4 projects what
+    /// [`Material::rgb_mode`] says.
+    pub spectral: Option<SpectralMaterial<'static>>,
     /// T4 band limit L; `None`: no T4 file (a lobe too narrow for SH).
     pub band_limit: Option<usize>,
     /// Optional half-Gaussian band filter of T4.
@@ -168,6 +173,13 @@ impl Materials {
 }
 
 impl Material {
+    /// What T4 projects for this material: the integral over the spectrum
+    /// for a preset, the materials file's wavelengths otherwise (the
+    /// runtime's rule, [`RgbMode::default_for`]).
+    pub fn rgb_mode(&self) -> RgbMode {
+        RgbMode::default_for(self.spectral.is_some())
+    }
+
     /// The material of `[[material]]` number `index` (from 0): the file's
     /// keys taken out, the rest read as a material description
     /// ([`twoscale::desc`]) with one index per wavelength.
@@ -185,7 +197,7 @@ impl Material {
         let own: FileKeys = own
             .try_into()
             .map_err(|e| MaterialsError(format!("[[material]] {}: {e}", index + 1)))?;
-        let (name, layer, eta) = match own.preset {
+        let (name, layer, eta, spectral) = match own.preset {
             Some(preset) if own.name.is_none() => from_preset(&preset, &table, wavelengths)?,
             Some(preset) => {
                 return Err(MaterialsError(format!(
@@ -195,7 +207,7 @@ impl Material {
             None => {
                 let name = own.name.unwrap_or_default();
                 let (layer, eta) = keywords(&name, table, wavelengths.len())?;
-                (name, layer, eta)
+                (name, layer, eta, None)
             }
         };
         let err = |m: String| Err(MaterialsError(format!("material '{name}': {m}")));
@@ -233,6 +245,7 @@ impl Material {
             name,
             layer,
             eta,
+            spectral,
             band_limit: own.band_limit,
             filter,
         })
@@ -265,13 +278,22 @@ fn keywords(
     Ok((layer, eta))
 }
 
-/// The name, layer and RGB indices of shipped preset `preset` (defined once,
-/// in `twoscale::materials`); `rest` must hold no material key.
+/// The name, layer, RGB indices and material over the spectrum of shipped
+/// preset `preset` (defined once, in `twoscale::materials`); `rest` must hold
+/// no material key.
 fn from_preset(
     preset: &str,
     rest: &toml::Table,
     wavelengths: &[f64],
-) -> Result<(String, Layer, Vec<Complex>), MaterialsError> {
+) -> Result<
+    (
+        String,
+        Layer,
+        Vec<Complex>,
+        Option<SpectralMaterial<'static>>,
+    ),
+    MaterialsError,
+> {
     let err = |m: String| Err(MaterialsError(format!("preset '{preset}': {m}")));
     let Some(material) = twoscale::materials::preset(preset) else {
         let names: Vec<_> = twoscale::materials::PRESETS
@@ -298,6 +320,7 @@ fn from_preset(
         preset.to_string(),
         material.layer,
         material.eta_rgb.to_vec(),
+        twoscale::materials::spectral(preset),
     ))
 }
 
@@ -387,7 +410,16 @@ lambertian = 0.1
         for (m, (name, preset)) in file.materials.iter().zip(twoscale::materials::PRESETS) {
             assert_eq!(m.layer, preset.layer, "{name}");
             assert_eq!(m.eta, preset.eta_rgb.to_vec(), "{name}");
+            // T4 projects a preset's integrated RGB, the runtime's default.
+            assert_eq!(m.spectral, twoscale::materials::spectral(name), "{name}");
+            assert_eq!(m.rgb_mode(), twoscale::brdf::RgbMode::Integrated, "{name}");
         }
+        let own = Materials::parse(GOOD).unwrap();
+        assert_eq!(own.materials[0].spectral, None);
+        assert_eq!(
+            own.materials[0].rgb_mode(),
+            twoscale::brdf::RgbMode::PaperWavelengths
+        );
     }
 
     #[test]

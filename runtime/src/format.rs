@@ -233,11 +233,12 @@ table_ids! {
         in_set: true,
     }
     /// T4: spherical-harmonic BRDF matrix of one material (\[WAT92\] §2,
-    /// docs/model.md §2.9), one channel per wavelength; see [`crate::sh`].
+    /// docs/model.md §2.9), one channel per RGB channel (at a wavelength, or
+    /// integrated over the spectrum: aux `brdf_model`); see [`crate::sh`].
     ShBrdf = 6 {
         number: 4,
         stem: "t4-sh-brdf",
-        description: "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, docs/model.md 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per wavelength",
+        description: "spherical-harmonic matrix of rho cos(theta_i) cos(theta_o) of one material (WAT92 2, docs/model.md 2.9): odd completion (l+m odd), packed upper triangles of the m-blocks; one channel per RGB channel (a wavelength, or integrated over the spectrum: aux brdf_model)",
         axes: ["coefficient"],
         params: ShBrdfParams,
         kernel: Multilinear,

@@ -96,7 +96,9 @@ pub const MAX_CHANNELS: usize = 3;
 /// Names of the auxiliary values of T4 (after the coefficients).
 ///
 /// - `brdf_model`: what was projected: 1 Lambertian, 2 Beckmann Cook–Torrance
-///   stand-in (no diffraction), 3 the two-scale model of docs/model.md §2.5;
+///   stand-in (no diffraction), 3 the two-scale model of docs/model.md §2.5
+///   at each channel's wavelength, 4 its linear-sRGB channels integrated over
+///   the spectrum (docs/model.md §2.12; [`ProjectedModel`]);
 /// - `phi_nodes`: midpoint nodes in `Δφ ∈ [0, π]` of the azimuthal Fourier
 ///   decomposition;
 /// - `beta`, `p`, `sigma_s` (µm), `b` (µm), `c`: the material's two-scale
@@ -331,6 +333,13 @@ pub enum ProjectedModel {
     /// when σs > 0; the matrix is symmetrised and the header's `asymmetry`
     /// says by how much it was not.
     TwoScale,
+    /// The same two-scale model in linear sRGB integrated over the spectrum
+    /// ([`crate::brdf::IntegratedRgb`], docs/model.md §2.12; what the presets
+    /// give by default, [`crate::brdf::RgbMode::default_for`]): channel `c`
+    /// is ρ_c, red, green, blue; the header's wavelengths are then the
+    /// materials file's nominal ones, not what was evaluated. Not reciprocal
+    /// when σs > 0, as [`ProjectedModel::TwoScale`].
+    IntegratedRgb,
 }
 
 impl ProjectedModel {
@@ -340,6 +349,7 @@ impl ProjectedModel {
             ProjectedModel::Lambertian => 1,
             ProjectedModel::BeckmannStandIn => 2,
             ProjectedModel::TwoScale => 3,
+            ProjectedModel::IntegratedRgb => 4,
         }
     }
 
@@ -349,6 +359,7 @@ impl ProjectedModel {
             ProjectedModel::Lambertian,
             ProjectedModel::BeckmannStandIn,
             ProjectedModel::TwoScale,
+            ProjectedModel::IntegratedRgb,
         ]
         .into_iter()
         .find(|m| m.code() as f32 == code)

@@ -1,17 +1,22 @@
 //! T4: the spherical-harmonic BRDF matrix of each material of the materials
 //! file (\[WAT92\] §2, docs/model.md §2.9), one file `t4-<material>.tbl` per material,
-//! one channel per wavelength. Layout and conventions: `twoscale::sh`;
-//! projection: [`crate::sh`].
+//! one channel per RGB channel (at a wavelength or integrated: below).
+//! Layout and conventions: `twoscale::sh`; projection: [`crate::sh`].
 //!
 //! # What is projected
 //!
 //! The committed files project the **runtime two-scale model**
 //! (`twoscale::brdf::TwoScale`, docs/model.md §2.5–§2.6, default [`Options`]: the
-//! paper's `σrel(θi)`, separable G, physical F and Q̄) at each channel's
-//! wavelength, reading T1 (`t1-smith-g1.tbl`), T2 (`t2-sigma-ratio.tbl`), T5
+//! paper's `σrel(θi)`, separable G, physical F and Q̄) as the runtime gives
+//! the material's RGB by default ([`Material::rgb_mode`]): for a preset (all
+//! the committed files), each linear-sRGB channel integrated over the
+//! spectrum (`twoscale::brdf::IntegratedRgb`, docs/model.md §2.12; header
+//! `brdf_model = 4`, [`ProjectedModel::IntegratedRgb`]); for a material
+//! given by its indices, the model at each channel's wavelength
+//! (`brdf_model = 3`, [`ProjectedModel::TwoScale`]). Either reads T1
+//! (`t1-smith-g1.tbl`), T2 (`t2-sigma-ratio.tbl`), T5
 //! (`t5-diffuse-fresnel.tbl`) and C from T3b (`t3-convolution.tbl` through
-//! `twoscale::ConvTable`). The header records it as
-//! `brdf_model = 3` ([`ProjectedModel::TwoScale`]). The model's interface is
+//! `twoscale::ConvTable`). The model's interface is
 //! f32: the projection's f64 directions are rounded to f32 and ρ comes back
 //! in f32 (relative rounding ~6e-8, far below the truncation error in L).
 //! The f64 reference (`crate::reference::brdf`, exact C) costs 1–30 ms per
@@ -36,7 +41,7 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use twoscale::brdf::{BaseLayer, Options, Tables};
+use twoscale::brdf::{BaseLayer, ChannelBake, IntegratedRgb, Options, RgbMode, Tables};
 use twoscale::format::write::{TableSpec, encode};
 use twoscale::format::{AlignedBuf, AxisHeader, Mapping, ShBrdfParams, aligned_copy};
 use twoscale::sh::{AUX_NAMES, ProjectedModel, coefficient_count};
@@ -79,11 +84,12 @@ pub enum Projected {
 }
 
 impl Projected {
-    /// The code written into the header.
-    pub fn model(&self) -> ProjectedModel {
-        match self {
-            Projected::TwoScale { .. } => ProjectedModel::TwoScale,
-            Projected::BeckmannStandIn => ProjectedModel::BeckmannStandIn,
+    /// The code written into the header of `material`'s file.
+    pub fn model(&self, material: &Material) -> ProjectedModel {
+        match (self, material.rgb_mode()) {
+            (Projected::TwoScale { .. }, RgbMode::Integrated) => ProjectedModel::IntegratedRgb,
+            (Projected::TwoScale { .. }, RgbMode::PaperWavelengths) => ProjectedModel::TwoScale,
+            (Projected::BeckmannStandIn, _) => ProjectedModel::BeckmannStandIn,
         }
     }
 }
@@ -232,17 +238,43 @@ pub fn stand_in_brdf(material: &Material, channel: usize) -> Result<StandIn, Bui
     })
 }
 
-/// The BRDF of `material` at `channel` that T4 projects: the two-scale
-/// model when `tables` is given, else the Beckmann stand-in.
+/// One linear-sRGB channel of the integrated two-scale model
+/// ([`IntegratedRgb::eval`]) as an [`IsotropicBrdf`], at the directions
+/// rounded to f32.
+pub struct IntegratedChannel<'a> {
+    /// The model (its bakes on the heap).
+    pub model: IntegratedRgb<'a, Box<ChannelBake>>,
+    /// 0 red, 1 green, 2 blue.
+    pub channel: usize,
+}
+
+impl IsotropicBrdf for IntegratedChannel<'_> {
+    fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+        let rgb = self.model.eval(wi.map(|v| v as f32), wo.map(|v| v as f32));
+        f64::from(rgb[self.channel])
+    }
+}
+
+/// The BRDF of `material` at `channel` that T4 projects
+/// ([`Projected::model`]): with `tables`, the two-scale model as the runtime
+/// gives it by default ([`Material::rgb_mode`]: channel `channel` of the
+/// integral over the spectrum for a preset, the model at `wavelength` µm
+/// otherwise); without, the Beckmann stand-in.
 pub fn material_brdf<'a>(
     material: &Material,
     channel: usize,
     wavelength: f64,
     tables: Option<&Tables<'a>>,
 ) -> Result<Box<dyn IsotropicBrdf + 'a>, BuildError> {
-    Ok(match tables {
-        Some(tables) => Box::new(two_scale_brdf(material, channel, wavelength, tables)),
-        None => Box::new(stand_in_brdf(material, channel)?),
+    Ok(match (tables, &material.spectral) {
+        (Some(tables), Some(spectral)) if material.rgb_mode() == RgbMode::Integrated => {
+            Box::new(IntegratedChannel {
+                model: IntegratedRgb::boxed(tables, spectral, Options::default()),
+                channel,
+            })
+        }
+        (Some(tables), _) => Box::new(two_scale_brdf(material, channel, wavelength, tables)),
+        (None, _) => Box::new(stand_in_brdf(material, channel)?),
     })
 }
 
@@ -299,7 +331,7 @@ impl ShBrdf {
         };
         let s = m.layer.surface;
         let mut aux = vec![
-            self.projected.model().code() as f32,
+            self.projected.model(m).code() as f32,
             phi_nodes as f32,
             s.beta,
             s.p,
