@@ -320,12 +320,9 @@ class _Channel:
             dr.select(ok, w[k] / total, 0.0) if k in columns else w[k] for k in range(1, 4)]
 
     def diffraction_pdf(self, wi, wo, geo):
-        """`TwoScale::diffraction_pdf`: the mixture of the spectrum's draw
-        and the half-vector draw (`HaloBake::pdf`), f64."""
-        share = self.s["halo_spectrum_share"]
-        spectrum = self.spectrum_pdf(wi, wo)
-        half = dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z), 0.0)
-        return share * spectrum + (1.0 - share) * half
+        """`TwoScale::diffraction_pdf` where C is baked (the plugin requires
+        it): the half-vector draw's `HaloBake::pdf`, f64."""
+        return dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z), 0.0)
 
     def _row_cell(self, wi):
         """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
@@ -432,29 +429,6 @@ class _Channel:
             lambda psi: _Channel._azimuth_cdf(coef, psi) - target,
             lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
             psi, mi.Float64(big_h), _NEWTON_TOL)
-
-    def _radial_inv_m(self, sin_i):
-        """`1/M(sin θi)` of the spectrum's radial law, linear in the bake (f64)."""
-        n = self.shapes["radial_inv_m"][0]
-        i, frac = _cell_at(mi.Float(sin_i) * float(n - 1), n)
-        return mi.Float64(_lerp_gather(self.t["radial_inv_m"], 1, 0, self._node_row(i, n), frac))
-
-    def spectrum_pdf(self, wi, wo):
-        """`TwoScale::spectrum_pdf` (HP17 51-55), f64."""
-        s = self.s
-        if not (s["sigma_s"] > 0.0 and s["big_b"] > 0.0):
-            return mi.Float64(0.0)
-        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        inv_m = self._radial_inv_m(sin_i)
-        dx, dy = wo.x + wi.x, wo.y + wi.y
-        r = dr.sqrt(dx * dx + dy * dy)
-        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
-        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
-        b, c = self.d["big_b"], self.d["c"]
-        density = ((c - 1.0) * b * b * dr.power(1.0 + b * b * r * r, -0.5 * (c + 1.0)) * inv_m
-                   / (2.0 * phi_max))
-        ok = (inv_m > 0.0) & (r <= 1.0 + sin_i) & (phi_max > 0.0)
-        return dr.select(ok, density * wo.z, 0.0)
 
     def visible_pdf(self, wi, wo):
         """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
@@ -650,43 +624,13 @@ class _Channel:
                                   t, mi.Float64(tau_max), tol)
 
     def diffraction_sample(self, wi, u0, u1):
-        """The diffraction lobe's direction (`TwoScale::sample_diffraction`:
-        the spectrum's draw with its share, else a reflected half-vector of
+        """The diffraction lobe's direction where C is baked
+        (`TwoScale::sample_diffraction`: a reflected half-vector of
         `halo_sample`) and whether it exists (f64)."""
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
-        share = self.s["halo_spectrum_share"]
-        spectral = u1 < share
-        os_, ok_s = self.spectrum_sample(wi, u0, u1 / share)
-        v = dr.minimum((u1 - share) / (1.0 - share), below_one)
-        m, ok_h = self.halo_sample(wi, v, u0)
+        m, ok = self.halo_sample(wi, dr.minimum(u1, below_one), u0)
         k = 2.0 * dr.dot(wi, m)
-        oh = k * m - wi
-        ok_h &= k > 0.0
-        return dr.select(spectral, os_, oh), dr.select(spectral, ok_s, ok_h)
-
-    def spectrum_sample(self, wi, u0, u1):
-        """The spectrum's draw (`TwoScale::sample_spectrum`, HP17 51-55) and
-        whether it exists (f64)."""
-        s = self.s
-        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
-        inv_m = self._radial_inv_m(sin_i)
-        b, c = self.d["big_b"], self.d["c"]
-        m = 1.0 / inv_m
-        # ln_1pf and exp_m1f of the runtime, in f64.
-        t = -2.0 / (c - 1.0) * dr.log(1.0 - m * u0)
-        r = dr.minimum(dr.sqrt(dr.maximum(dr.exp(t) - 1.0, 0.0)) / b, 1.0 + sin_i)
-        x = dr.clip((r * r + sin_i * sin_i - 1.0) / (2.0 * r * sin_i), -1.0, 1.0)
-        phi_max = dr.select(r + sin_i <= 1.0, math.pi, _acos_approx(x))
-        psi = (2.0 * u1 - 1.0) * phi_max
-        has = sin_i > 0.0
-        cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
-        sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
-        cp, sp = dr.cos(psi), dr.sin(psi)
-        ox = r * (cos_phi_i * cp - sin_phi_i * sp) - wi.x
-        oy = r * (sin_phi_i * cp + cos_phi_i * sp) - wi.y
-        z2 = 1.0 - ox * ox - oy * oy
-        ok = (inv_m > 0.0) & (z2 > 0.0) & (s["sigma_s"] > 0.0) & (b > 0.0)
-        return mi.Vector3d(ox, oy, dr.sqrt(dr.maximum(z2, 0.0))), ok
+        return k * m - wi, ok & (k > 0.0)
 
     # -- the model -----------------------------------------------------
     def q_bar(self, fi, fo, along, across):
@@ -1041,7 +985,7 @@ class _NodeChannel(_Channel):
     # Read as Python floats (branches, literals), by `Model` from model 0
     # (D, G) or from the shared tables: one value for every model.
     SHARED = {"sigma_s", "b", "white", "has_q", "symmetrised", "halo_incident", "base",
-              "conv_baked", "height_correlated", "halo_spectrum_share", "conv_u0",
+              "conv_baked", "height_correlated", "conv_u0",
               "conv_cos_h_min", "masking_beta", "masking_g1", "beta", "p", "epd_norm",
               "epd_inv_beta_sq"}
 

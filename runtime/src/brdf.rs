@@ -920,7 +920,6 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 flag(self.options.halo_weight == HaloWeight::Incident),
             ),
             ("conv_baked", flag(self.bake().conv_baked)),
-            ("halo_spectrum_share", SPECTRUM_SHARE),
         ] {
             v.scalar(name, value);
         }
@@ -1354,9 +1353,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// * specular: the density of reflecting `i` about a visible EPD normal
     ///   (the tabulated `D_vis`, `crate::visible`: `P2_tab g_tab / (8 N_tab β²
     ///   |i'| cos⁴θh)`, docs/model.md §2.1), 0 where `i·h ≤ 0`;
-    /// * diffraction: `ε pdf_spectrum + (1 − ε) pdf_half` (ε =
-    ///   `SPECTRUM_SHARE`, 0: the half-vector draw alone; the spectrum's
-    ///   alone when C is not baked). The spectrum's
+    /// * diffraction: the half-vector draw's where C is baked, else the
+    ///   spectrum's. The spectrum's
     ///   (HP17 51-55): with `d = o_p + i_p` (the tangential parts;
     ///   `|d| = λ f`), `B = b/λ`, `s = sin θi`,
     ///   `M = 1 − (1 + B²(1 + s)²)^(−(c−1)/2)` and `φmax(|d|)` of (HP17 53),
@@ -1407,10 +1405,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         math::acos_approx(x.max(-1.0).min(1.0))
     }
 
-    /// The diffraction lobe's density: the mixture of the spectrum's draw
-    /// (share [`SPECTRUM_SHARE`]) and the half-vector draw of
-    /// [`HaloBake`], `p(h) / (4 i·h)`, when the C bake is there; else the
-    /// spectrum's draw alone.
+    /// The diffraction lobe's density: the half-vector draw of [`HaloBake`],
+    /// `p(h) / (4 i·h)`, when the C bake is there; else the spectrum's draw.
     fn diffraction_pdf(&self, geometry: &Geometry) -> f64 {
         let Geometry {
             wi,
@@ -1421,19 +1417,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             ..
         } = *geometry;
         match self.bake().halo() {
-            Some(halo) => {
-                let half = if cos_d > 0.0 {
-                    halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h, wo[2])
-                } else {
-                    0.0
-                };
-                let spectrum = if SPECTRUM_SHARE > 0.0 {
-                    self.spectrum_pdf(wi, wo)
-                } else {
-                    0.0
-                };
-                SPECTRUM_SHARE * spectrum + (1.0 - SPECTRUM_SHARE) * half
-            }
+            Some(halo) if cos_d > 0.0 => halo.pdf(wi, self.big_b * wi[2], sin_h, cos_h, wo[2]),
+            Some(_) => 0.0,
             None => self.spectrum_pdf(wi, wo),
         }
     }
@@ -1466,9 +1451,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///
     /// * specular: `m` a visible normal of the EPD (the tabulated visible-slope
     ///   sampler of docs/model.md §2.1, `u` its two uniforms), `o = 2(i·m)m − i`;
-    /// * diffraction: with probability ε (`SPECTRUM_SHARE`, 0; picked by `u₁`,
-    ///   rescaled) the spectrum's draw, else the half-vector draw of
-    ///   `crate::halo` reflected; the spectrum's draw
+    /// * diffraction: the half-vector draw of `crate::halo` reflected where C
+    ///   is baked, else the spectrum's draw
     ///   (HP17 51-55): `r = λ f = √((1 − M u₀)^(−2/(c−1)) − 1) / B`,
     ///   `ψ = (2u₁ − 1) φmax(r)`, `d = r (cos(φi + ψ), sin(φi + ψ))`,
     ///   `o_p = d − i_p`. (HP17 54-55) write the same arc as `φf = φi + π ± φmax`
@@ -1517,19 +1501,14 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         Some(to_f32(o))
     }
 
-    /// The diffraction lobe's draw: with probability [`SPECTRUM_SHARE`]
-    /// (picked by `u[1]`, rescaled) the spectrum's, else a half-vector from
-    /// [`HaloBake`] (`u[1]` rescaled again picks its row and then the
-    /// azimuth, `u[0]` gives θh) reflected, when the C bake is there.
+    /// The diffraction lobe's draw: a half-vector from [`HaloBake`] (`u[1]`
+    /// picks its row and then the azimuth, `u[0]` gives θh) reflected, when
+    /// the C bake is there; else the spectrum's.
     fn sample_diffraction(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
         let Some(halo) = self.bake().halo() else {
             return self.sample_spectrum(wi, u);
         };
-        if u[1] < SPECTRUM_SHARE {
-            return self.sample_spectrum(wi, [u[0], u[1] / SPECTRUM_SHARE]);
-        }
-        let v = ((u[1] - SPECTRUM_SHARE) / (1.0 - SPECTRUM_SHARE)).min(f64::from(BELOW_ONE));
-        let m = halo.sample_h(wi, self.big_b * wi[2], v, u[0])?;
+        let m = halo.sample_h(wi, self.big_b * wi[2], u[1], u[0])?;
         let k = 2.0 * dot(wi, m);
         if !(k > 0.0) {
             return None;
@@ -1633,12 +1612,6 @@ fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
     let t = x - k as f64;
     nodes[k] + t * (nodes[k + 1] - nodes[k])
 }
-
-/// The share of the spectrum's draw (HP17 51-55) in the diffraction lobe's
-/// mixture with the half-vector draw where C is baked: 0, the half-vector
-/// draw follows the halo closer everywhere measured
-/// (docs/design/halo-sampling.md).
-const SPECTRUM_SHARE: f64 = 0.0;
 
 /// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).
 fn sigma_ratio_sq(mode: SigmaRelMode, at_i: &DirectionValues, at_o: &DirectionValues) -> f64 {
