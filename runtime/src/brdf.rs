@@ -706,27 +706,12 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
                 }
                 let (_, at_i, g1_i) = row.get();
                 let at_o = direction.at(cos_o as f32);
-                let q = if white {
-                    1.0
-                } else {
-                    match &q {
-                        Some(q) => q
-                            .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
-                            .max(0.0),
-                        None => 0.0,
-                    }
-                };
+                let q = q_bar(q.as_ref(), white, &at_i, &at_o, along, across);
                 let sigma_rel_sq = sigma_s_sq * sigma_ratio_sq(options.sigma_rel, &at_i, &at_o);
-                let cos_a = match options.halo_weight {
-                    HaloWeight::Printed => cos_d,
-                    HaloWeight::Incident => cos_i,
-                };
-                let halo = exp_and_one_minus_over(x_scale * cos_a * cos_a, sigma_rel_sq).1;
-                let g = match options.masking {
-                    Masking::Separable => g1_i * g1(cos_o),
-                    Masking::HeightCorrelated => 1.0 / (1.0 / g1_i + 1.0 / g1(cos_o) - 1.0),
-                };
-                q * halo * g
+                let printed = exp_and_one_minus_over(x_scale * cos_d * cos_d, sigma_rel_sq).1;
+                let halo =
+                    halo_attenuation(options.halo_weight, printed, x_scale, cos_i, sigma_rel_sq);
+                q * halo * masking_g(options.masking, g1_i, g1(cos_o))
             };
             bake.halo.init(&bake.conv, &weight);
         }
@@ -787,10 +772,6 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
     /// [`DEFICIT_PANELS`] panels of t, φ by the trapezoid rule on
     /// [`DEFICIT_AZIMUTHS`] points; both terms come from the same nodes.
     fn halo_deficit(&self, cos_i: f64) -> f64 {
-        const GAUSS_4: [(f64, f64); 2] = [
-            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-            (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-        ];
         let sin_i = math::sqrt((1.0 - cos_i * cos_i).max(0.0));
         let i = [sin_i as f32, 0.0, cos_i as f32];
         // The mirror direction r and two unit vectors orthogonal to it.
@@ -807,7 +788,7 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
         let mut total = 0.0;
         for k in 0..DEFICIT_PANELS {
             let mid = t0 + (k as f64 + 0.5) * h;
-            for (x, weight) in GAUSS_4 {
+            for (x, weight) in math::GAUSS_LEGENDRE_4 {
                 for t in [mid - 0.5 * h * x, mid + 0.5 * h * x] {
                     let alpha = math::exp(t);
                     let (sa, ca) = (math::sin(alpha), math::cos(alpha));
@@ -1007,13 +988,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             self.bake().masking.g1(tangential(wi), wi[2] as f32),
             self.bake().masking.g1(tangential(wo), wo[2] as f32),
         );
-        let g = match self.options.masking {
-            Masking::Separable => f64::from(g1_i) * f64::from(g1_o),
-            // Λ = 1/G1 − 1; G1 = 0 gives 1/∞ = 0.
-            Masking::HeightCorrelated => {
-                1.0 / (1.0 / f64::from(g1_i) + 1.0 / f64::from(g1_o) - 1.0)
-            }
-        };
+        let g = masking_g(self.options.masking, f64::from(g1_i), f64::from(g1_o));
         let cos = |x: f64| DirectionCell::new(x as f32);
         Pair {
             geometry,
@@ -1099,23 +1074,15 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
         // ρ_CTD = Q̄ G (1 − A)/σrel² · (c−1) σs² b² / (2π λ²) · C    (HP17 32-33, docs/model.md §2.5)
         let diffraction = if s.sigma_s > 0.0 && s.b > 0.0 && g > 0.0 {
-            let q = if white {
-                1.0
-            } else {
-                match &self.q {
-                    Some(q) => q
-                        .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
-                        .max(0.0),
-                    None => 0.0,
-                }
-            };
-            let one_minus_a_over = match self.options.halo_weight {
-                HaloWeight::Printed => one_minus_a_over,
-                HaloWeight::Incident => {
-                    exp_and_one_minus_over(self.x_scale * cos_i * cos_i, sigma_rel_sq).1
-                }
-            };
-            let halo = self.halo_scale * one_minus_a_over;
+            let q = q_bar(self.q.as_ref(), white, &at_i, &at_o, along, across);
+            let halo = self.halo_scale
+                * halo_attenuation(
+                    self.options.halo_weight,
+                    one_minus_a_over,
+                    self.x_scale,
+                    cos_i,
+                    sigma_rel_sq,
+                );
             let c_value = self.conv_at(sin_h, cos_h, (self.big_b * cos_d) as f32);
             q * g * halo * c_value
         } else {
@@ -1611,6 +1578,53 @@ fn halo_albedo_at(nodes: &[f64; HALO_ALBEDO_NODES], cos: f64) -> f64 {
     let k = (x as usize).min(HALO_ALBEDO_NODES - 2);
     let t = x - k as f64;
     nodes[k] + t * (nodes[k + 1] - nodes[k])
+}
+
+/// Q̄ of a pair (HP17 33, docs/model.md §2.5), clamped at 0: 1 for white
+/// colour terms, 0 without an index (`q` `None`).
+#[inline]
+fn q_bar(
+    q: Option<&QConstants>,
+    white: bool,
+    at_i: &DirectionValues,
+    at_o: &DirectionValues,
+    along: f64,
+    across: f64,
+) -> f64 {
+    match (q, white) {
+        (_, true) => 1.0,
+        (Some(q), false) => q
+            .combine(&at_i.q_factors(), &at_o.q_factors(), along, across)
+            .max(0.0),
+        (None, false) => 0.0,
+    }
+}
+
+/// G(i, o) from G1(i) and G1(o) ([`Masking`]; docs/model.md §2.2).
+#[inline]
+fn masking_g(mode: Masking, g1_i: f64, g1_o: f64) -> f64 {
+    match mode {
+        Masking::Separable => g1_i * g1_o,
+        // Λ = 1/G1 − 1; G1 = 0 gives 1/∞ = 0.
+        Masking::HeightCorrelated => 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0),
+    }
+}
+
+/// The halo's `(1 − A)/σrel²` of [`HaloWeight`]: `printed` (at θd, from
+/// the same exponential as A_spec) or at θi (`x_scale` the exponent's
+/// `(4π/λ)²`).
+#[inline]
+fn halo_attenuation(
+    mode: HaloWeight,
+    printed: f64,
+    x_scale: f64,
+    cos_i: f64,
+    sigma_rel_sq: f64,
+) -> f64 {
+    match mode {
+        HaloWeight::Printed => printed,
+        HaloWeight::Incident => exp_and_one_minus_over(x_scale * cos_i * cos_i, sigma_rel_sq).1,
+    }
 }
 
 /// `σrel²/σs²` for the incidence `i` (and `o` when symmetrised).

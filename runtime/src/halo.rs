@@ -356,7 +356,10 @@ fn row_value(
     };
     let (a, b) = (sin_i * sin_h, cos_i * cos_h);
     let mut sum = 0.0;
-    for (x, w) in GL_X.iter().zip(GL_W) {
+    let nodes = math::GAUSS_LEGENDRE_4
+        .iter()
+        .flat_map(|&(x, w)| [(-x, w), (x, w)]);
+    for (x, w) in nodes {
         let psi = 0.5 * law.big_h * (1.0 + x);
         let (cos_psi, sin_psi) = (math::cos(psi), math::sin(psi));
         let cos_d = a * cos_psi + b;
@@ -373,20 +376,6 @@ fn row_value(
     let value = math::sqrt((sum * law.big_h * law.half).max(0.0));
     if value.is_finite() { value } else { 0.0 }
 }
-
-/// Gauss–Legendre nodes and weights on [−1, 1] for [`row_value`].
-const GL_X: [f64; 4] = [
-    -0.861136311594053,
-    -0.339981043584856,
-    0.339981043584856,
-    0.861136311594053,
-];
-const GL_W: [f64; 4] = [
-    0.347854845137454,
-    0.652145154862546,
-    0.652145154862546,
-    0.347854845137454,
-];
 
 /// At most this many Newton steps for the azimuth (bisection alone would
 /// need ~40 for 1e-12 of π).

@@ -183,6 +183,13 @@ pub fn erfc(x: f64) -> f64 {
 /// `[0, BELOW_ONE]`.
 pub const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// 4-point Gauss–Legendre nodes and weights on [−1, 1], the positive half
+/// (the rule is symmetric: each `(x, w)` stands for `±x`).
+pub(crate) const GAUSS_LEGENDRE_4: [(f64, f64); 2] = [
+    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+];
+
 /// A direction normalised in f64, or `None` when it is not finite, zero, or
 /// at/below the horizon (`z ≤ 0`).
 #[inline]

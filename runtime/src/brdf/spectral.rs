@@ -20,8 +20,8 @@
 
 use super::integrated::models_at;
 use super::{
-    BakeVisitor, ChannelBake, ColourTerms, HaloWeight, Options, Pair, Sample, Tables, TwoScale,
-    exp_and_one_minus_over, finite_or_zero,
+    BakeVisitor, ChannelBake, ColourTerms, Options, Pair, Sample, Tables, TwoScale,
+    exp_and_one_minus_over, finite_or_zero, halo_attenuation, q_bar,
 };
 use crate::fresnel::{Complex, fresnel};
 use crate::math;
@@ -82,18 +82,14 @@ impl NodeTerms {
             direction.at_cell(pair.cells[1]),
         );
         let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
-        let q = match (&node.q, white) {
-            (_, true) => 1.0,
-            (Some(q), false) => q
-                .combine(
-                    &at_i.q_factors(),
-                    &at_o.q_factors(),
-                    pair.along,
-                    pair.across,
-                )
-                .max(0.0),
-            (None, false) => 0.0,
-        };
+        let q = q_bar(
+            node.q.as_ref(),
+            white,
+            &at_i,
+            &at_o,
+            pair.along,
+            pair.across,
+        );
         let multiple = node.multiple_value(&at_i, &at_o);
         NodeTerms {
             ratio_sq: node.sigma_ratio_sq(&at_i, &at_o),
@@ -261,13 +257,16 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
             } else {
                 lerp(a.q, b.q)
             };
-            let one_minus_a_over = match node.options.halo_weight {
-                HaloWeight::Printed => one_minus_a_over,
-                HaloWeight::Incident => {
-                    exp_and_one_minus_over(x_scale * cos_i * cos_i, sigma_rel_sq).1
-                }
-            };
-            let halo = node.halo_scale * ratio * ratio * one_minus_a_over;
+            let halo = node.halo_scale
+                * ratio
+                * ratio
+                * halo_attenuation(
+                    node.options.halo_weight,
+                    one_minus_a_over,
+                    x_scale,
+                    cos_i,
+                    sigma_rel_sq,
+                );
             let u = (node.big_b * ratio * cos_d) as f32;
             q * pair.g * halo * node.conv_at(geometry.sin_h, geometry.cos_h, u)
         } else {
