@@ -63,6 +63,42 @@ impl<F: Fn([f64; 3], [f64; 3]) -> f64 + Sync> IsotropicBrdf for F {
     }
 }
 
+/// Several isotropic BRDFs evaluated together at each direction pair (an RGB
+/// model's channels, which share most of their work), projected in one pass
+/// by [`project_channels`].
+pub trait ChannelBrdf: Sync {
+    /// The number of channels.
+    fn channels(&self) -> usize;
+    /// `ρ_c(wi, wo)` of every channel `c` into `out` (`channels()` long).
+    fn eval_channels(&self, wi: [f64; 3], wo: [f64; 3], out: &mut [f64]);
+}
+
+/// One channel per BRDF of the list.
+pub struct EachChannel<'a>(pub Vec<Box<dyn IsotropicBrdf + 'a>>);
+
+impl ChannelBrdf for EachChannel<'_> {
+    fn channels(&self) -> usize {
+        self.0.len()
+    }
+    fn eval_channels(&self, wi: [f64; 3], wo: [f64; 3], out: &mut [f64]) {
+        for (v, brdf) in out.iter_mut().zip(&self.0) {
+            *v = brdf.eval(wi, wo);
+        }
+    }
+}
+
+/// One BRDF as a one-channel [`ChannelBrdf`].
+struct One<'a>(&'a dyn IsotropicBrdf);
+
+impl ChannelBrdf for One<'_> {
+    fn channels(&self) -> usize {
+        1
+    }
+    fn eval_channels(&self, wi: [f64; 3], wo: [f64; 3], out: &mut [f64]) {
+        out[0] = self.0.eval(wi, wo);
+    }
+}
+
 /// A one-wavelength runtime BRDF as an [`IsotropicBrdf`]: [`Bxdf::eval`] at
 /// the directions rounded to f32, widened to f64 (relative rounding ~6e-8).
 #[derive(Clone)]
@@ -179,6 +215,19 @@ pub fn project(
     quadrature: Quadrature,
     progress: Option<&ProgressBar>,
 ) -> Projection {
+    let mut projections = project_channels(&One(brdf), band_limit, quadrature, progress);
+    projections.pop().expect("one channel")
+}
+
+/// [`project`] for every channel of `brdf`, sampling the grid once: each
+/// channel's projection is the one [`project`] gives for that channel alone
+/// (the same sums in the same order).
+pub fn project_channels(
+    brdf: &dyn ChannelBrdf,
+    band_limit: usize,
+    quadrature: Quadrature,
+    progress: Option<&ProgressBar>,
+) -> Vec<Projection> {
     assert!(
         (2..=MAX_BAND_LIMIT).contains(&band_limit),
         "band limit {band_limit} outside 2..={MAX_BAND_LIMIT}"
@@ -202,24 +251,34 @@ pub fn project(
     let (cos_delta, sin_delta): (Vec<f64>, Vec<f64>) =
         delta.iter().map(|d| (d.cos(), d.sin())).unzip();
 
-    // g[m][a * n_theta + b] = g_m(x_a, x_b).
+    let channels = brdf.channels();
+    let row_len = (band_limit + 1) * n_theta;
+    // g[m][a * n_theta + b] = g_m(x_a, x_b) of channel c at rows[a][c * row_len ..].
     let rows: Vec<Vec<f64>> = (0..n_theta)
         .into_par_iter()
         .map(|a| {
             let (xi, si) = (x[a], (1.0 - x[a] * x[a]).sqrt());
             let wi = [si, 0.0, xi];
-            let mut row = vec![0.0; (band_limit + 1) * n_theta];
-            let mut f = vec![0.0; n_phi];
+            let mut row = vec![0.0; channels * row_len];
+            // f[c * n_phi + k]: channel c at Δφ_k.
+            let mut f = vec![0.0; channels * n_phi];
+            let mut values = vec![0.0; channels];
             for b in 0..n_theta {
                 let (xo, so) = (x[b], (1.0 - x[b] * x[b]).sqrt());
                 for k in 0..n_phi {
                     let wo = [so * cos_delta[k], so * sin_delta[k], xo];
-                    f[k] = brdf.eval(wi, wo) * xi * xo;
+                    brdf.eval_channels(wi, wo, &mut values);
+                    for (c, v) in values.iter().enumerate() {
+                        f[c * n_phi + k] = v * xi * xo;
+                    }
                 }
-                for m in 0..=band_limit {
-                    let cosines = &cos_table[m * n_phi..(m + 1) * n_phi];
-                    let sum: f64 = f.iter().zip(cosines).map(|(v, c)| v * c).sum();
-                    row[m * n_theta + b] = sum;
+                for c in 0..channels {
+                    let f = &f[c * n_phi..(c + 1) * n_phi];
+                    for m in 0..=band_limit {
+                        let cosines = &cos_table[m * n_phi..(m + 1) * n_phi];
+                        let sum: f64 = f.iter().zip(cosines).map(|(v, cos)| v * cos).sum();
+                        row[c * row_len + m * n_theta + b] = sum;
+                    }
                 }
             }
             if let Some(p) = progress {
@@ -228,7 +287,26 @@ pub fn project(
             row
         })
         .collect();
+    (0..channels)
+        .map(|c| {
+            let rows: Vec<&[f64]> = rows
+                .iter()
+                .map(|row| &row[c * row_len..(c + 1) * row_len])
+                .collect();
+            blocks_of(&rows, band_limit, n_theta, &x, &w)
+        })
+        .collect()
+}
 
+/// The blocks `B^m` from `g_m` (`rows[a][m * n_theta + b] = g_m(x_a, x_b)`)
+/// and the Gauss–Legendre rule `(x, w)` on [0, 1].
+fn blocks_of(
+    rows: &[&[f64]],
+    band_limit: usize,
+    n_theta: usize,
+    x: &[f64],
+    w: &[f64],
+) -> Projection {
     let mut column = vec![0.0; band_limit + 1];
     let blocks = (0..=band_limit)
         .map(|m| {
@@ -410,6 +488,27 @@ mod tests {
         }
         let rho = projection.eval([0.6, 0.0, 0.8], [0.0, -0.28, 0.96]);
         assert!((rho - albedo / PI).abs() < 1e-14, "{rho}");
+    }
+
+    #[test]
+    fn channels_projected_together_equal_each_alone() {
+        let narrow = BeckmannCt {
+            alpha: 0.15,
+            eta: None,
+        };
+        let wide = BeckmannCt {
+            alpha: 0.6,
+            eta: None,
+        };
+        let q = default_quadrature(10);
+        let both = EachChannel(vec![Box::new(narrow), Box::new(wide)]);
+        let together = project_channels(&both, 10, q, None);
+        assert_eq!(together.len(), 2);
+        for (projection, brdf) in together.iter().zip(&both.0) {
+            let alone = project(brdf.as_ref(), 10, q, None);
+            assert_eq!(projection.packed(None), alone.packed(None));
+        }
+        assert_ne!(together[0].packed(None), together[1].packed(None));
     }
 
     #[test]

@@ -21,6 +21,8 @@
 //! in f32 (relative rounding ~6e-8, far below the truncation error in L).
 //! The f64 reference (`crate::reference::brdf`, exact C) costs 1–30 ms per
 //! call; the projection needs ~10⁶ evaluations per channel, hence the runtime.
+//! The channels are projected in one pass ([`crate::sh::project_channels`]):
+//! the integrated model's three come from one evaluation.
 //!
 //! **Where the input tables come from** ([`input_dir`]): the directory the
 //! T4 files are written to (`build --out`) or read from (`verify DIR`) when it
@@ -52,7 +54,9 @@ use crate::analytic::{BeckmannCt, StandIn};
 use crate::materials::{Material, Materials};
 use crate::reference::fresnel::{self, Complex64};
 use crate::rng::SplitMix64;
-use crate::sh::{IsotropicBrdf, Runtime, default_quadrature, project};
+use crate::sh::{
+    ChannelBrdf, EachChannel, IsotropicBrdf, Runtime, default_quadrature, project_channels,
+};
 
 /// The workspace's table directory (the studies and tests read it; the
 /// generator's defaults never do).
@@ -238,20 +242,37 @@ pub fn stand_in_brdf(material: &Material, channel: usize) -> Result<StandIn, Bui
     })
 }
 
-/// One linear-sRGB channel of the integrated two-scale model
-/// ([`IntegratedRgb::eval`]) as an [`IsotropicBrdf`], at the directions
-/// rounded to f32.
-pub struct IntegratedChannel<'a> {
-    /// The model (its bakes on the heap).
-    pub model: IntegratedRgb<'a, Box<ChannelBake>>,
-    /// 0 red, 1 green, 2 blue.
+/// The linear-sRGB channels of the integrated two-scale model
+/// ([`IntegratedRgb::eval`]) as a [`ChannelBrdf`], at the directions rounded
+/// to f32.
+pub struct IntegratedChannels<'a>(pub IntegratedRgb<'a, Box<ChannelBake>>);
+
+impl ChannelBrdf for IntegratedChannels<'_> {
+    fn channels(&self) -> usize {
+        3
+    }
+    fn eval_channels(&self, wi: [f64; 3], wo: [f64; 3], out: &mut [f64]) {
+        let rgb = self.0.eval(wi.map(|v| v as f32), wo.map(|v| v as f32));
+        for (v, c) in out.iter_mut().zip(rgb) {
+            *v = f64::from(c);
+        }
+    }
+}
+
+/// One channel of a [`ChannelBrdf`] as an [`IsotropicBrdf`].
+pub struct ChannelOf<B> {
+    /// The model.
+    pub model: B,
+    /// The channel.
     pub channel: usize,
 }
 
-impl IsotropicBrdf for IntegratedChannel<'_> {
+impl<B: ChannelBrdf> IsotropicBrdf for ChannelOf<B> {
     fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
-        let rgb = self.model.eval(wi.map(|v| v as f32), wo.map(|v| v as f32));
-        f64::from(rgb[self.channel])
+        let mut out = [0.0; 3];
+        let out = &mut out[..self.model.channels()];
+        self.model.eval_channels(wi, wo, out);
+        out[self.channel]
     }
 }
 
@@ -268,13 +289,45 @@ pub fn material_brdf<'a>(
 ) -> Result<Box<dyn IsotropicBrdf + 'a>, BuildError> {
     Ok(match (tables, &material.spectral) {
         (Some(tables), Some(spectral)) if material.rgb_mode() == RgbMode::Integrated => {
-            Box::new(IntegratedChannel {
-                model: IntegratedRgb::boxed(tables, spectral, Options::default()),
+            Box::new(ChannelOf {
+                model: IntegratedChannels(IntegratedRgb::boxed(
+                    tables,
+                    spectral,
+                    Options::default(),
+                )),
                 channel,
             })
         }
         (Some(tables), _) => Box::new(two_scale_brdf(material, channel, wavelength, tables)),
         (None, _) => Box::new(stand_in_brdf(material, channel)?),
+    })
+}
+
+/// Every channel of [`material_brdf`] at `wavelengths` as one [`ChannelBrdf`]:
+/// the integrated model's three channels from one evaluation, else one
+/// [`material_brdf`] per channel.
+pub fn material_channels<'a>(
+    material: &Material,
+    wavelengths: &[f64],
+    tables: Option<&Tables<'a>>,
+) -> Result<Box<dyn ChannelBrdf + 'a>, BuildError> {
+    Ok(match (tables, &material.spectral) {
+        (Some(tables), Some(spectral))
+            if material.rgb_mode() == RgbMode::Integrated && wavelengths.len() == 3 =>
+        {
+            Box::new(IntegratedChannels(IntegratedRgb::boxed(
+                tables,
+                spectral,
+                Options::default(),
+            )))
+        }
+        _ => Box::new(EachChannel(
+            wavelengths
+                .iter()
+                .enumerate()
+                .map(|(c, &lambda)| material_brdf(material, c, lambda, tables))
+                .collect::<Result<_, _>>()?,
+        )),
     })
 }
 
@@ -360,7 +413,7 @@ impl TableKind for ShBrdf {
     }
 
     fn work_items(&self) -> u64 {
-        (default_quadrature(self.band_limit).theta_nodes * self.wavelengths.len()) as u64
+        default_quadrature(self.band_limit).theta_nodes as u64
     }
 
     fn build(&self, progress: &ProgressBar) -> Result<Vec<u8>, BuildError> {
@@ -372,9 +425,9 @@ impl TableKind for ShBrdf {
         let mut grid = vec![0.0f32; count * channels];
         let mut asymmetry: f64 = 0.0;
         with_source(&self.projected, |tables| {
-            for (c, &lambda) in self.wavelengths.iter().enumerate() {
-                let brdf = material_brdf(m, c, lambda, tables)?;
-                let projection = project(brdf.as_ref(), l, quadrature, Some(progress));
+            let brdf = material_channels(m, &self.wavelengths, tables)?;
+            let projections = project_channels(brdf.as_ref(), l, quadrature, Some(progress));
+            for (c, projection) in projections.iter().enumerate() {
                 let (diff, norm) = projection.asymmetry();
                 asymmetry = asymmetry.max(if norm > 0.0 { diff / norm } else { 0.0 });
                 for (k, v) in projection.packed(m.filter).into_iter().enumerate() {
@@ -420,13 +473,24 @@ impl TableKind for ShBrdf {
         let mut out = Vec::new();
         let pairs = verification_pairs(points, seed);
         with_source(&self.projected, |tables| {
-            for (c, &lambda) in self.wavelengths.iter().enumerate() {
-                let brdf = material_brdf(&self.material, c, lambda, tables)?;
+            let brdf = material_channels(&self.material, &self.wavelengths, tables)?;
+            let channels = self.wavelengths.len();
+            // exact[p * channels + c]: channel c at pair p.
+            let exact: Vec<f64> = pairs
+                .par_iter()
+                .flat_map_iter(|&(wi, wo)| {
+                    let mut values = vec![0.0; channels];
+                    brdf.eval_channels(wi, wo, &mut values);
+                    values
+                })
+                .collect();
+            for c in 0..channels {
                 let values: Vec<(f64, f64, String)> = pairs
                     .par_iter()
-                    .map(|&(wi, wo)| {
+                    .enumerate()
+                    .map(|(p, &(wi, wo))| {
                         let cc = wi[2] * wo[2];
-                        let exact = brdf.eval(wi, wo) * cc;
+                        let exact = exact[p * channels + c] * cc;
                         let got = f64::from(table.eval(c, narrow(wi), narrow(wo))) * cc;
                         let at = format!(
                             "θi {:.1}°, θo {:.1}°, Δφ {:.1}°",
