@@ -170,6 +170,9 @@ pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
 pub struct IntegratedRgb<'a, B = ChannelBake> {
     nodes: [TwoScale<'a, B>; INTEGRATED_COUNT],
     colour: ColourBake,
+    /// Whether the models have a base lobe, `k_d` or the compensation lobe
+    /// (else their `ρ_base + ρ_ms` is 0 and is not evaluated).
+    diffuse: bool,
 }
 
 #[cfg(feature = "std")]
@@ -194,7 +197,12 @@ impl<'a, B: BorrowMut<ChannelBake>> IntegratedRgb<'a, B> {
     ) -> Self {
         let nodes = models_at(bakes, tables, material, options, &INTEGRATED_WAVELENGTHS);
         let colour = ColourBake::new(material, options.colour == ColourTerms::White);
-        IntegratedRgb { nodes, colour }
+        let diffuse = nodes.iter().any(|node| node.has_lobes().1);
+        IntegratedRgb {
+            nodes,
+            colour,
+            diffuse,
+        }
     }
 }
 
@@ -241,13 +249,20 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
             let t = node.surface_terms(&pair, node.white());
             let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
             let surface = finite(t.a_spec * t.rho_ct + t.diffraction);
-            // The compensation lobe's colour is F_avg's, per node: plain weights.
-            let base = finite(
-                node.base_value(&t.at_i, &t.at_o, cos_i, cos_o)
-                    + node.multiple_value(&t.at_i, &t.at_o),
-            );
-            for c in 0..3 {
-                out[c] += surface * f64::from(r[k][c]) + base * f64::from(self.colour.plain[k][c]);
+            if self.diffuse {
+                // The compensation lobe's colour is F_avg's, per node: plain weights.
+                let base = finite(
+                    node.base_value(&t.at_i, &t.at_o, cos_i, cos_o)
+                        + node.multiple_value(&t.at_i, &t.at_o),
+                );
+                for c in 0..3 {
+                    out[c] +=
+                        surface * f64::from(r[k][c]) + base * f64::from(self.colour.plain[k][c]);
+                }
+            } else {
+                for c in 0..3 {
+                    out[c] += surface * f64::from(r[k][c]);
+                }
             }
         }
         out.map(|x| finite_or_zero(x.max(0.0)))

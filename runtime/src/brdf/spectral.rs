@@ -24,7 +24,6 @@ use super::{
     exp_and_one_minus_over, finite_or_zero, halo_attenuation, q_bar,
 };
 use crate::fresnel::{Complex, fresnel};
-use crate::math;
 use crate::optical::SpectralMaterial;
 use core::borrow::{Borrow, BorrowMut};
 
@@ -46,11 +45,44 @@ const ETA_NODES: usize = 471;
 const ETA_FIRST: f32 = 0.36;
 const ETA_STEP: f32 = 0.001;
 
-/// The hats' cell of `lambda` on `nodes` (held at the ends): `(k, f)` with
-/// `hat_k = 1 − f`, `hat_{k+1} = f`.
+/// Width of the bins of [`CELL_START`], µm.
+const CELL_BIN: f32 = 0.01;
+/// Bins of [`CELL_START`] over [0.36, 0.83] µm.
+const CELL_BINS: usize = 48;
+
+/// Per 0.01 µm bin from 0.36 µm, a model index at or below the hats' cell
+/// of every λ in the bin: the number of inner nodes below the bin's start
+/// less one, so that rounding of the bin index cannot overshoot; the nodes
+/// are ≥ 0.02 µm apart, so [`cell`] steps at most twice from it.
+const CELL_START: [u8; CELL_BINS] = {
+    let mut start = [0u8; CELL_BINS];
+    let mut j = 0;
+    while j < CELL_BINS {
+        let edge = SPECTRAL_WAVELENGTHS[0] + CELL_BIN * j as f32;
+        let mut below = 0u8;
+        let mut m = 1;
+        while m + 1 < SPECTRAL_COUNT {
+            if SPECTRAL_WAVELENGTHS[m] < edge {
+                below += 1;
+            }
+            m += 1;
+        }
+        start[j] = below.saturating_sub(1);
+        j += 1;
+    }
+    start
+};
+
+/// The hats' cell of `lambda` (clamped to [0.36, 0.83] µm) on
+/// [`SPECTRAL_WAVELENGTHS`] (held at the ends): `(k, f)` with
+/// `hat_k = 1 − f`, `hat_{k+1} = f`. The search starts at [`CELL_START`]'s
+/// bin of λ.
 #[inline]
-fn cell(nodes: &[f32], lambda: f32) -> (usize, f32) {
-    let mut k = 0;
+fn cell(lambda: f32) -> (usize, f32) {
+    let nodes = &SPECTRAL_WAVELENGTHS;
+    // NaN and λ below the first node → bin 0 (`as` saturates).
+    let bin = (((lambda - nodes[0]) * (1.0 / CELL_BIN)) as usize).min(CELL_BINS - 1);
+    let mut k = usize::from(CELL_START[bin]);
     while k + 2 < nodes.len() && lambda > nodes[k + 1] {
         k += 1;
     }
@@ -74,8 +106,14 @@ struct NodeTerms {
 }
 
 impl NodeTerms {
-    /// The terms of `node` at `pair`.
-    fn new<B: Borrow<ChannelBake>>(node: &TwoScale<'_, B>, pair: &Pair, white: bool) -> Self {
+    /// The terms of `node` at `pair`; `plain` 0 unless `diffuse` (the
+    /// models have a base lobe, `k_d` or the compensation lobe).
+    fn new<B: Borrow<ChannelBake>>(
+        node: &TwoScale<'_, B>,
+        pair: &Pair,
+        white: bool,
+        diffuse: bool,
+    ) -> Self {
         let direction = &node.bake().direction;
         let (at_i, at_o) = (
             direction.at_cell(pair.cells[0]),
@@ -90,13 +128,18 @@ impl NodeTerms {
             pair.along,
             pair.across,
         );
-        let multiple = node.multiple_value(&at_i, &at_o);
+        let plain = if diffuse {
+            let multiple = node.multiple_value(&at_i, &at_o);
+            f64::from(finite_or_zero(node.base_value(&at_i, &at_o, cos_i, cos_o)))
+                + f64::from(finite_or_zero(multiple))
+        } else {
+            0.0
+        };
         NodeTerms {
             ratio_sq: node.sigma_ratio_sq(&at_i, &at_o),
             q,
             fresnel: node.fresnel_at(pair.cells[2]),
-            plain: f64::from(finite_or_zero(node.base_value(&at_i, &at_o, cos_i, cos_o)))
-                + f64::from(finite_or_zero(multiple)),
+            plain,
         }
     }
 }
@@ -111,6 +154,9 @@ pub struct Spectral<'a, B = ChannelBake> {
     /// η every 1 nm from 0.36 µm.
     eta: [Complex; ETA_NODES],
     white: bool,
+    /// Whether the models have a base lobe, `k_d` or the compensation lobe
+    /// (else their `ρ_base + ρ_ms` is 0 and is not evaluated).
+    diffuse: bool,
 }
 
 #[cfg(feature = "std")]
@@ -131,8 +177,10 @@ impl<'a, B: BorrowMut<ChannelBake>> Spectral<'a, B> {
         material: &SpectralMaterial<'_>,
         options: Options,
     ) -> Self {
+        let nodes = models_at(bakes, tables, material, options, &SPECTRAL_WAVELENGTHS);
         Spectral {
-            nodes: models_at(bakes, tables, material, options, &SPECTRAL_WAVELENGTHS),
+            diffuse: nodes.iter().any(|node| node.has_lobes().1),
+            nodes,
             eta: core::array::from_fn(|j| material.eta.at(ETA_FIRST + ETA_STEP * j as f32)),
             white: options.colour == ColourTerms::White,
         }
@@ -176,7 +224,8 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     /// η at `lambda` (clamped), linear between the 1 nm nodes.
     fn eta_at(&self, lambda: f32) -> Complex {
         let t = (lambda - ETA_FIRST) / ETA_STEP;
-        let j = (math::floor(f64::from(t.max(0.0))) as usize).min(ETA_NODES - 2);
+        // ⌊t⌋ for t ≥ 0 (`as` truncates; NaN → 0).
+        let j = (t.max(0.0) as usize).min(ETA_NODES - 2);
         let f = (t - j as f32).max(0.0).min(1.0);
         let (a, b) = (self.eta[j], self.eta[j + 1]);
         Complex::new(a.re + f * (b.re - a.re), a.im + f * (b.im - a.im))
@@ -203,9 +252,9 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         };
         lambdas.map(|lambda| {
             let lambda = Self::clamped(lambda);
-            let (k, f) = cell(&SPECTRAL_WAVELENGTHS, lambda);
-            let a = NodeTerms::new(&self.nodes[k], &pair, self.white);
-            let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white);
+            let (k, f) = cell(lambda);
+            let a = NodeTerms::new(&self.nodes[k], &pair, self.white, self.diffuse);
+            let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white, self.diffuse);
             self.at_lambda(&pair, lambda, k, f64::from(f), &a, &b)
         })
     }
@@ -281,7 +330,7 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     /// The model whose sampler serves `lambda`: the nearest of
     /// [`SPECTRAL_WAVELENGTHS`].
     fn nearest(&self, lambda: f32) -> &TwoScale<'_, B> {
-        let (k, f) = cell(&SPECTRAL_WAVELENGTHS, Self::clamped(lambda));
+        let (k, f) = cell(Self::clamped(lambda));
         &self.nodes[if f < 0.5 { k } else { k + 1 }]
     }
 
