@@ -253,14 +253,28 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         lambdas.map(|lambda| {
             let lambda = Self::clamped(lambda);
             let (k, f) = cell(lambda);
+            // F first: its chain (η, a complex root, two quotients) is the
+            // longest, and the models' terms do not wait for it.
+            let fl = self.fresnel_at(lambda, pair.geometry.cos_d);
             let a = NodeTerms::new(&self.nodes[k], &pair, self.white, self.diffuse);
             let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white, self.diffuse);
-            self.at_lambda(&pair, lambda, k, f64::from(f), &a, &b)
+            self.at_lambda(&pair, lambda, fl, (k, f64::from(f)), &a, &b)
         })
     }
 
+    /// F(η(λ), θd) at `lambda` (clamped), or 1 for white colour terms.
+    #[inline]
+    fn fresnel_at(&self, lambda: f32, cos_d: f64) -> f64 {
+        if self.white {
+            1.0
+        } else {
+            f64::from(fresnel(self.eta_at(lambda), cos_d as f32))
+        }
+    }
+
     /// ρ at `lambda` (clamped) between the models `k` and `k + 1` (terms `a`,
-    /// `b`, fraction `f`; docs/model.md §2.12): the surface lobes at λ itself
+    /// `b`, fraction `f`; `fl` = [`Spectral::fresnel_at`] λ; docs/model.md
+    /// §2.12): the surface lobes at λ itself
     /// (F(θd) of η(λ), A_spec, (1 − A)/σrel² and the halo's constant at λ, C
     /// at `u = b cos θd/λ` from model `k`'s bake, which covers `[0, b/λ_k]`),
     /// σrel/σs and Q̄/F(θd) linear in λ between the models; the base lobes
@@ -269,8 +283,8 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         &self,
         pair: &Pair,
         lambda: f32,
-        k: usize,
-        f: f64,
+        fl: f64,
+        (k, f): (usize, f64),
         a: &NodeTerms,
         b: &NodeTerms,
     ) -> f32 {
@@ -278,11 +292,6 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
         let node = &self.nodes[k];
         let geometry = &pair.geometry;
         let (cos_i, cos_o, cos_d) = (geometry.wi[2], geometry.wo[2], geometry.cos_d);
-        let fl = if self.white {
-            1.0
-        } else {
-            f64::from(fresnel(self.eta_at(lambda), cos_d as f32))
-        };
         // λ_k/λ: B, the exponents' (4π/λ)² and the halo's 1/λ² from model k's.
         let ratio = node.lambda / f64::from(lambda);
         let x_scale = node.x_scale * ratio * ratio;
