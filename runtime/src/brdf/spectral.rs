@@ -233,33 +233,46 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
 
     /// ρ(i, o) at `lambda` µm (module documentation). 0 below the horizon.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3], lambda: f32) -> f32 {
-        self.eval_at(i, o, [lambda])[0]
+        match self.nodes[0].pair(i, o) {
+            Some(pair) => self.finish(&pair, self.start(&pair, lambda)),
+            None => 0.0,
+        }
     }
 
     /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
-    /// the pair's geometry, D and G once, each model needed once.
+    /// the pair's geometry, D and G once, then F at each wavelength
+    /// ([`Spectral::start`]), then each wavelength's models
+    /// ([`Spectral::finish`]).
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
-        self.eval_at(i, o, lambdas)
+        let Some(pair) = self.nodes[0].pair(i, o) else {
+            return [0.0; 4];
+        };
+        // F at every λ first: its chain is the longest.
+        let started = lambdas.map(|lambda| self.start(&pair, lambda));
+        started.map(|s| self.finish(&pair, s))
     }
 
-    /// ρ(i, o) at `N` wavelengths: the pair's geometry, D and G once, then
-    /// per wavelength its two models' terms ([`NodeTerms`]; not shared
-    /// between wavelengths: a renderer's wavelengths rarely share a model,
-    /// and a cache cost more than it saved) and [`Spectral::at_lambda`].
-    fn eval_at<const N: usize>(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; N]) -> [f32; N] {
-        let Some(pair) = self.nodes[0].pair(i, o) else {
-            return [0.0; N];
-        };
-        lambdas.map(|lambda| {
-            let lambda = Self::clamped(lambda);
-            let (k, f) = cell(lambda);
-            // F first: its chain (η, a complex root, two quotients) is the
-            // longest, and the models' terms do not wait for it.
-            let fl = self.fresnel_at(lambda, pair.geometry.cos_d);
-            let a = NodeTerms::new(&self.nodes[k], &pair, self.white, self.diffuse);
-            let b = NodeTerms::new(&self.nodes[k + 1], &pair, self.white, self.diffuse);
-            self.at_lambda(&pair, lambda, fl, (k, f64::from(f)), &a, &b)
-        })
+    /// What comes first at `lambda`: λ clamped, its models' cell `(k, f)`
+    /// and F(η(λ), θd), whose chain (η, a complex root, two quotients) is
+    /// the longest of [`Spectral::at_lambda`]'s; the models' terms do not
+    /// wait for it.
+    #[inline(always)]
+    fn start(&self, pair: &Pair, lambda: f32) -> (f32, f64, (usize, f64)) {
+        let lambda = Self::clamped(lambda);
+        let (k, f) = cell(lambda);
+        let fl = self.fresnel_at(lambda, pair.geometry.cos_d);
+        (lambda, fl, (k, f64::from(f)))
+    }
+
+    /// ρ at a wavelength [`Spectral::start`]ed: its two models' terms
+    /// ([`NodeTerms`]; not shared between wavelengths: a renderer's
+    /// wavelengths rarely share a model, and a cache cost more than it
+    /// saved) and [`Spectral::at_lambda`].
+    #[inline(always)]
+    fn finish(&self, pair: &Pair, (lambda, fl, (k, f)): (f32, f64, (usize, f64))) -> f32 {
+        let a = NodeTerms::new(&self.nodes[k], pair, self.white, self.diffuse);
+        let b = NodeTerms::new(&self.nodes[k + 1], pair, self.white, self.diffuse);
+        self.at_lambda(pair, lambda, fl, (k, f), &a, &b)
     }
 
     /// F(η(λ), θd) at `lambda` (clamped), or 1 for white colour terms.
