@@ -1113,7 +1113,7 @@ class SpectralModel(Model):
 
     def eval_spectral(self, wi, wo, lams):
         """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
-        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval_at``):
+        ``mi.Float``), as a list of ``mi.Float`` (``Spectral::eval4``):
         each model's terms at the pair (:meth:`_Channel.node_terms`), then
         the surface lobes at λ itself with C from the lower model's bake
         (``Spectral::at_lambda``)."""
