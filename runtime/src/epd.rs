@@ -90,7 +90,13 @@ impl<'a> Epd<'a> {
         let tan_sq = tan_sq(m);
         // libm's f32 powf and expf: the inlined f64 forms (math::pow_positive,
         // exp_inline) count fewer instructions but ran slower (speed.md).
-        let y = math::powff(tan_sq * self.inv_beta_sq, self.p);
+        let x = tan_sq * self.inv_beta_sq;
+        // Beckmann (p = 1) needs no power: powf(x, 1) is x exactly.
+        let y = if self.p == 1.0 {
+            x
+        } else {
+            math::powff(x, self.p)
+        };
         // e^−y is 0 in f32 beyond y ≈ 104.
         if !(y < 104.0) {
             return 0.0;
