@@ -48,7 +48,8 @@ ISSUE_HALO = "strong halo (β 0.1, p 1, σs 0.1, b 3,"
 @pytest.mark.parametrize("name,theta", [
     ("gold-hp17-geometry", 85), ("gold-rough", 70), ("gold-rough", 85), ("aluminium", 85),
     ("silver", 70), ("copper", 45), ("iron", 70), (ISSUE_HALO, 0), (ISSUE_HALO, 70),
-    (ISSUE_HALO, 85), ("strong halo (β 0.5, p 1, σs 0.1, b 1,", 70),
+    (ISSUE_HALO, 85), ("strong halo (β 0.01, p 1, σs 0.1, b 1,", 0),
+    ("strong halo (β 0.5, p 1, σs 0.1, b 1,", 70),
     ("strong halo (β 0.5, p 1, σs 0.1, b 20,", 0),
 ])
 def test_halo_materials_meet_the_targets(name, theta):

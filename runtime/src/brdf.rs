@@ -1673,6 +1673,73 @@ fn compensation(e_avg: f64, f_avg: f64) -> (f64, f64) {
     (f_ms, f_ms / (PI * lost))
 }
 
+/// The lobe weights of three channels whose samplers are mixed with equal
+/// probability under one density ([`Rgb::pdf`]), set in each channel's
+/// table. With `s_cl` a channel's own weights (its lobes'
+/// albedo shares, [`TwoScale::lobe_weights`]), the mixture picks lobe `l` with
+///
+/// ```text
+/// π_l ∝ (min_c s_cl + max_c s_cl) / 2,     Σ_l π_l = 1
+/// ```
+///
+/// and the halo's `π_h` is split over the channels' halo draws (whose shapes
+/// differ) as their own shares, channel `c`'s weights being
+///
+/// ```text
+/// w_ch = min(1, 3 π_h s_ch / Σ_c' s_c'h),   w_cl = π_l (1 − w_ch)/(1 − π_h)  (l ≠ h)
+/// ```
+///
+/// so that `(1/3) Σ_c w_cl = π_l`. For lobes apart, a channel's relative
+/// variance is at least `Σ_l s_cl²/π_l − 1`; with two lobes that is
+/// `(s_c − π)²/(π (1 − π))`, whose largest over the channels is smallest at
+/// the mid-range `π = (min s_c + max s_c)/2`. Each channel's own weights
+/// (the mixture `π_l = mean_c s_cl`) sent the lobe carrying most of the
+/// energy in one channel too few samples (docs/design/halo-sampling.md;
+/// not applied to `IntegratedRgb`'s sampler nodes, where it raised the
+/// presets' largest variance by up to 10%).
+fn share_lobe_weights<B: BorrowMut<ChannelBake>>(channels: [&mut TwoScale<'_, B>; 3]) {
+    let nodes = {
+        let own = |cos: f64| channels.each_ref().map(|ch| ch.weights(cos));
+        let shared = |c: usize, cos: f64| shared_lobe_weights(own(cos))[c];
+        [0, 1, 2].map(|c| {
+            channels[c]
+                .bake()
+                .direction
+                .lobe_weight_nodes(|_, cos| shared(c, cos))
+        })
+    };
+    for (channel, nodes) in channels.into_iter().zip(&nodes) {
+        channel.bake.borrow_mut().direction.set_lobe_weights(nodes);
+    }
+}
+
+/// [`share_lobe_weights`] at one incidence: the channels' weights from
+/// their own (normalised) weights `s`.
+fn shared_lobe_weights(s: [[f64; 4]; 3]) -> [[f64; 4]; 3] {
+    let mut pi = [0usize, 1, 2, 3].map(|l| {
+        let (lo, hi) = s.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), w| {
+            (lo.min(w[l]), hi.max(w[l]))
+        });
+        0.5 * (lo + hi)
+    });
+    let total: f64 = pi.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return s;
+    }
+    pi = pi.map(|x| x / total);
+    let halo: f64 = s.iter().map(|w| w[1]).sum();
+    let rest = 1.0 - pi[1];
+    s.map(|w| {
+        let h = if halo > 0.0 {
+            (3.0 * pi[1] * w[1] / halo).min(1.0)
+        } else {
+            0.0
+        };
+        let k = if rest > 0.0 { (1.0 - h) / rest } else { 0.0 };
+        [pi[0] * k, h, pi[2] * k, pi[3] * k]
+    })
+}
+
 /// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
 /// past the last interval falls on the last lobe of positive weight.
 fn pick_lobe(pick: f64, w: [f64; 4]) -> Lobe {
@@ -1781,6 +1848,8 @@ impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
         for (channel, eta) in channels.iter_mut().zip(material.eta_rgb) {
             channel.bake_wavelength(tables, &shared, eta);
         }
+        let [r, g, b] = &mut channels;
+        share_lobe_weights([r, g, b]);
         Rgb { channels }
     }
 
@@ -1800,7 +1869,8 @@ impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
     }
 
     /// The density of [`Rgb::sample`]: the mean of the channels' pdfs (one
-    /// channel's sampler is picked uniformly).
+    /// channel's sampler is picked uniformly; the channels' lobe weights are
+    /// shared, `share_lobe_weights`).
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
         match self.channels[0].geometry(i, o) {
             Some(geometry) => finite_or_zero(self.pdf_at(&geometry)),
