@@ -27,7 +27,7 @@ impl Convolution for Unbaked<'_> {
 fn errors(set: &TableSet<'_>, material: &Material, pairs: usize, seed: u64) -> Vec<f64> {
     let unbaked_source = Unbaked(set.convolution);
     let unbaked_tables = set.brdf_tables_with(&unbaked_source);
-    // Boxed: two models by value (312 KB each) may overflow a test thread's stack.
+    // Boxed: two models by value (366 KB each) may overflow a test thread's stack.
     let baked = Rgb::boxed(&set.brdf_tables(), material, Options::default());
     let unbaked = Rgb::boxed(&unbaked_tables, material, Options::default());
     let mut rng = SplitMix64::new(seed);

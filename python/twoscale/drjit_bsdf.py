@@ -326,33 +326,46 @@ class _Channel:
 
     def _row_cell(self, wi):
         """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
-        fraction, linear in `u` (f64)."""
+        fraction `(u − u_j)/(u_j+1 − u_j)` (f64)."""
         n_u = self.shapes["halo_u"][0]
         u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_u_top)
-
-        def node(j):
-            return dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u))
-
-        j = _last_at_most(n_u - 1, lambda j: node(j) <= u, 6)
-        u0, u1 = node(j), node(j + 1)
+        j = _last_at_most(
+            n_u - 1,
+            lambda j: dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u)) <= u, 6)
         row = self._node_row(j, n_u)
-        return row, dr.select(u1 > u0, dr.clip((u - u0) / (u1 - u0), 0.0, 1.0), 0.0)
+        u0 = dr.gather(mi.Float64, self.t["halo_u"], row)
+        inv_du = dr.gather(mi.Float64, self.t["halo_inv_du"], row)
+        return row, dr.clip((u - u0) * inv_du, 0.0, 1.0)
 
-    def _halo_node(self, name, row, k):
+    def _halo_zeta(self, row, k):
         n_s = self.shapes["halo_zeta"][1]
-        return mi.Float64(dr.gather(mi.Float, self.t[name], row * n_s + k))
+        return mi.Float64(dr.gather(mi.Float, self.t["halo_zeta"], row * n_s + k))
+
+    def _halo_cum(self, row, k):
+        n_s = self.shapes["halo_zeta"][1]
+        return dr.gather(mi.Float64, self.t["halo_cum"], row * n_s + k)
+
+    def _halo_coef(self, row, k):
+        """`[start, slope]` of row `row`'s cell `k` (f64)."""
+        n_s = self.shapes["halo_zeta"][1]
+        c = dr.gather(mi.Vector2f, self.t["halo_coef"], row * n_s + k)
+        return mi.Float64(c.x), mi.Float64(c.y)
 
     @staticmethod
     def _azimuth(sin_i, cos_i, sin_h, cos_h):
         """`halo::Azimuth::new`: `(H, [A₂, A₁, A₀], F(H))` of the azimuth law
-        `∝ (i·h)(cos θo)₊` and whether it exists (f64)."""
+        `∝ (i·h)(cos θo)₊` and whether it exists (f64); `F(H)` from
+        `x = cos H` without a sine or cosine."""
         a, b = sin_i * sin_h, cos_i * cos_h
         kappa = cos_i / (2.0 * cos_h)
         wide = b - a >= kappa
         exists = (cos_h > 0.0) & (wide | (b + a > kappa))
-        big_h = dr.select(wide, math.pi, _acos_approx(dr.clip((kappa - b) / a, -1.0, 1.0)))
+        x = dr.clip((kappa - b) / a, -1.0, 1.0)
+        big_h = dr.select(wide, math.pi, _acos_approx(x))
+        sin = dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0)))
+        x = dr.select(wide, -1.0, x)
         coef = (2.0 * cos_h * a * a, (4.0 * cos_h * b - cos_i) * a, (2.0 * cos_h * b - cos_i) * b)
-        half = _Channel._azimuth_cdf(coef, big_h)
+        half = 0.5 * coef[0] * (big_h + x * sin) + coef[1] * sin + coef[2] * big_h
         return big_h, coef, half, exists & (half > 0.0)
 
     @staticmethod
@@ -362,18 +375,14 @@ class _Channel:
         return 0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
 
     def _row_pdf(self, row, z):
-        """`HaloBake::row_pdf`."""
+        """`HaloBake::row_pdf`: `(start_k + slope_k (ζ − ζ_k)) / M_j`."""
         n_s = self.shapes["halo_zeta"][1]
-        total = self._halo_node("halo_cum", row, n_s - 1)
-        k = _last_at_most(n_s - 1, lambda k: self._halo_node("halo_zeta", row, k) <= z, 8)
-        z0, z1 = self._halo_node("halo_zeta", row, k), self._halo_node("halo_zeta", row, k + 1)
-        d0, d1 = self._halo_node("halo_dens", row, k), self._halo_node("halo_dens", row, k + 1)
-        cell = 0.5 * (d0 + d1) * (z1 - z0)
-        tau = dr.clip((z - z0) / (z1 - z0), 0.0, 1.0)
-        d = d0 + tau * (d1 - d0)
-        mass = self._halo_node("halo_cum", row, k + 1) - self._halo_node("halo_cum", row, k)
-        ok = (total > 0.0) & (z <= self._halo_node("halo_zeta", row, n_s - 1)) & (cell > 0.0)
-        return dr.select(ok, mass / total * d / cell, 0.0)
+        k = _last_at_most(n_s - 1, lambda k: self._halo_zeta(row, k) <= z, 8)
+        start, slope = self._halo_coef(row, k)
+        d = start + slope * (z - self._halo_zeta(row, k))
+        inv_total = dr.gather(mi.Float64, self.t["halo_inv_total"], row)
+        ok = z <= self._halo_zeta(row, n_s - 1)
+        return dr.select(ok, dr.maximum(d, 0.0) * inv_total, 0.0)
 
     def halo_pdf(self, wi, sin_h, cos_h, cos_o):
         """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`, f64."""
@@ -394,17 +403,15 @@ class _Channel:
         row = dr.select(lower, j, j + 1)
         azimuth = dr.select(lower, pick / (1.0 - t), (pick - (1.0 - t)) / t)
         azimuth = dr.clip(azimuth, 0.0, below_one)
-        total = self._halo_node("halo_cum", row, n_s - 1)
+        total = self._halo_cum(row, n_s - 1)
         target = along * total
-        k = _last_at_most(n_s - 1, lambda k: self._halo_node("halo_cum", row, k) <= target, 8)
-        c0, c1 = self._halo_node("halo_cum", row, k), self._halo_node("halo_cum", row, k + 1)
-        r = dr.select(c1 > c0, dr.clip((target - c0) / (c1 - c0), 0.0, 1.0), 0.0)
-        d0, d1 = self._halo_node("halo_dens", row, k), self._halo_node("halo_dens", row, k + 1)
-        q = r * 0.5 * (d0 + d1)
-        den = d0 + dr.sqrt(dr.maximum(d0 * d0 + 2.0 * (d1 - d0) * q, 0.0))
-        tau = dr.select(den > 0.0, dr.minimum(2.0 * q / den, 1.0), r)
-        z0, z1 = self._halo_node("halo_zeta", row, k), self._halo_node("halo_zeta", row, k + 1)
-        z = z0 + tau * (z1 - z0)
+        k = _last_at_most(n_s - 1, lambda k: self._halo_cum(row, k) <= target, 8)
+        rest = dr.maximum(target - self._halo_cum(row, k), 0.0)
+        start, slope = self._halo_coef(row, k)
+        z0, z1 = self._halo_zeta(row, k), self._halo_zeta(row, k + 1)
+        den = start + dr.sqrt(dr.maximum(start * start + 2.0 * slope * rest, 0.0))
+        s = dr.select(den > 0.0, 2.0 * rest / den, 0.0)
+        z = z0 + dr.minimum(s, z1 - z0)
         cos_h = 1.0 - z
         sin_h = dr.sqrt(dr.maximum(z * (2.0 - z), 0.0))
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
@@ -991,7 +998,7 @@ class _NodeChannel(_Channel):
 
     # The tables read through `_node_row`: stacked even where the models agree.
     ROWS = ("direction_rows", "direction_weights", "conv_ln_c", "radial_inv_m", "halo_u",
-            "halo_zeta", "halo_dens", "halo_cum")
+            "halo_inv_du", "halo_inv_total", "halo_zeta", "halo_coef", "halo_cum")
 
     def __init__(self, models, per_node, count):
         clash = sorted(n for n in per_node if n in self.SHARED or n.startswith("visible_"))

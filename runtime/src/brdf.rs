@@ -360,8 +360,8 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// What a [`TwoScale`] bakes for its material and wavelength (F, Q̄'s
 /// factors and σrel over `cos θ`, G1 over the slope, the sampler's
 /// visible-slope density, and C over `(u, θh)` when the source of C is T3b;
-/// modules `bake`, `visible` and `halo`): 104 KB of plain numbers (the
-/// visible-slope tables 40 KB, the halo sampler's densities 26 KB, C 18 KB,
+/// modules `bake`, `visible` and `halo`): 122 KB of plain numbers (the
+/// visible-slope tables 40 KB, the halo sampler's densities 44 KB, C 18 KB,
 /// the direction bake 12 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
 ///
 /// All zeros is a valid (empty) value, so storage can be allocated zeroed on
@@ -399,7 +399,7 @@ impl ChannelBake {
         })
     }
 
-    /// Empty storage by value (104 KB on the caller's stack).
+    /// Empty storage by value (122 KB on the caller's stack).
     pub fn zeroed() -> ChannelBake {
         ChannelBake::new_zeroed()
     }
@@ -421,7 +421,7 @@ impl ChannelBake {
 ///
 /// Construction bakes what depends only on the material and wavelength into
 /// a [`ChannelBake`] (so that `eval` reads small tables), held as `B`: by
-/// value (the default, 104 KB; [`TwoScale::new`]), boxed
+/// value (the default, 122 KB; [`TwoScale::new`]), boxed
 /// (`TwoScale::boxed`, feature `std`) or borrowed (`&mut ChannelBake`),
 /// any `B: Borrow<ChannelBake>`; [`Rgb`] is three of them. `Clone` (when `B`
 /// is), not `Copy`.
@@ -552,7 +552,7 @@ impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
     /// [`ChannelBake`] (cost: `cargo bench --bench brdf -- construct`). The
-    /// value is 104 KB: on small stacks use `TwoScale::boxed` or
+    /// value is 122 KB: on small stacks use `TwoScale::boxed` or
     /// [`TwoScale::new_in`].
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN
@@ -1766,7 +1766,7 @@ fn pick_lobe(pick: f64, w: [f64; 4]) -> Lobe {
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
 /// The channels share the geometry, D and G of each evaluation (they must
 /// share the surface, as [`Rgb::new`] makes them). The bakes are held as `B`,
-/// as [`TwoScale`]'s: by value ([`Rgb::new`], 312 KB), boxed (`Rgb::boxed`)
+/// as [`TwoScale`]'s: by value ([`Rgb::new`], 366 KB), boxed (`Rgb::boxed`)
 /// or in caller-provided storage ([`Rgb::new_in`]).
 #[derive(Clone)]
 pub struct Rgb<'a, B = ChannelBake> {
@@ -1787,7 +1787,7 @@ pub struct RgbSample {
 
 impl<'a> Rgb<'a> {
     /// The three channels of `material` at [`RGB_WAVELENGTHS`]. The value is
-    /// 312 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
+    /// 366 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
         let bakes = [
             ChannelBake::zeroed(),

@@ -17,7 +17,7 @@
 //!
 //! ```text
 //! p(h)   = Σ_j w_j(B cos θi) p_j(ζ) · (i·h)(cos θo)₊ / N(θh)
-//! p_j(ζ) = m_jk / M_j · d_j(ζ) / ((d_jk + d_j,k+1)/2 · Δζ_k)     ζ in cell k
+//! p_j(ζ) = (s_jk + σ_jk (ζ − ζ_k)) / M_j                          ζ in cell k
 //! N(θh)  = ∫ (i·h)(cos θo)₊ dψ = 2 F(H)              (Azimuth: i·h = a cos ψ + b,
 //!          cos θo = 2 (i·h) cos θh − cos θi, a = sin θi sin θh, b = cos θi cos θh)
 //! pdf(o) = p(h) / (4 i·h) = Σ_j w_j p_j(ζ) cos θo / (4 N(θh))
@@ -25,9 +25,11 @@
 //!
 //! with `w_j` the weights of the rows around `u`, linear in `u` between the
 //! rows' own `u_j` (a mixture: the row is picked with its weight; found in
-//! f64 by a binary search, so that ports reproduce the pick), `d_j` the
-//! piecewise-linear density, `m_jk` the cell's mass as stored in the row's
-//! cumulative and `M_j` the row's total. Within a cell the CDF of ζ is a
+//! f64 by a binary search, so that ports reproduce the pick), `s_jk`,
+//! `σ_jk` the start and slope of the piecewise-linear density on cell `k`
+//! (baked in f32 from the node values: a gather and one multiply-add per
+//! row) and `M_j` the row's total, the integral of the stored coefficients
+//! in f64. Within a cell the CDF of ζ is a
 //! quadratic, solved in closed form; the azimuth's CDF `F(ψ)/F(H)` on each
 //! side is inverted by Newton's method in a shrinking bracket.
 //! [`HaloBake::pdf`] evaluates the same expression, so the density is the
@@ -53,18 +55,25 @@ use core::f64::consts::PI;
 use zerocopy::FromZeros;
 
 /// The halo sampler's per-row densities over `ζ = 1 − cos θh` (module
-/// documentation): 26 KB.
+/// documentation), as per-cell coefficients: 44 KB.
 #[derive(Clone, Debug, FromZeros)]
 pub(crate) struct HaloBake {
     /// The `u` of each row (increasing from 0 to `B`).
     u: [f64; CONV_U_NODES],
+    /// `1/(u_{j+1} − u_j)` (0 where the rows coincide; the last unused).
+    inv_du: [f64; CONV_U_NODES],
     /// `ζ` at each row's nodes (increasing from 0).
     zeta: [[f32; NODES]; CONV_U_NODES],
-    /// The density over `ζ` at the nodes, `C` normalised per row.
-    dens: [[f32; NODES]; CONV_U_NODES],
-    /// Its integral from 0 to each node (trapezoid, summed in f64; the
-    /// last is the row's total `M_j`, 1 up to rounding).
-    cum: [[f32; NODES]; CONV_U_NODES],
+    /// `[start, slope]` of each cell `k`: the row's density on
+    /// `[ζ_k, ζ_k+1]` is `(start + slope (ζ − ζ_k)) / M_j` (≥ 0 on the cell;
+    /// the last node's unused).
+    coef: [[[f32; 2]; NODES]; CONV_U_NODES],
+    /// The integral of `start + slope (ζ − ζ_0)` from 0 to each node, exact
+    /// in f64 from the stored coefficients (the last is `M_j`, 1 up to
+    /// rounding; 0 for a row without density).
+    cum: [[f64; NODES]; CONV_U_NODES],
+    /// `1/M_j` (0 for a row without density).
+    inv_total: [f64; CONV_U_NODES],
 }
 
 impl HaloBake {
@@ -95,33 +104,71 @@ impl HaloBake {
                     integral += 0.5 * dz * (f[k] + f[k - 1]);
                 }
             }
-            if !(integral > 0.0 && integral.is_finite()) {
-                self.dens[j] = [0.0; NODES];
-                self.cum[j] = [0.0; NODES];
-                continue;
-            }
-            for (d, value) in self.dens[j].iter_mut().zip(f) {
-                *d = (value / integral) as f32;
-            }
-            // The cumulative of the stored (f32) densities, summed in f64.
-            let mut sum = 0.0f64;
-            self.cum[j][0] = 0.0;
-            for k in 1..NODES {
-                let dz = f64::from(self.zeta[j][k]) - f64::from(self.zeta[j][k - 1]);
-                sum += 0.5 * dz * (f64::from(self.dens[j][k]) + f64::from(self.dens[j][k - 1]));
-                self.cum[j][k] = sum as f32;
-            }
+            self.set_row(j, &f, integral);
+        }
+        for j in 0..CONV_U_NODES {
+            let du = if j + 1 < CONV_U_NODES {
+                self.u[j + 1] - self.u[j]
+            } else {
+                0.0
+            };
+            self.inv_du[j] = if du > 0.0 { 1.0 / du } else { 0.0 };
         }
     }
 
-    /// Hands the tables to `v` (`halo_zeta`, `halo_dens`, `halo_cum`
-    /// `[33, 66]`; `halo_u` `[33]` (f64); rows as `conv_ln_c`'s without ghosts).
+    /// Row `j`'s cells from its node values `f` (piecewise linear in ζ over
+    /// `self.zeta[j]`, of integral `integral`): the coefficients normalised
+    /// and rounded to f32 (a slope rounded so that the cell's density stays
+    /// ≥ 0), the cumulative and `1/M_j` from the stored coefficients in f64.
+    fn set_row(&mut self, j: usize, f: &[f64; NODES], integral: f64) {
+        let (zeta, coef, cum) = (&self.zeta[j], &mut self.coef[j], &mut self.cum[j]);
+        *coef = [[0.0; 2]; NODES];
+        *cum = [0.0; NODES];
+        self.inv_total[j] = 0.0;
+        if !(integral > 0.0 && integral.is_finite()) {
+            return;
+        }
+        let mut sum = 0.0f64;
+        for k in 0..NODES - 1 {
+            let dz = f64::from(zeta[k + 1]) - f64::from(zeta[k]);
+            let (d0, d1) = (f[k] / integral, f[k + 1] / integral);
+            let start = d0 as f32;
+            let mut slope = if dz > 0.0 {
+                ((d1 - f64::from(start)) / dz) as f32
+            } else {
+                0.0
+            };
+            // At the cell's end `start + slope Δζ` must not round below 0.
+            while slope < 0.0 && f64::from(start) + f64::from(slope) * dz < 0.0 {
+                slope = f32::from_bits(slope.to_bits() - 1);
+            }
+            coef[k] = [start, slope];
+            sum += dz * (f64::from(start) + 0.5 * f64::from(slope) * dz);
+            cum[k + 1] = sum;
+        }
+        if sum > 0.0 && sum.is_finite() {
+            self.inv_total[j] = 1.0 / sum;
+        } else {
+            *coef = [[0.0; 2]; NODES];
+            *cum = [0.0; NODES];
+        }
+    }
+
+    /// Hands the tables to `v` (`halo_zeta` `[33, 66]`, `halo_coef`
+    /// `[33, 66, 2]`; f64: `halo_cum` `[33, 66]`, `halo_u`, `halo_inv_du`,
+    /// `halo_inv_total` `[33]`; rows as `conv_ln_c`'s without ghosts).
     pub fn visit(&self, v: &mut dyn BakeVisitor) {
         let shape = [CONV_U_NODES, NODES];
         v.array("halo_zeta", &shape, self.zeta.as_flattened());
-        v.array("halo_dens", &shape, self.dens.as_flattened());
-        v.array("halo_cum", &shape, self.cum.as_flattened());
+        v.array(
+            "halo_coef",
+            &[CONV_U_NODES, NODES, 2],
+            self.coef.as_flattened().as_flattened(),
+        );
+        v.array_f64("halo_cum", &shape, self.cum.as_flattened());
         v.array_f64("halo_u", &[CONV_U_NODES], &self.u);
+        v.array_f64("halo_inv_du", &[CONV_U_NODES], &self.inv_du);
+        v.array_f64("halo_inv_total", &[CONV_U_NODES], &self.inv_total);
     }
 
     /// Draws `h` for the incidence `wi` and `u = B cos θi` from two
@@ -137,31 +184,20 @@ impl HaloBake {
             (j + 1, (pick - (1.0 - t)) / t)
         };
         let azimuth = azimuth.max(0.0).min(f64::from(math::BELOW_ONE));
-        let (zeta, dens, cum) = (&self.zeta[row], &self.dens[row], &self.cum[row]);
-        let total = f64::from(cum[NODES - 1]);
+        let (zeta, coef, cum) = (&self.zeta[row], &self.coef[row], &self.cum[row]);
+        let total = cum[NODES - 1];
         if !(total > 0.0) {
             return None;
         }
         let target = along * total;
-        let k = last_at_most(NODES - 1, |k| f64::from(cum[k]) <= target);
-        let (c0, c1) = (f64::from(cum[k]), f64::from(cum[k + 1]));
-        let r = if c1 > c0 {
-            ((target - c0) / (c1 - c0)).max(0.0).min(1.0)
-        } else {
-            0.0
-        };
-        // ∫₀^τ (d0 + (d1 − d0) s) ds = r (d0 + d1)/2, the root in [0, 1].
-        let (d0, d1) = (f64::from(dens[k]), f64::from(dens[k + 1]));
-        let q = r * 0.5 * (d0 + d1);
-        let disc = (d0 * d0 + 2.0 * (d1 - d0) * q).max(0.0);
-        let den = d0 + math::sqrt(disc);
-        let tau = if den > 0.0 {
-            (2.0 * q / den).min(1.0)
-        } else {
-            r
-        };
+        let k = last_at_most(NODES - 1, |k| cum[k] <= target);
+        // ∫₀^s (start + slope x) dx = rest, the root in [0, Δζ].
+        let rest = (target - cum[k]).max(0.0);
+        let (start, slope) = (f64::from(coef[k][0]), f64::from(coef[k][1]));
         let (z0, z1) = (f64::from(zeta[k]), f64::from(zeta[k + 1]));
-        let z = z0 + tau * (z1 - z0);
+        let den = start + math::sqrt((start * start + 2.0 * slope * rest).max(0.0));
+        let s = if den > 0.0 { 2.0 * rest / den } else { 0.0 };
+        let z = z0 + s.min(z1 - z0);
         let cos_h = 1.0 - z;
         let sin_h = math::sqrt((z * (2.0 - z)).max(0.0));
         // ψ = φh − φi from (i·h)(cos θo)₊: the side from the azimuth's
@@ -215,38 +251,27 @@ impl HaloBake {
     }
 
     /// The row below `u` (clamped to the rows) and the fraction towards the
-    /// next, linear in `u`.
+    /// next, `(u − u_j)/(u_j+1 − u_j)`.
     #[inline]
     fn row_cell(&self, u: f64) -> (usize, f64) {
         let u = u.max(0.0).min(self.u[CONV_U_NODES - 1]);
         let j = last_at_most(CONV_U_NODES - 1, |j| self.u[j] <= u);
-        let (u0, u1) = (self.u[j], self.u[j + 1]);
-        let t = if u1 > u0 {
-            ((u - u0) / (u1 - u0)).max(0.0).min(1.0)
-        } else {
-            0.0
-        };
+        let t = ((u - self.u[j]) * self.inv_du[j]).max(0.0).min(1.0);
         (j, t)
     }
 
-    /// `p_j(ζ)` of row `j` (module documentation); 0 beyond its last node.
+    /// `p_j(ζ) = (start_k + slope_k (ζ − ζ_k)) / M_j` of row `j` on its cell
+    /// `k` (module documentation); 0 beyond its last node.
     #[inline]
     fn row_pdf(&self, j: usize, z: f64) -> f64 {
-        let (zeta, dens, cum) = (&self.zeta[j], &self.dens[j], &self.cum[j]);
-        let total = f64::from(cum[NODES - 1]);
-        if !(total > 0.0 && z <= f64::from(zeta[NODES - 1])) {
+        let zeta = &self.zeta[j];
+        if !(z <= f64::from(zeta[NODES - 1])) {
             return 0.0;
         }
         let k = last_at_most(NODES - 1, |k| f64::from(zeta[k]) <= z);
-        let (z0, z1) = (f64::from(zeta[k]), f64::from(zeta[k + 1]));
-        let (d0, d1) = (f64::from(dens[k]), f64::from(dens[k + 1]));
-        let cell = 0.5 * (d0 + d1) * (z1 - z0);
-        if !(cell > 0.0) {
-            return 0.0;
-        }
-        let tau = ((z - z0) / (z1 - z0)).max(0.0).min(1.0);
-        let d = d0 + tau * (d1 - d0);
-        (f64::from(cum[k + 1]) - f64::from(cum[k])) / total * d / cell
+        let [start, slope] = self.coef[j][k];
+        let d = f64::from(start) + f64::from(slope) * (z - f64::from(zeta[k]));
+        d.max(0.0) * self.inv_total[j]
     }
 }
 
@@ -264,7 +289,10 @@ pub(crate) struct Azimuth {
     /// `[A₂, A₁, A₀]`.
     coef: [f64; 3],
     /// `F(H)` with `F(ψ) = A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ`; the
-    /// normalisation `N(θh) = ∫ (i·h)(cos θo)₊ dψ` is `2 F(H)`.
+    /// normalisation `N(θh) = ∫ (i·h)(cos θo)₊ dψ` is `2 F(H)`. With
+    /// `x = cos H = (κ − b)/a`, `F(H) = A₂ (H + x √(1 − x²))/2 + A₁ √(1 − x²)
+    /// + A₀ H` (`A₂ π/2 + A₀ π` at `H = π`): `H` to 2.2e-8 moves it by
+    /// `O(10⁻¹⁶)` only, as `F′(H) ∝ (cos θo)₊ = 0` there.
     pub half: f64,
 }
 
@@ -277,20 +305,24 @@ impl Azimuth {
         }
         let (a, b) = (sin_i * sin_h, cos_i * cos_h);
         let kappa = cos_i / (2.0 * cos_h);
-        let big_h = if b - a >= kappa {
-            PI
-        } else if b + a > kappa {
-            // Inlined (to 2.2e-8, as φmax): a libm call was 13% of `pdf`.
-            math::acos_approx(((kappa - b) / a).max(-1.0).min(1.0))
-        } else {
-            return None;
-        };
         let coef = [
             2.0 * cos_h * a * a,
             (4.0 * cos_h * b - cos_i) * a,
             (2.0 * cos_h * b - cos_i) * b,
         ];
-        let half = cdf(coef, big_h);
+        // F(H) from x = cos H, without a sine or cosine: sin H = √(1 − x²).
+        let (big_h, half) = if b - a >= kappa {
+            (PI, (0.5 * coef[0] + coef[2]) * PI)
+        } else if b + a > kappa {
+            let x = ((kappa - b) / a).max(-1.0).min(1.0);
+            // Inlined (to 2.2e-8, as φmax): a libm call was 13% of `pdf`.
+            let big_h = math::acos_approx(x);
+            let sin = math::sqrt((1.0 - x * x).max(0.0));
+            let half = 0.5 * coef[0] * (big_h + x * sin) + coef[1] * sin + coef[2] * big_h;
+            (big_h, half)
+        } else {
+            return None;
+        };
         (half > 0.0).then_some(Azimuth { big_h, coef, half })
     }
 
