@@ -96,6 +96,20 @@ def _lerp_gather(table, width, column, i, frac):
     return dr.fma(frac, b - a, a)
 
 
+def _upload(values):
+    """A bake as a Dr.Jit array (``mi.Float``, or ``mi.Float64`` for f64)
+    over a copy of `values` aligned to 64 bytes. Dr.Jit maps a NumPy
+    array's memory rather than copying it, and gathers a packet
+    (:func:`_gather4`) as one load only from an aligned table: elsewhere it
+    falls back to four gathers."""
+    values = np.ascontiguousarray(values).ravel()
+    buf = np.empty(values.nbytes + 64, np.uint8)
+    start = -buf.ctypes.data % 64
+    out = buf[start:start + values.nbytes].view(values.dtype)
+    out[:] = values
+    return (mi.Float64 if values.dtype == np.float64 else mi.Float)(out)
+
+
 def _gather4(table, k):
     """Floats `4k … 4k + 3` of `table`, one packet gather."""
     return dr.gather(mi.Vector4f, table, k)
@@ -207,9 +221,7 @@ class _Channel:
     def __init__(self, bakes):
         self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
         self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
-        self.t = {k: (mi.Float64 if v.dtype == np.float64 else mi.Float)(
-                      np.ascontiguousarray(v).ravel())
-                  for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        self.t = {k: _upload(v) for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
         self.halo_u_top = float(bakes["halo_u"][-1])
@@ -225,7 +237,7 @@ class _Channel:
         # flattened grid (so that a Catmull–Rom row is one packet gather).
         ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()
         ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
-        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        self.conv_quads = _upload(np.lib.stride_tricks.sliding_window_view(ln_c, 4))
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
@@ -1021,13 +1033,12 @@ class _NodeChannel(_Channel):
         stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
         arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
         for name, v in arrays.items():
-            self.t[name] = (mi.Float64 if v.dtype == np.float64 else mi.Float)(
-                np.ascontiguousarray(v).ravel())
+            self.t[name] = _upload(v)
         # As `_Channel`'s packets, over the stacked grids (a packet never
         # crosses a row, so never a model).
         ln_c = np.ascontiguousarray(arrays["conv_ln_c"], dtype=np.float32).ravel()
         ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
-        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        self.conv_quads = _upload(np.lib.stride_tricks.sliding_window_view(ln_c, 4))
         scalars = {k: np.asarray(v, np.float64) for k, v in stacked.items() if k not in arrays}
         if "eta_re" in scalars or "f_dr_int" in scalars:
             # The base layer's constants per model (as `_Channel`'s).
@@ -1096,7 +1107,7 @@ class SpectralModel(Model):
         self.stack = _NodeChannel(models, per_node, len(spectral["wavelengths"]))
         self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
         self.node_table = mi.Float(spectral["wavelengths"])
-        self.eta = mi.Float(np.ascontiguousarray(spectral["eta"]).ravel())
+        self.eta = _upload(np.asarray(spectral["eta"], np.float32))
         self.eta_nodes = spectral["eta"].shape[0]
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
@@ -1247,7 +1258,7 @@ class IntegratedModel(Model):
         shared = dict(zip(sampler, self.channels))
         self.nodes = [shared[k] if k in shared else _Channel(b) for k, b in enumerate(models)]
         self.colour_nodes = integrated["surface"].shape[0]
-        self.surface = mi.Float(np.ascontiguousarray(integrated["surface"], np.float32).ravel())
+        self.surface = _upload(np.asarray(integrated["surface"], np.float32))
         self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
 
     def surface_weights(self, cos_d):
