@@ -1258,7 +1258,11 @@ class IntegratedModel(Model):
         shared = dict(zip(sampler, self.channels))
         self.nodes = [shared[k] if k in shared else _Channel(b) for k, b in enumerate(models)]
         self.colour_nodes = integrated["surface"].shape[0]
-        self.surface = _upload(np.asarray(integrated["surface"], np.float32))
+        # R_kc a row per node of `√cos θd`, padded to whole packets of four.
+        surface = np.asarray(integrated["surface"], np.float32).reshape(self.colour_nodes, -1)
+        self.surface_packets = -(-surface.shape[1] // 4)
+        self.surface = _upload(np.pad(surface, ((0, 0), (0, 4 * self.surface_packets
+                                                         - surface.shape[1]))))
         self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
 
     def surface_weights(self, cos_d):
@@ -1268,16 +1272,12 @@ class IntegratedModel(Model):
         t = dr.sqrt(dr.clip(cos_d, 0.0, 1.0)) * (n - 1)
         m = dr.minimum(mi.UInt32(dr.floor(t)), n - 2)
         f = t - mi.Float(m)
-        width = 3 * len(self.nodes)
-        out = []
-        for k in range(len(self.nodes)):
-            row = []
-            for c in range(3):
-                a = dr.gather(mi.Float, self.surface, m * width + 3 * k + c)
-                b = dr.gather(mi.Float, self.surface, (m + 1) * width + 3 * k + c)
-                row.append(a + f * (b - a))
-            out.append(row)
-        return out
+        # The two rows, each as packets of four floats.
+        packets = self.surface_packets
+        a = [v for j in range(packets) for v in _gather4(self.surface, m * packets + j)]
+        b = [v for j in range(packets) for v in _gather4(self.surface, (m + 1) * packets + j)]
+        return [[dr.fma(f, b[3 * k + c] - a[3 * k + c], a[3 * k + c]) for c in range(3)]
+                for k in range(len(self.nodes))]
 
     def eval(self, wi, wo):
         """ρ(wi, wo) in linear sRGB (sr⁻¹) as an ``mi.Color3f``
