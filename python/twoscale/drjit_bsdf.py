@@ -745,31 +745,24 @@ class _Channel:
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
-    def node_terms(self, g, geo, params):
+    def node_terms(self, pair, params):
         """`spectral::NodeTerms::new`: (σrel²/σs², Q̄, F(θd), ρ_base + k_d/π
-        + ρ_ms) of this model at a pair, in f64."""
-        s = self.s
-        wi, wo = geo["wi"], geo["wo"]
-        at_i, at_o = ([mi.Float64(v) for v in self.direction(self.direction_cell(mi.Float(w.z)),
-                                                             range(8))] for w in (wi, wo))
+        + ρ_ms) of this model at a pair (:meth:`Model.pair`'s terms), f32."""
+        s, f = self.s, self.f
+        at_i = self.direction(self.direction_cell(pair["cos_i"]), range(8))
+        at_o = self.direction(self.direction_cell(pair["cos_o"]), range(8))
         r_i, r_o = at_i[5], at_o[5]
         ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
         if s["white"]:
-            q, fresnel_d = mi.Float64(1.0), mi.Float64(1.0)
+            q, fresnel_d = mi.Float(1.0), mi.Float(1.0)
         else:
-            q = (mi.Float64(dr.maximum(self.q_bar([mi.Float(v) for v in at_i[:5]],
-                                                   [mi.Float(v) for v in at_o[:5]],
-                                                   mi.Float(geo["along"]), mi.Float(geo["across"])),
-                                       0.0))
-                 if s["has_q"] else mi.Float64(0.0))
-            fresnel_d = mi.Float64(
-                self.direction(self.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
-        base = self.base_value(mi.Float(at_i[6]), mi.Float(at_o[6]), mi.Float(wi.z),
-                               mi.Float(wo.z), params)
-        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
-                    else mi.Float64(0.0))
-        plain = (mi.Float64(_finite_or_zero(base))
-                 + mi.Float64(_finite_or_zero(mi.Float(multiple))))
+            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], pair["along"], pair["across"]), 0.0)
+                 if s["has_q"] else mi.Float(0.0))
+            fresnel_d = self.direction(self.direction_cell(pair["cos_d"]), [6])[0]
+        base = self.base_value(at_i[6], at_o[6], pair["cos_i"], pair["cos_o"], params)
+        multiple = (f["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float(0.0))
+        plain = _finite_or_zero(base) + _finite_or_zero(multiple)
         return ratio_sq, q, fresnel_d, plain
 
 
@@ -965,7 +958,8 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
 
 def _fresnel(n, k, cos):
     """`fresnel::fresnel`: F of the index `n + ik` (f32) at `cos θ` (f32),
-    unpolarised (HP17 3-4), computed in f64 as the runtime; 0 for η² = 1."""
+    unpolarised (HP17 3-4): `(|a_s − c|²/|a_s + c|² + |a_p − c|²/|a_p + c|²)/2`
+    with one division, computed in f64 as the runtime; 0 for η² = 1."""
     n = dr.minimum(dr.abs(mi.Float64(n)), 1e9)
     k = dr.minimum(dr.abs(mi.Float64(k)), 1e9)
     n = dr.select(n * n + k * k < 1e-20, 1e-10, n)
@@ -980,11 +974,12 @@ def _fresnel(n, k, cos):
     c_im = dr.select(x >= 0.0, y / (2.0 * t_safe), dr.select(y < 0.0, -t, t))
 
     def ratio(a_re, a_im):
-        """|a − c|² / |a + c|²."""
-        return (((a_re - c_re) ** 2 + (a_im - c_im) ** 2)
-                / ((a_re + c_re) ** 2 + (a_im + c_im) ** 2))
+        """|a − c|² and |a + c|²."""
+        return ((a_re - c_re) ** 2 + (a_im - c_im) ** 2, (a_re + c_re) ** 2 + (a_im + c_im) ** 2)
 
-    f = 0.5 * (ratio(cos, 0.0) + ratio((n * n - k * k) * cos, e_im * cos))
+    num_s, den_s = ratio(cos, 0.0)
+    num_p, den_p = ratio((n * n - k * k) * cos, e_im * cos)
+    f = 0.5 * (num_s * den_p + num_p * den_s) / (den_s * den_p)
     f = dr.select((e_re == 0.0) & (e_im == 0.0), 0.0, f)
     return dr.clip(mi.Float(f), 0.0, 1.0)
 
@@ -1147,57 +1142,57 @@ class SpectralModel(Model):
         the surface lobes at λ itself with C from the lower model's bake
         (``Spectral::at_lambda``)."""
         valid, geo = self.geometry(wi, wo)
-        g = mi.Float64(self.masking(geo))
-        cos_i, cos_o, cos_d = geo["wi"].z, geo["wo"].z, geo["cos_d"]
+        pair = self.pair(geo)
+        cos_i, cos_d, g = pair["cos_i"], pair["cos_d"], pair["g"]
         s = self.channels[0].s
         out = []
         for lam in lams:
             lam = self.clamped(mi.Float(lam))
             k, f = self.cell(lam)
-            f = mi.Float64(f)
             # The two models around λ: their terms at the pair.
             lower, upper = self.stack.at(k), self.stack.at(k + 1)
-            ta = lower.node_terms(g, geo, self.params)
-            tb = upper.node_terms(g, geo, self.params)
+            ta = lower.node_terms(pair, self.params)
+            tb = upper.node_terms(pair, self.params)
 
             def lerp(j):
-                return (1.0 - f) * ta[j] + f * tb[j]
+                return dr.fma(f, tb[j] - ta[j], ta[j])
 
             # λ_k/λ: B, (4π/λ)² and the halo's 1/λ² from model k's.
-            ratio = lower.d["lambda"] / mi.Float64(lam)
-            x_scale = lower.d["x_scale"] * ratio * ratio
-            sigma_rel_sq = lower.d["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0 else 0.0
-            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_d * cos_d,
+            ratio = lower.f["lambda"] / lam
+            ratio_sq = ratio * ratio
+            x_scale = lower.f["x_scale"] * ratio_sq
+            sigma_rel_sq = (lower.f["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0
+                            else mi.Float(0.0))
+            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * pair["cos_d_sq"],
                                                                 sigma_rel_sq)
-            fl = mi.Float64(1.0) if self.white else mi.Float64(
-                _fresnel(*self.eta_at(lam), mi.Float(cos_d)))
-            specular = a_spec * fl * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+            fl = mi.Float(1.0) if self.white else _fresnel(*self.eta_at(lam), cos_d)
+            specular = a_spec * fl * pair["rho_geo"]
             if lower.diffraction:
                 if self.white:
-                    q = mi.Float64(1.0)
+                    q = mi.Float(1.0)
                 else:
+                    # F(θd, λ) ((1 − f) Q̄_k/F_k + f Q̄_k+1/F_k+1), one division.
                     fa, fb = ta[2], tb[2]
                     coloured = (fa > 0.0) & (fb > 0.0)
                     fa = dr.select(coloured, fa, 1.0)
                     fb = dr.select(coloured, fb, 1.0)
                     qa, qb = ta[1], tb[1]
-                    q = dr.select(coloured, fl * ((1.0 - f) * qa / fa + f * qb / fb),
-                                  (1.0 - f) * qa + f * qb)
+                    q = dr.select(coloured,
+                                  fl * ((1.0 - f) * qa * fb + f * qb * fa) / (fa * fb),
+                                  lerp(1))
                 if s["halo_incident"]:
                     one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_i * cos_i,
                                                                sigma_rel_sq)[1]
-                halo = lower.d["halo_scale"] * ratio * ratio * one_minus_a_over
+                halo = lower.f["halo_scale"] * ratio_sq * one_minus_a_over
                 # C from the lower model's bake only, at u = b cos θd/λ.
-                u = mi.Float(lower.d["big_b"] * ratio * cos_d)
-                c_value = lower.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]), u)
+                c_value = lower.conv(pair["sin_h"], pair["cos_h"], lower.f["big_b"] * ratio * cos_d)
                 diffraction = dr.select(
-                    g > 0.0, q * g * halo * mi.Float64(dr.maximum(c_value, 0.0)), 0.0
-                ) * mi.Float64(self.params["halo_factor"])
+                    g > 0.0, (q * g) * halo * dr.maximum(c_value, 0.0), 0.0
+                ) * self.params["halo_factor"]
             else:
-                diffraction = mi.Float64(0.0)
-            value = (mi.Float64(_finite_or_zero(mi.Float(specular)))
-                     + mi.Float64(_finite_or_zero(mi.Float(diffraction))) + lerp(3))
-            out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
+                diffraction = mi.Float(0.0)
+            value = _finite_or_zero(specular) + _finite_or_zero(diffraction) + lerp(3)
+            out.append(dr.select(valid, _finite_or_zero(dr.maximum(value, 0.0)), 0.0))
         return out
 
     def nearest(self, lam):
