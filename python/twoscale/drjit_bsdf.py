@@ -96,6 +96,20 @@ def _lerp_gather(table, width, column, i, frac):
     return dr.fma(frac, b - a, a)
 
 
+def _upload(values):
+    """A bake as a Dr.Jit array (``mi.Float``, or ``mi.Float64`` for f64)
+    over a copy of `values` aligned to 64 bytes. Dr.Jit maps a NumPy
+    array's memory rather than copying it, and gathers a packet
+    (:func:`_gather4`) as one load only from an aligned table: elsewhere it
+    falls back to four gathers."""
+    values = np.ascontiguousarray(values).ravel()
+    buf = np.empty(values.nbytes + 64, np.uint8)
+    start = -buf.ctypes.data % 64
+    out = buf[start:start + values.nbytes].view(values.dtype)
+    out[:] = values
+    return (mi.Float64 if values.dtype == np.float64 else mi.Float)(out)
+
+
 def _gather4(table, k):
     """Floats `4k … 4k + 3` of `table`, one packet gather."""
     return dr.gather(mi.Vector4f, table, k)
@@ -189,12 +203,16 @@ def _finite_or_zero(x):
 
 
 def _exp_and_one_minus_over(x, srs):
-    """`brdf::exp_and_one_minus_over`: `(e^−x s, (1 − e^−x s)/s)` in f64."""
+    """`brdf::exp_and_one_minus_over`: `(e^−t, (1 − e^−t)/s)`, `t = x s`, in
+    the type of `x` (f32 in the lobes). Below `t = 0.1` the second is
+    `x (1 − e^−t)/t` by its series to `t⁶` (truncation < 3e-12 relative),
+    where `1 − e^−t` would cancel (in f32, `2^−24/t` relative); above, the
+    division (≤ 6e-7 relative in f32)."""
     t = x * srs
     e = dr.exp(-t)
-    small = t < 1e-8
-    return (dr.select(small, 1.0 - t, e),
-            dr.select(small, x * (1.0 - 0.5 * t), (1.0 - e) / srs))
+    series = 1.0 - t * (1.0 / 2.0 - t * (1.0 / 6.0 - t * (1.0 / 24.0 - t * (
+        1.0 / 120.0 - t * (1.0 / 720.0 - t * (1.0 / 5040.0))))))
+    return e, dr.select(t < 0.1, x * series, (1.0 - e) / srs)
 
 
 class _Channel:
@@ -203,9 +221,7 @@ class _Channel:
     def __init__(self, bakes):
         self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
         self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
-        self.t = {k: (mi.Float64 if v.dtype == np.float64 else mi.Float)(
-                      np.ascontiguousarray(v).ravel())
-                  for k, v in bakes.items() if isinstance(v, np.ndarray)}
+        self.t = {k: _upload(v) for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
         self.r_max = float(bakes["visible_rows"][-1])
         self.halo_u_top = float(bakes["halo_u"][-1])
@@ -221,7 +237,7 @@ class _Channel:
         # flattened grid (so that a Catmull–Rom row is one packet gather).
         ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()
         ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
-        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        self.conv_quads = _upload(np.lib.stride_tricks.sliding_window_view(ln_c, 4))
         self.diffraction = s["sigma_s"] > 0.0 and s["b"] > 0.0
         if self.diffraction and s["conv_baked"] == 0.0:
             raise ValueError("twoscale: this material's C is not baked (source other than T3b)")
@@ -641,7 +657,8 @@ class _Channel:
 
     # -- the model -----------------------------------------------------
     def q_bar(self, fi, fo, along, across):
-        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`)."""
+        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`
+        at θi and θo and the pair's `along = −(wi·wo)ₜ`, `across`), f32."""
         s = self.s
         s_sq = along * along + across * across
         ok = s_sq > 0.0
@@ -653,7 +670,7 @@ class _Channel:
         uu_im = fi[1] * fo[2] + fi[2] * fo[1]
         ww_re = fi[3] * fo[3] - fi[4] * fo[4]
         ww_im = fi[3] * fo[4] + fi[4] * fo[3]
-        e_re, e_im = self.d["q_eta_sq_re"], self.d["q_eta_sq_im"]
+        e_re, e_im = self.f["q_eta_sq_re"], self.f["q_eta_sq_im"]
         pp_re = uu_re * along - (e_re * ww_re - e_im * ww_im) * s_sq
         pp_im = uu_im * along - (e_re * ww_im + e_im * ww_re) * s_sq
         norm_ui = fi[1] * fi[1] + fi[2] * fi[2]
@@ -661,19 +678,19 @@ class _Channel:
         q = (fi[0] * fo[0] * (along * along)
              + (fi[0] * norm_uo + norm_ui * fo[0]) * (across * across)
              + pp_re * pp_re + pp_im * pp_im)
-        return 0.5 * self.d["q_e_norm_sqr"] * q * inv_s_sq
+        return 0.5 * self.f["q_e_norm_sqr"] * q * inv_s_sq
 
     def base_value(self, f_i, f_o, cos_i, cos_o, params):
         """`TwoScale::base_value`: ρ_base + k_d/π (HP17 42-47), with the
         albedo α and k_d of `params` (differentiable: closed forms after
         the lookups). Plastic: `T α / (π n² (1 − α F_dr))`; subsurface:
         `T α/(4π (cos θi' + cos θo')) + T α/(2π) e^−r (1 + e^−(4/3) A r)`,
-        `r = √(3(1 − α))`, `T = (1 − F(θi))(1 − F(θo))`."""
-        s, d = self.s, self.d
-        lambertian = mi.Float64(params["lambertian"]) * (1.0 / math.pi)
+        `r = √(3(1 − α))`, `T = (1 − F(θi))(1 − F(θo))`; f32."""
+        s, d = self.s, self.f
+        lambertian = params["lambertian"] * (1.0 / math.pi)
         if s["white"] != 0.0 or s["base"] == 0.0:
             return lambertian
-        alpha = mi.Float64(params["albedo"])
+        alpha = params["albedo"]
         t = (1.0 - f_i) * (1.0 - f_o)
         if s["base"] == 1.0:
             plastic = alpha * d["base_inv_n_sq"] / (math.pi * (1.0 - alpha * d["f_dr_int"]))
@@ -689,78 +706,70 @@ class _Channel:
             refracted(cos_i) + refracted(cos_o), 1e-12)
         return single + t * multi + lambertian
 
-    def lobes(self, g, geo, params):
-        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair,
-        the diffraction lobe times `params["halo_factor"]` and the base
-        layer's with `params`' albedo and k_d (:meth:`base_value`)."""
-        s = self.s
-        wi, wo = geo["wi"], geo["wo"]
-        cos_i, cos_o, cos_d = wi.z, wo.z, geo["cos_d"]
-        cell_i = self.direction_cell(mi.Float(cos_i))
-        cell_o = self.direction_cell(mi.Float(cos_o))
-        at_i = [mi.Float64(v) for v in self.direction(cell_i, range(8))]
-        at_o = [mi.Float64(v) for v in self.direction(cell_o, range(8))]
-        # A_spec and (1 − A)/σrel² from one exponential, in f64 (1 − e^−t at small t).
-        x = self.d["x_scale"] * cos_d * cos_d
+    def lobes(self, pair, params):
+        """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair
+        (:meth:`Model.pair`'s terms), in f32, the diffraction lobe times
+        `params["halo_factor"]` and the base layer's with `params`' albedo and
+        k_d (:meth:`base_value`). ρ_spec = A_spec F(θd) · `g D/(4 cos θi cos θo)`
+        (the pair's), ρ_CTD = Q̄ G halo (1 − A)/σrel² C (HP17 22, 37)."""
+        s, f = self.s, self.f
+        cos_i, cos_o, cos_d = pair["cos_i"], pair["cos_o"], pair["cos_d"]
+        at_i = self.direction(self.direction_cell(cos_i), range(8))
+        at_o = self.direction(self.direction_cell(cos_o), range(8))
+        # A_spec and (1 − A)/σrel² from one exponential.
         if s["sigma_s"] > 0.0:
             r_i, r_o = at_i[5], at_o[5]
             ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
-            sigma_rel_sq = self.d["sigma_s_sq"] * ratio_sq
+            sigma_rel_sq = f["sigma_s_sq"] * ratio_sq
         else:
-            sigma_rel_sq = mi.Float64(0.0)
-
-        a_spec, one_minus_a_over = _exp_and_one_minus_over(x, sigma_rel_sq)
-        fresnel_d = (mi.Float64(1.0) if s["white"] else
-                     mi.Float64(self.direction(self.direction_cell(mi.Float(cos_d)), [6])[0]))
-        rho_ct = fresnel_d * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
-        specular = a_spec * rho_ct
+            sigma_rel_sq = mi.Float(0.0)
+        a_spec, one_minus_a_over = _exp_and_one_minus_over(f["x_scale"] * pair["cos_d_sq"],
+                                                           sigma_rel_sq)
+        fresnel_d = (mi.Float(1.0) if s["white"] else
+                     self.direction(self.direction_cell(cos_d), [6])[0])
+        specular = a_spec * fresnel_d * pair["rho_geo"]
 
         if self.diffraction:
             if s["white"]:
-                q = mi.Float64(1.0)
+                q = mi.Float(1.0)
             elif s["has_q"]:
-                q = dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
+                q = dr.maximum(self.q_bar(at_i[:5], at_o[:5], pair["along"], pair["across"]), 0.0)
             else:
-                q = mi.Float64(0.0)
+                q = mi.Float(0.0)
             if s["halo_incident"]:
-                one_minus_a_over = _exp_and_one_minus_over(self.d["x_scale"] * cos_i * cos_i,
+                one_minus_a_over = _exp_and_one_minus_over(f["x_scale"] * cos_i * cos_i,
                                                            sigma_rel_sq)[1]
-            halo = self.d["halo_scale"] * one_minus_a_over
-            c_value = self.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]),
-                                mi.Float(self.d["big_b"] * cos_d))
-            c_value = mi.Float64(dr.maximum(c_value, 0.0))
-            diffraction = dr.select(g > 0.0, q * g * halo * c_value, 0.0) * mi.Float64(
-                params["halo_factor"])
+            c_value = dr.maximum(self.conv(pair["sin_h"], pair["cos_h"], f["big_b"] * cos_d), 0.0)
+            g = pair["g"]
+            diffraction = dr.select(g > 0.0, (q * g) * (f["halo_scale"] * one_minus_a_over)
+                                    * c_value, 0.0) * params["halo_factor"]
         else:
-            diffraction = mi.Float64(0.0)
+            diffraction = mi.Float(0.0)
         base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
-                    else mi.Float64(0.0))
+        multiple = (f["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float(0.0))
         return (_finite_or_zero(specular), _finite_or_zero(diffraction), _finite_or_zero(base),
                 _finite_or_zero(multiple))
 
-    def node_terms(self, g, geo, params):
+    def node_terms(self, pair, params):
         """`spectral::NodeTerms::new`: (σrel²/σs², Q̄, F(θd), ρ_base + k_d/π
-        + ρ_ms) of this model at a pair, in f64."""
-        s = self.s
-        wi, wo = geo["wi"], geo["wo"]
-        at_i, at_o = ([mi.Float64(v) for v in self.direction(self.direction_cell(mi.Float(w.z)),
-                                                             range(8))] for w in (wi, wo))
+        + ρ_ms) of this model at a pair (:meth:`Model.pair`'s terms), f32."""
+        s, f = self.s, self.f
+        at_i = self.direction(self.direction_cell(pair["cos_i"]), range(8))
+        at_o = self.direction(self.direction_cell(pair["cos_o"]), range(8))
         r_i, r_o = at_i[5], at_o[5]
         ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
         if s["white"]:
-            q, fresnel_d = mi.Float64(1.0), mi.Float64(1.0)
+            q, fresnel_d = mi.Float(1.0), mi.Float(1.0)
         else:
-            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], geo["along"], geo["across"]), 0.0)
-                 if s["has_q"] else mi.Float64(0.0))
-            fresnel_d = mi.Float64(
-                self.direction(self.direction_cell(mi.Float(geo["cos_d"])), [6])[0])
-        base = self.base_value(at_i[6], at_o[6], wi.z, wo.z, params)
-        multiple = (self.d["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
-                    else mi.Float64(0.0))
-        plain = (mi.Float64(_finite_or_zero(mi.Float(base)))
-                 + mi.Float64(_finite_or_zero(mi.Float(multiple))))
+            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], pair["along"], pair["across"]), 0.0)
+                 if s["has_q"] else mi.Float(0.0))
+            fresnel_d = self.direction(self.direction_cell(pair["cos_d"]), [6])[0]
+        base = self.base_value(at_i[6], at_o[6], pair["cos_i"], pair["cos_o"], params)
+        multiple = (f["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+                    else mi.Float(0.0))
+        plain = _finite_or_zero(base) + _finite_or_zero(multiple)
         return ratio_sq, q, fresnel_d, plain
 
 
@@ -827,33 +836,47 @@ class Model:
         }
 
     def masking(self, geo):
-        """G at a pair (`TwoScale::with_masking`), f64."""
+        """G at a pair (`TwoScale::with_masking`), f32: `G1(i) G1(o)`, or
+        height-correlated `G1(i) G1(o)/(G1(i) + G1(o) − G1(i) G1(o))` (the
+        runtime's `1/(1/G1(i) + 1/G1(o) − 1)` with one division; 0 where a
+        G1 is 0)."""
         wi, wo = geo["wi"], geo["wo"]
         ch = self.channels[0]
 
         def tangential(w):
             return dr.sqrt(mi.Float(w.x * w.x + w.y * w.y))
 
-        g1_i = mi.Float64(ch.g1(tangential(wi), mi.Float(wi.z)))
-        g1_o = mi.Float64(ch.g1(tangential(wo), mi.Float(wo.z)))
+        g1_i = ch.g1(tangential(wi), mi.Float(wi.z))
+        g1_o = ch.g1(tangential(wo), mi.Float(wo.z))
+        g = g1_i * g1_o
         if self.height_correlated:
-            g = 1.0 / (1.0 / g1_i + 1.0 / g1_o - 1.0)
-        else:
-            g = g1_i * g1_o
+            den = g1_i + g1_o - g
+            g = dr.select(den > 0.0, g / den, 0.0)
         return g
+
+    def pair(self, geo):
+        """The terms of a pair every channel's (model's) lobes share, f32:
+        the cosines, G, `rho_geo = G D/(4 cos θi cos θo)` and the
+        half-vector's and Q̄'s arguments."""
+        cos_i, cos_o, cos_d = mi.Float(geo["wi"].z), mi.Float(geo["wo"].z), mi.Float(geo["cos_d"])
+        g = self.masking(geo)
+        return {
+            "cos_i": cos_i, "cos_o": cos_o, "cos_d": cos_d, "cos_d_sq": cos_d * cos_d,
+            "g": g, "rho_geo": g * geo["d"] / (4.0 * cos_i * cos_o),
+            "sin_h": mi.Float(geo["sin_h"]), "cos_h": mi.Float(geo["cos_h"]),
+            "along": mi.Float(geo["along"]), "across": mi.Float(geo["across"]),
+        }
 
     def eval(self, wi, wo):
         """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
         light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
         below the horizon."""
         valid, geo = self.geometry(wi, wo)
-        g = self.masking(geo)
+        pair = self.pair(geo)
         values = []
         for channel in self.channels:
-            spec, diff, base, multiple = channel.lobes(g, geo, self.params)
-            values.append(mi.Float(_finite_or_zero(
-                mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff)) + mi.Float64(mi.Float(base))
-                + mi.Float64(mi.Float(multiple)))))
+            spec, diff, base, multiple = channel.lobes(pair, self.params)
+            values.append(_finite_or_zero((spec + diff) + (base + multiple)))
         return dr.select(valid, mi.Color3f(*values), 0.0)
 
     def pdf(self, wi, wo):
@@ -942,7 +965,8 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
 
 def _fresnel(n, k, cos):
     """`fresnel::fresnel`: F of the index `n + ik` (f32) at `cos θ` (f32),
-    unpolarised (HP17 3-4), computed in f64 as the runtime; 0 for η² = 1."""
+    unpolarised (HP17 3-4): `(|a_s − c|²/|a_s + c|² + |a_p − c|²/|a_p + c|²)/2`
+    with one division, computed in f64 as the runtime; 0 for η² = 1."""
     n = dr.minimum(dr.abs(mi.Float64(n)), 1e9)
     k = dr.minimum(dr.abs(mi.Float64(k)), 1e9)
     n = dr.select(n * n + k * k < 1e-20, 1e-10, n)
@@ -957,11 +981,12 @@ def _fresnel(n, k, cos):
     c_im = dr.select(x >= 0.0, y / (2.0 * t_safe), dr.select(y < 0.0, -t, t))
 
     def ratio(a_re, a_im):
-        """|a − c|² / |a + c|²."""
-        return (((a_re - c_re) ** 2 + (a_im - c_im) ** 2)
-                / ((a_re + c_re) ** 2 + (a_im + c_im) ** 2))
+        """|a − c|² and |a + c|²."""
+        return ((a_re - c_re) ** 2 + (a_im - c_im) ** 2, (a_re + c_re) ** 2 + (a_im + c_im) ** 2)
 
-    f = 0.5 * (ratio(cos, 0.0) + ratio((n * n - k * k) * cos, e_im * cos))
+    num_s, den_s = ratio(cos, 0.0)
+    num_p, den_p = ratio((n * n - k * k) * cos, e_im * cos)
+    f = 0.5 * (num_s * den_p + num_p * den_s) / (den_s * den_p)
     f = dr.select((e_re == 0.0) & (e_im == 0.0), 0.0, f)
     return dr.clip(mi.Float(f), 0.0, 1.0)
 
@@ -1010,13 +1035,12 @@ class _NodeChannel(_Channel):
         stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
         arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
         for name, v in arrays.items():
-            self.t[name] = (mi.Float64 if v.dtype == np.float64 else mi.Float)(
-                np.ascontiguousarray(v).ravel())
+            self.t[name] = _upload(v)
         # As `_Channel`'s packets, over the stacked grids (a packet never
         # crosses a row, so never a model).
         ln_c = np.ascontiguousarray(arrays["conv_ln_c"], dtype=np.float32).ravel()
         ln_c = np.concatenate([ln_c, np.zeros(3, np.float32)])
-        self.conv_quads = mi.Float(np.lib.stride_tricks.sliding_window_view(ln_c, 4).ravel())
+        self.conv_quads = _upload(np.lib.stride_tricks.sliding_window_view(ln_c, 4))
         scalars = {k: np.asarray(v, np.float64) for k, v in stacked.items() if k not in arrays}
         if "eta_re" in scalars or "f_dr_int" in scalars:
             # The base layer's constants per model (as `_Channel`'s).
@@ -1085,7 +1109,7 @@ class SpectralModel(Model):
         self.stack = _NodeChannel(models, per_node, len(spectral["wavelengths"]))
         self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
         self.node_table = mi.Float(spectral["wavelengths"])
-        self.eta = mi.Float(np.ascontiguousarray(spectral["eta"]).ravel())
+        self.eta = _upload(np.asarray(spectral["eta"], np.float32))
         self.eta_nodes = spectral["eta"].shape[0]
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
@@ -1125,57 +1149,57 @@ class SpectralModel(Model):
         the surface lobes at λ itself with C from the lower model's bake
         (``Spectral::at_lambda``)."""
         valid, geo = self.geometry(wi, wo)
-        g = self.masking(geo)
-        cos_i, cos_o, cos_d = geo["wi"].z, geo["wo"].z, geo["cos_d"]
+        pair = self.pair(geo)
+        cos_i, cos_d, g = pair["cos_i"], pair["cos_d"], pair["g"]
         s = self.channels[0].s
         out = []
         for lam in lams:
             lam = self.clamped(mi.Float(lam))
             k, f = self.cell(lam)
-            f = mi.Float64(f)
             # The two models around λ: their terms at the pair.
             lower, upper = self.stack.at(k), self.stack.at(k + 1)
-            ta = lower.node_terms(g, geo, self.params)
-            tb = upper.node_terms(g, geo, self.params)
+            ta = lower.node_terms(pair, self.params)
+            tb = upper.node_terms(pair, self.params)
 
             def lerp(j):
-                return (1.0 - f) * ta[j] + f * tb[j]
+                return dr.fma(f, tb[j] - ta[j], ta[j])
 
             # λ_k/λ: B, (4π/λ)² and the halo's 1/λ² from model k's.
-            ratio = lower.d["lambda"] / mi.Float64(lam)
-            x_scale = lower.d["x_scale"] * ratio * ratio
-            sigma_rel_sq = lower.d["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0 else 0.0
-            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_d * cos_d,
+            ratio = lower.f["lambda"] / lam
+            ratio_sq = ratio * ratio
+            x_scale = lower.f["x_scale"] * ratio_sq
+            sigma_rel_sq = (lower.f["sigma_s_sq"] * lerp(0) if s["sigma_s"] > 0.0
+                            else mi.Float(0.0))
+            a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * pair["cos_d_sq"],
                                                                 sigma_rel_sq)
-            fl = mi.Float64(1.0) if self.white else mi.Float64(
-                _fresnel(*self.eta_at(lam), mi.Float(cos_d)))
-            specular = a_spec * fl * g / (4.0 * cos_i * cos_o) * mi.Float64(geo["d"])
+            fl = mi.Float(1.0) if self.white else _fresnel(*self.eta_at(lam), cos_d)
+            specular = a_spec * fl * pair["rho_geo"]
             if lower.diffraction:
                 if self.white:
-                    q = mi.Float64(1.0)
+                    q = mi.Float(1.0)
                 else:
+                    # F(θd, λ) ((1 − f) Q̄_k/F_k + f Q̄_k+1/F_k+1), one division.
                     fa, fb = ta[2], tb[2]
                     coloured = (fa > 0.0) & (fb > 0.0)
                     fa = dr.select(coloured, fa, 1.0)
                     fb = dr.select(coloured, fb, 1.0)
                     qa, qb = ta[1], tb[1]
-                    q = dr.select(coloured, fl * ((1.0 - f) * qa / fa + f * qb / fb),
-                                  (1.0 - f) * qa + f * qb)
+                    q = dr.select(coloured,
+                                  fl * ((1.0 - f) * qa * fb + f * qb * fa) / (fa * fb),
+                                  lerp(1))
                 if s["halo_incident"]:
                     one_minus_a_over = _exp_and_one_minus_over(x_scale * cos_i * cos_i,
                                                                sigma_rel_sq)[1]
-                halo = lower.d["halo_scale"] * ratio * ratio * one_minus_a_over
+                halo = lower.f["halo_scale"] * ratio_sq * one_minus_a_over
                 # C from the lower model's bake only, at u = b cos θd/λ.
-                u = mi.Float(lower.d["big_b"] * ratio * cos_d)
-                c_value = lower.conv(mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]), u)
+                c_value = lower.conv(pair["sin_h"], pair["cos_h"], lower.f["big_b"] * ratio * cos_d)
                 diffraction = dr.select(
-                    g > 0.0, q * g * halo * mi.Float64(dr.maximum(c_value, 0.0)), 0.0
-                ) * mi.Float64(self.params["halo_factor"])
+                    g > 0.0, (q * g) * halo * dr.maximum(c_value, 0.0), 0.0
+                ) * self.params["halo_factor"]
             else:
-                diffraction = mi.Float64(0.0)
-            value = (mi.Float64(_finite_or_zero(mi.Float(specular)))
-                     + mi.Float64(_finite_or_zero(mi.Float(diffraction))) + lerp(3))
-            out.append(dr.select(valid, _finite_or_zero(mi.Float(dr.maximum(value, 0.0))), 0.0))
+                diffraction = mi.Float(0.0)
+            value = _finite_or_zero(specular) + _finite_or_zero(diffraction) + lerp(3)
+            out.append(dr.select(valid, _finite_or_zero(dr.maximum(value, 0.0)), 0.0))
         return out
 
     def nearest(self, lam):
@@ -1236,42 +1260,42 @@ class IntegratedModel(Model):
         shared = dict(zip(sampler, self.channels))
         self.nodes = [shared[k] if k in shared else _Channel(b) for k, b in enumerate(models)]
         self.colour_nodes = integrated["surface"].shape[0]
-        self.surface = mi.Float(np.ascontiguousarray(integrated["surface"], np.float32).ravel())
+        # R_kc a row per node of `√cos θd`, padded to whole packets of four.
+        surface = np.asarray(integrated["surface"], np.float32).reshape(self.colour_nodes, -1)
+        self.surface_packets = -(-surface.shape[1] // 4)
+        self.surface = _upload(np.pad(surface, ((0, 0), (0, 4 * self.surface_packets
+                                                         - surface.shape[1]))))
         self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
 
     def surface_weights(self, cos_d):
         """``ColourBake::surface_at``: `R_kc` at `cos θd`, linear in
         `√cos θd` between nodes, in f32 (a list over k of three values)."""
         n = self.colour_nodes
-        t = dr.sqrt(dr.clip(mi.Float64(cos_d), 0.0, 1.0)) * (n - 1)
+        t = dr.sqrt(dr.clip(cos_d, 0.0, 1.0)) * (n - 1)
         m = dr.minimum(mi.UInt32(dr.floor(t)), n - 2)
-        f = mi.Float(t - mi.Float64(m))
-        width = 3 * len(self.nodes)
-        out = []
-        for k in range(len(self.nodes)):
-            row = []
-            for c in range(3):
-                a = dr.gather(mi.Float, self.surface, m * width + 3 * k + c)
-                b = dr.gather(mi.Float, self.surface, (m + 1) * width + 3 * k + c)
-                row.append(a + f * (b - a))
-            out.append(row)
-        return out
+        f = t - mi.Float(m)
+        # The two rows, each as packets of four floats.
+        packets = self.surface_packets
+        a = [v for j in range(packets) for v in _gather4(self.surface, m * packets + j)]
+        b = [v for j in range(packets) for v in _gather4(self.surface, (m + 1) * packets + j)]
+        return [[dr.fma(f, b[3 * k + c] - a[3 * k + c], a[3 * k + c]) for c in range(3)]
+                for k in range(len(self.nodes))]
 
     def eval(self, wi, wo):
         """ρ(wi, wo) in linear sRGB (sr⁻¹) as an ``mi.Color3f``
         (``IntegratedRgb::eval``; arguments as :meth:`Model.eval`'s)."""
         valid, geo = self.geometry(wi, wo)
-        g = self.masking(geo)
-        r = self.surface_weights(geo["cos_d"])
-        out = [mi.Float64(0.0)] * 3
+        pair = self.pair(geo)
+        r = self.surface_weights(pair["cos_d"])
+        out = [mi.Float(0.0)] * 3
         for k, node in enumerate(self.nodes):
-            spec, diff, base, multiple = node.lobes(g, geo, self.params)
-            surface = mi.Float64(mi.Float(spec)) + mi.Float64(mi.Float(diff))
+            spec, diff, base, multiple = node.lobes(pair, self.params)
+            surface = spec + diff
             # The compensation lobe's colour is F_avg's, per node: plain weights.
-            rest = mi.Float64(mi.Float(base)) + mi.Float64(mi.Float(multiple))
-            out = [out[c] + surface * mi.Float64(r[k][c]) + rest * mi.Float64(self.plain[k][c])
+            rest = base + multiple
+            out = [dr.fma(surface, r[k][c], dr.fma(rest, self.plain[k][c], out[c]))
                    for c in range(3)]
-        values = [mi.Float(_finite_or_zero(dr.maximum(x, 0.0))) for x in out]
+        values = [_finite_or_zero(dr.maximum(x, 0.0)) for x in out]
         return dr.select(valid, mi.Color3f(*values), 0.0)
 
 
