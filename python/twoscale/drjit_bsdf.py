@@ -124,7 +124,7 @@ def _catmull_rom_weights(t):
 _NEWTON_TOL = 1e-9
 
 
-def _newton_in_bracket(residual, slope, t, hi, tol):
+def _newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
@@ -136,9 +136,18 @@ def _newton_in_bracket(residual, slope, t, hi, tol):
         lo = dr.select(f < 0.0, t, lo)
         hi = dr.select(f < 0.0, hi, t)
         d = slope(t)
-        nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
-        nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
-        done = dr.abs(nxt - t) <= tol
+        newton = t - f / d
+        inside = (d > 0.0) & (newton >= lo) & (newton <= hi)
+        # A converged step is taken even where it rounds onto the bracket's
+        # end (f = 0 puts it there): bisecting would leave the root.
+        step_size = dr.abs(newton - t)
+        converged = inside & (step_size <= tol)
+        if curvature is not None:
+            # Newton's error after the step, |f''| δ²/(2 f'), within `tol`.
+            converged |= inside & (step_size * step_size * dr.abs(curvature(t)) <= 2.0 * tol * d)
+        nxt = dr.select(inside & (newton > lo) & (newton < hi), newton, 0.5 * (lo + hi))
+        nxt = dr.select(converged, newton, nxt)
+        done = converged | (dr.abs(nxt - t) <= tol)
         return step + 1, done, nxt, lo, hi
 
     _, _, t, _, _ = dr.while_loop(
@@ -621,7 +630,8 @@ class _Channel:
         t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
         tol = _NEWTON_TOL * (dr.abs(x0) + tau_max)
         return _newton_in_bracket(lambda t: cell_integral(x0, p0, k, t) - rest, density,
-                                  t, mi.Float64(tau_max), tol)
+                                  t, mi.Float64(tau_max), tol,
+                                  lambda t: k * (a - sn * t) - sn * (p0 + k * t))
 
     def diffraction_sample(self, wi, u0, u1):
         """The diffraction lobe's direction where C is baked
