@@ -562,13 +562,19 @@ class _Channel:
         j = _last_at_most(inc.j_end + 1, lambda j: self._visible_phi(c, sn, j) <= target,
                           (x_nodes - 2).bit_length())
         x0, p0 = self._visible_node("visible_x", j), self._visible_node("visible_px", j)
-        h = self._visible_node("visible_x", j + 1) - x0
+        x1 = self._visible_node("visible_x", j + 1)
+        h = x1 - x0
         k = (self._visible_node("visible_px", j + 1) - p0) / h
         tau_max = dr.select(j == inc.j_end, inc.tau_end, h)
         rest = target - self._visible_phi(c, sn, j)
         x = x0 + self._solve_cell(c, sn, x0, p0, k, tau_max, rest)
-        # The conditional at |x̃|.
-        i, lam, _, _ = self._visible_locate(dr.abs(x), "visible_rows", self.f["visible_row_scale"])
+        # The conditional at |x̃|: its row is the cell j itself, mirrored
+        # where x̃ < 0 (`VisibleSlopeBake::row` of |x̃|, but without locating).
+        rows_n = self.shapes["visible_rows"][0]
+        negative = j < rows_n - 1
+        i = dr.select(negative, rows_n - 2 - j, j - (rows_n - 1))
+        a0, a1 = dr.select(negative, -x1, x0), dr.select(negative, -x0, x1)
+        lam = dr.clip((dr.abs(x) - a0) / (a1 - a0), 0.0, 1.0)
 
         def cum(col):
             a0 = self._visible_node("visible_cum", i * cols_n + col)
