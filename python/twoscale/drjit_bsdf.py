@@ -138,7 +138,7 @@ def _catmull_rom_weights(t):
 _NEWTON_TOL = 1e-9
 
 
-def _newton_in_bracket(residual, slope, t, hi, tol):
+def _newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
@@ -150,9 +150,18 @@ def _newton_in_bracket(residual, slope, t, hi, tol):
         lo = dr.select(f < 0.0, t, lo)
         hi = dr.select(f < 0.0, hi, t)
         d = slope(t)
-        nxt = dr.select(d > 0.0, t - f / d, 0.5 * (lo + hi))
-        nxt = dr.select((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
-        done = dr.abs(nxt - t) <= tol
+        newton = t - f / d
+        inside = (d > 0.0) & (newton >= lo) & (newton <= hi)
+        # A converged step is taken even where it rounds onto the bracket's
+        # end (f = 0 puts it there): bisecting would leave the root.
+        step_size = dr.abs(newton - t)
+        converged = inside & (step_size <= tol)
+        if curvature is not None:
+            # Newton's error after the step, |f''| δ²/(2 f'), within `tol`.
+            converged |= inside & (step_size * step_size * dr.abs(curvature(t)) <= 2.0 * tol * d)
+        nxt = dr.select(inside & (newton > lo) & (newton < hi), newton, 0.5 * (lo + hi))
+        nxt = dr.select(converged, newton, nxt)
+        done = converged | (dr.abs(nxt - t) <= tol)
         return step + 1, done, nxt, lo, hi
 
     _, _, t, _, _ = dr.while_loop(
@@ -226,6 +235,15 @@ class _Channel:
         self.r_max = float(bakes["visible_rows"][-1])
         self.halo_u_top = float(bakes["halo_u"][-1])
         s["visible_r_max"] = self.r_max
+        # The marginal's x̃ nodes −r_max … 0 … r_max and P2_tab there
+        # (`VisibleSlopeBake::x_node`, `p_node`), and the last node's mass
+        # and moment (`Φ` of the whole table), as constants.
+        rows, p2 = bakes["visible_rows"], bakes["visible_p2"]
+        self.t["visible_x"] = mi.Float64(np.concatenate([-rows[:0:-1], rows]))
+        self.t["visible_px"] = mi.Float64(np.concatenate([p2[:0:-1], p2]))
+        s["visible_mass_end"] = float(bakes["visible_mass"][-1])
+        s["visible_moment_end"] = float(bakes["visible_moment"][-1])
+        s["visible_h_end"] = float(rows[-1] - rows[-2])
         # Constants of the base layer (`TwoScale::base_value`; the albedo
         # and k_d are the plugin's parameters, `Model.params`).
         n = max(abs(s["eta_re"]), 1e-3)
@@ -453,14 +471,48 @@ class _Channel:
             lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
             psi, mi.Float64(big_h), _NEWTON_TOL)
 
-    def visible_pdf(self, wi, wo):
-        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
-        s, t = self.s, self.t
-        beta = self.d["visible_beta"]
-        rows_n, cols_n = self.shapes["visible_dens"]
-        x_nodes = self.shapes["visible_mass"][0]
-        sum_ = wi + wo
-        # The stretched incidence.
+    # -- the visible-slope sampler (`VisibleSlopeBake`) ------------------
+    def _visible_node(self, name, k):
+        return dr.gather(mi.Float64, self.t[name], k)
+
+    def _visible_locate(self, a, name, scale):
+        """`visible::locate`: the cell `[a0, a1]` of the nodes `name` that
+        holds `a ≥ 0` (from its axis position, corrected by one node where
+        the f32 axis and the f64 nodes disagree), its index and the fraction
+        in it. The four nodes around the axis position are gathered at once,
+        so the correction costs no second dependent gather."""
+        n = self.shapes[name][0]
+        position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
+        k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+        before = self._visible_node(name, dr.maximum(k, 1) - 1)
+        at0, at1 = self._visible_node(name, k), self._visible_node(name, k + 1)
+        after = self._visible_node(name, dr.minimum(k + 2, n - 1))
+        lower = (k > 0) & (a < at0)
+        upper = (k + 2 < n) & (a >= at1)
+        k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+        a0 = dr.select(lower, before, dr.select(upper, at1, at0))
+        a1 = dr.select(lower, at0, dr.select(upper, after, at1))
+        return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0), a0, a1
+
+    @staticmethod
+    def _visible_cell_integral(c, sn, x0, p0, k, tau):
+        """`VisibleSlopeBake::cell_integral`: `∫₀^τ (c − s x̃)(P0 + k t) dt`
+        over a cell from its left node `x0`."""
+        a = c - sn * x0
+        return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
+
+    def _visible_phi(self, c, sn, j):
+        """`Φ` at x̃ node `j`: `c ∫P2_tab − s ∫x̃ P2_tab` from `−r_max`."""
+        return (c * self._visible_node("visible_mass", j)
+                - sn * self._visible_node("visible_moment", j))
+
+    def _visible_incidence(self, wi):
+        """`VisibleSlopeBake::incidence` of the unit `wi` (f64, `wi.z > 0`):
+        the stretched incidence `c, s, |i'|`, its unit tangential direction,
+        the last cell `j_end` the visible marginal reaches, the visible
+        length `τ_end` of it and `N_tab`."""
+        beta, r_max = self.d["visible_beta"], self.d["visible_r_max"]
+        rows_n = self.shapes["visible_rows"][0]
         tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
         bt = beta * tangential
         length = dr.sqrt(bt * bt + wi.z * wi.z)
@@ -468,183 +520,133 @@ class _Channel:
         t0 = dr.select(has_t, wi.x / tangential, 1.0)
         t1 = dr.select(has_t, wi.y / tangential, 0.0)
         c, sn = wi.z / length, bt / length
+        # `VisibleSlopeBake::extent`: the cell of μ = c/s where it is inside.
+        reaches = sn * r_max > c
+        mu = c / sn
+        i_mu, _, x0, x1 = self._visible_locate(dr.select(reaches, mu, 0.0), "visible_rows",
+                                               self.f["visible_row_scale"])
+        p0 = self._visible_node("visible_p2", i_mu)
+        k = (self._visible_node("visible_p2", i_mu + 1) - p0) / (x1 - x0)
+        j_mu = rows_n - 1 + i_mu
+        phi_end = c * self.d["visible_mass_end"] - sn * self.d["visible_moment_end"]
+        j_end = dr.select(reaches, j_mu, mi.UInt32(2 * rows_n - 3))
+        tau_end = dr.select(reaches, mu - x0, self.d["visible_h_end"])
+        norm = dr.select(reaches, self._visible_phi(c, sn, j_mu)
+                         + self._visible_cell_integral(c, sn, x0, p0, k, mu - x0), phi_end)
+        return types.SimpleNamespace(c=c, sn=sn, length=length, t0=t0, t1=t1, j_end=j_end,
+                                     tau_end=tau_end, norm=norm)
+
+    def visible_pdf(self, wi, wo):
+        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
+        beta, r_max = self.d["visible_beta"], self.d["visible_r_max"]
+        cols_n = self.shapes["visible_cols"][0]
+        inc = self._visible_incidence(wi)
+        c, sn, t0, t1 = inc.c, inc.sn, inc.t0, inc.t1
+        sum_ = wi + wo
+        # Stretched slopes of h (|i + o| cancels).
         inv_bz = 1.0 / (beta * sum_.z)
         sx, sy = -sum_.x * inv_bz, -sum_.y * inv_bz
         x = sx * t0 + sy * t1
         y = -sx * t1 + sy * t0
-        r_max = self.d["visible_r_max"]
         valid = (sum_.z > 0.0) & (c - sn * x > 0.0) & (dr.abs(x) <= r_max) & (dr.abs(y) <= r_max)
-
-        def node(name, k):
-            return dr.gather(mi.Float64, t[name], k)
-
-        def locate(a, names, n, scale):
-            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
-            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
-            lower = (k > 0) & (a < node(names, k))
-            upper = (k + 2 < n) & (a >= node(names, k + 1))
-            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
-            a0, a1 = node(names, k), node(names, k + 1)
-            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
-
-        # The extent: N_tab.
-        def phi_node(j):
-            return c * node("visible_mass", j) - sn * node("visible_moment", j)
-
-        mu = c / sn
-        i_mu, _ = locate(dr.select(sn * r_max > c, mu, 0.0), "visible_rows", rows_n,
-                         self.f["visible_row_scale"])
-        x0 = node("visible_rows", i_mu)
-        p0 = node("visible_p2", i_mu)
-        h = node("visible_rows", i_mu + 1) - x0
-        slope = (node("visible_p2", i_mu + 1) - p0) / h
-        tau = mu - x0
-        a = c - sn * x0
-        partial = tau * (a * p0 + tau * (0.5 * (a * slope - sn * p0) - tau * (sn * slope / 3.0)))
-        norm = dr.select(sn * r_max > c, phi_node(rows_n - 1 + i_mu) + partial,
-                         phi_node(mi.UInt32(x_nodes - 1)))
         # The tabulated density at (x̃, ỹ).
-        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
+        i, lam, _, _ = self._visible_locate(dr.abs(x), "visible_rows", self.f["visible_row_scale"])
 
-        def blend(a0, a1):
-            return a0 + lam * (a1 - a0)
+        def blend(name, k0, k1):
+            a0 = self._visible_node(name, k0)
+            return a0 + lam * (self._visible_node(name, k1) - a0)
 
-        p2 = blend(node("visible_p2", i), node("visible_p2", i + 1))
-        ay = dr.abs(y)
-        kk, tt = locate(ay, "visible_cols", cols_n, self.f["visible_col_scale"])
+        def dens(k):
+            d0 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + k))
+            d1 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + k))
+            return d0 + lam * (d1 - d0)
 
-        def dens(row, col):
-            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
-
-        g0 = blend(dens(i, kk), dens(i + 1, kk))
-        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
-        total = blend(node("visible_cum", i * cols_n + cols_n - 1),
-                      node("visible_cum", (i + 1) * cols_n + cols_n - 1))
+        p2 = blend("visible_p2", i, i + 1)
+        kk, tt, _, _ = self._visible_locate(dr.abs(y), "visible_cols", self.f["visible_col_scale"])
+        g0, g1 = dens(kk), dens(kk + 1)
+        total = blend("visible_cum", i * cols_n + cols_n - 1, (i + 1) * cols_n + cols_n - 1)
         g = (g0 + tt * (g1 - g0)) / total
+        # 1/cos⁴θh = (1 + |slope|²)² with the unstretched slope β (sx, sy).
         slope_sq = beta * beta * (sx * sx + sy * sy)
         sec4 = (1.0 + slope_sq) * (1.0 + slope_sq)
-        value = p2 * g * sec4 / (8.0 * norm * beta * beta * length)
+        value = p2 * g * sec4 / (8.0 * inc.norm * beta * beta * inc.length)
         return dr.select(valid, value, 0.0)
 
     def visible_sample(self, wi, u0, u1):
         """`VisibleSlopeBake::sample`: a visible EPD normal for the unit `wi`
         (f64) from two uniforms, and whether the tables gave mass."""
-        s, t = self.s, self.t
         beta = self.d["visible_beta"]
-        rows_n, cols_n = self.shapes["visible_dens"]
+        cols_n = self.shapes["visible_cols"][0]
         x_nodes = self.shapes["visible_mass"][0]
-        r_max = self.d["visible_r_max"]
+        inc = self._visible_incidence(wi)
+        c, sn = inc.c, inc.sn
+        target = u0 * inc.norm
+        # The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0).
+        j = _last_at_most(inc.j_end + 1, lambda j: self._visible_phi(c, sn, j) <= target,
+                          (x_nodes - 2).bit_length())
+        x0, p0 = self._visible_node("visible_x", j), self._visible_node("visible_px", j)
+        x1 = self._visible_node("visible_x", j + 1)
+        h = x1 - x0
+        k = (self._visible_node("visible_px", j + 1) - p0) / h
+        tau_max = dr.select(j == inc.j_end, inc.tau_end, h)
+        rest = target - self._visible_phi(c, sn, j)
+        x = x0 + self._solve_cell(c, sn, x0, p0, k, tau_max, rest)
+        # The conditional at |x̃|: its row is the cell j itself, mirrored
+        # where x̃ < 0 (`VisibleSlopeBake::row` of |x̃|, but without locating).
+        rows_n = self.shapes["visible_rows"][0]
+        negative = j < rows_n - 1
+        i = dr.select(negative, rows_n - 2 - j, j - (rows_n - 1))
+        a0, a1 = dr.select(negative, -x1, x0), dr.select(negative, -x0, x1)
+        lam = dr.clip((dr.abs(x) - a0) / (a1 - a0), 0.0, 1.0)
 
-        def node(name, k):
-            return dr.gather(mi.Float64, t[name], k)
+        def cum(col):
+            a0 = self._visible_node("visible_cum", i * cols_n + col)
+            return a0 + lam * (self._visible_node("visible_cum", (i + 1) * cols_n + col) - a0)
 
-        tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
-        bt = beta * tangential
-        length = dr.sqrt(bt * bt + wi.z * wi.z)
-        has_t = tangential > 0.0
-        t0 = dr.select(has_t, wi.x / tangential, 1.0)
-        t1 = dr.select(has_t, wi.y / tangential, 0.0)
-        c, sn = wi.z / length, bt / length
-
-        def x_node(j):
-            below = j + 1 >= rows_n
-            k = dr.select(below, j + 1 - rows_n, rows_n - 1 - j)
-            v = node("visible_rows", k)
-            return dr.select(below, v, -v)
-
-        def p_node(j):
-            below = j + 1 >= rows_n
-            return node("visible_p2", dr.select(below, j + 1 - rows_n, rows_n - 1 - j))
-
-        def phi_node(j):
-            return c * node("visible_mass", j) - sn * node("visible_moment", j)
-
-        def cell_integral(x0, p0, k, tau):
-            a = c - sn * x0
-            return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
-
-        def locate(a, name, n, scale):
-            position = _log2_axis(1.0 + mi.Float(a) * self.f["visible_inv_sigma"]) * scale
-            k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
-            lower = (k > 0) & (a < node(name, k))
-            upper = (k + 2 < n) & (a >= node(name, k + 1))
-            k = dr.select(lower, k - 1, dr.select(upper, k + 1, k))
-            a0, a1 = node(name, k), node(name, k + 1)
-            return k, dr.clip((a - a0) / (a1 - a0), 0.0, 1.0)
-
-        # The extent (`VisibleSlopeBake::extent`).
-        reaches = sn * r_max > c
-        mu = c / sn
-        i_mu, _ = locate(dr.select(reaches, mu, 0.0), "visible_rows", rows_n,
-                         self.f["visible_row_scale"])
-        j_mu = rows_n - 1 + i_mu
-        x0m, p0m = node("visible_rows", i_mu), node("visible_p2", i_mu)
-        km = (node("visible_p2", i_mu + 1) - p0m) / (node("visible_rows", i_mu + 1) - x0m)
-        last = mi.UInt32(x_nodes - 2)
-        j_end = dr.select(reaches, j_mu, last)
-        tau_end = dr.select(reaches, mu - x0m, x_node(last + 1) - x_node(last))
-        norm = dr.select(reaches, phi_node(j_mu) + cell_integral(x0m, p0m, km, mu - x0m),
-                         phi_node(last + 1))
-        ok = norm > 0.0
-        target = u0 * norm
-
-        last_at_most = _last_at_most
-
-        j = last_at_most(j_end + 1, lambda j: phi_node(j) <= target, 8)
-        x0, p0 = x_node(j), p_node(j)
-        h = x_node(j + 1) - x0
-        k = (p_node(j + 1) - p0) / h
-        tau_max = dr.select(j == j_end, tau_end, h)
-        rest = target - phi_node(j)
-        tau = self._solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral)
-        x = x0 + tau
-        # The conditional at |x̃|.
-        i, lam = locate(dr.abs(x), "visible_rows", rows_n, self.f["visible_row_scale"])
-
-        def blend(a0, a1):
-            return a0 + lam * (a1 - a0)
-
-        def cum(row, col):
-            return node("visible_cum", row * cols_n + col)
-
-        def dens(row, col):
-            return mi.Float64(dr.gather(mi.Float, t["visible_dens"], row * cols_n + col))
+        def dens(col):
+            d0 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + col))
+            d1 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + col))
+            return d0 + lam * (d1 - d0)
 
         signed = 2.0 * u1 - 1.0
-        q = dr.abs(signed) * blend(cum(i, cols_n - 1), cum(i + 1, cols_n - 1))
-        kk = last_at_most(cols_n - 1, lambda kc: blend(cum(i, kc), cum(i + 1, kc)) <= q, 7)
-        w = node("visible_cols", kk + 1) - node("visible_cols", kk)
-        g0 = blend(dens(i, kk), dens(i + 1, kk))
-        g1 = blend(dens(i, kk + 1), dens(i + 1, kk + 1))
-        r = dr.maximum(q - blend(cum(i, kk), cum(i + 1, kk)), 0.0)
+        q = dr.abs(signed) * cum(cols_n - 1)
+        kk = _last_at_most(cols_n - 1, lambda kc: cum(kc) <= q, (cols_n - 2).bit_length())
+        y0 = self._visible_node("visible_cols", kk)
+        w = self._visible_node("visible_cols", kk + 1) - y0
+        g0, g1 = dens(kk), dens(kk + 1)
+        r = dr.maximum(q - cum(kk), 0.0)
+        # (g1 − g0) w τ²/2 + g0 w τ = r, the root in [0, 1] without cancellation.
         b = g0 * w
         disc = dr.maximum(b * b + 2.0 * (g1 - g0) * w * r, 0.0)
         denom = b + dr.sqrt(disc)
         tau_y = dr.select(denom > 0.0, dr.clip(2.0 * r / denom, 0.0, 1.0), 0.0)
-        y = dr.copysign(node("visible_cols", kk) + tau_y * w, signed)
-        sx = beta * (x * t0 - y * t1)
-        sy = beta * (x * t1 + y * t0)
+        y = dr.copysign(y0 + tau_y * w, signed)
+        # Back to the surface: slope β (x̃ t + ỹ t⊥), m = (−slope, 1)/|…|.
+        sx = beta * (x * inc.t0 - y * inc.t1)
+        sy = beta * (x * inc.t1 + y * inc.t0)
         inv = 1.0 / dr.sqrt(1.0 + sx * sx + sy * sy)
-        return mi.Vector3d(-sx * inv, -sy * inv, inv), ok
+        return mi.Vector3d(-sx * inv, -sy * inv, inv), inc.norm > 0.0
 
     @staticmethod
-    def _solve_cell(c, sn, x0, p0, k, tau_max, rest, cell_integral):
+    def _solve_cell(c, sn, x0, p0, k, tau_max, rest):
         """`visible::solve_cell`: Newton's method in a shrinking bracket (a
-        symbolic loop, each lane until a step is ≤ `_NEWTON_TOL` of the
-        cell's scale, at most 40 steps)."""
+        symbolic loop, each lane until a step, or Newton's predicted error
+        after it, is ≤ `_NEWTON_TOL` of the cell's scale, at most 40 steps)."""
         a = c - sn * x0
 
         def density(t):
             return (a - sn * t) * (p0 + k * t)
 
+        # Start from the root without the cubic term: f0 t + b t²/2 = rest.
         f0 = density(0.0 * a)
         b = a * k - sn * p0
         disc = f0 * f0 + 2.0 * b * rest
         denom = f0 + dr.sqrt(dr.maximum(disc, 0.0))
         t = dr.select(denom > 0.0, dr.clip(2.0 * rest / denom, 0.0, tau_max), 0.5 * tau_max)
         tol = _NEWTON_TOL * (dr.abs(x0) + tau_max)
-        return _newton_in_bracket(lambda t: cell_integral(x0, p0, k, t) - rest, density,
-                                  t, mi.Float64(tau_max), tol)
+        return _newton_in_bracket(
+            lambda t: _Channel._visible_cell_integral(c, sn, x0, p0, k, t) - rest, density,
+            t, mi.Float64(tau_max), tol, lambda t: k * (a - sn * t) - sn * (p0 + k * t))
 
     def diffraction_sample(self, wi, u0, u1):
         """The diffraction lobe's direction where C is baked

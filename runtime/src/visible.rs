@@ -340,8 +340,15 @@ impl VisibleSlopeBake {
         let rest = target - self.phi_node(c, s, j);
         let tau = solve_cell(c, s, x0, p0, k, tau_max, rest);
         let x = x0 + tau;
-        // The conditional at |x̃|.
-        let (i, lambda) = self.row(x.abs());
+        // The conditional at |x̃|: its row is the cell j itself, mirrored
+        // where x̃ < 0 (no second look-up of |x̃|).
+        let x1 = self.x_node(j + 1);
+        let (i, a0, a1) = if j + 1 < ROWS {
+            (ROWS - 2 - j, -x1, -x0)
+        } else {
+            (j + 1 - ROWS, x0, x1)
+        };
+        let lambda = ((x.abs() - a0) / (a1 - a0)).max(0.0).min(1.0);
         let blend = |a: f64, b: f64| a + lambda * (b - a);
         let (ci, cn) = (&self.cum[i], &self.cum[i + 1]);
         let (di, dn) = (&self.dens[i], &self.dens[i + 1]);
