@@ -21,7 +21,7 @@ use twoscale::brdf::{
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
-pub const OPERATIONS: [&str; 14] = [
+pub const OPERATIONS: [&str; 15] = [
     "ggx-eval",
     "ggx-eval-rgb",
     "ggx-sample-eval",
@@ -36,6 +36,7 @@ pub const OPERATIONS: [&str; 14] = [
     "sample",
     "construct",
     "construct-rgb",
+    "construct-spectral",
 ];
 
 /// One of [`OPERATIONS`], resolved once so that the timed loop matches on
@@ -56,6 +57,7 @@ enum Operation {
     Sample,
     Construct,
     ConstructRgb,
+    ConstructSpectral,
 }
 
 impl Operation {
@@ -76,6 +78,7 @@ impl Operation {
             "sample" => Operation::Sample,
             "construct" => Operation::Construct,
             "construct-rgb" => Operation::ConstructRgb,
+            "construct-spectral" => Operation::ConstructSpectral,
             other => {
                 return Err(format!(
                     "unknown operation {other}; one of {}",
@@ -192,6 +195,13 @@ impl<'a> Workload<'a> {
                     Options::default(),
                 )
                 .eval(i, o)[1],
+                // The `nickel` preset at any wavelength (criterion's `spectral_preset`).
+                Operation::ConstructSpectral => Spectral::boxed(
+                    &set.brdf_tables(),
+                    &materials::spectral(black_box("nickel")).expect("preset"),
+                    Options::default(),
+                )
+                .eval(i, o, cost::LAMBDA),
             };
         }
         Ok(black_box(sum))
