@@ -241,8 +241,8 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
 
     /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
     /// the pair's geometry, D and G once, then F at each wavelength
-    /// ([`Spectral::start`]), then each wavelength's models
-    /// ([`Spectral::finish`]).
+    /// (`Spectral::start`), then each wavelength's models
+    /// (`Spectral::finish`).
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 4];
