@@ -1094,8 +1094,8 @@ class SpectralModel(Model):
     nodes; C from the lower model's bake at u = b cos θd/λ) with σrel/σs and
     Q̄/F(θd) interpolated linearly in λ between the two models; the base
     lobes interpolated in λ (docs/model.md §2.12). ``pdf`` and
-    ``sample_direction`` at λ are those of the nearest model
-    (``Spectral::pdf``, ``Spectral::sample``).
+    ``sample_direction`` at λ are those of the nearest of the sampler
+    models, every other one (``Spectral::pdf``, ``Spectral::sample``).
 
     As ``Spectral::eval4``, the pair's geometry, D and G are computed once
     per path and each wavelength reads the two models around it (of the
@@ -1205,9 +1205,14 @@ class SpectralModel(Model):
         return out
 
     def nearest(self, lam):
-        """`Spectral::nearest`: the index of the model nearest λ."""
-        k, f = self.cell(self.clamped(mi.Float(lam)))
-        return dr.select(f < 0.5, k, k + 1)
+        """`Spectral::nearest`: the index of the sampler model (the even
+        ones) nearest λ, the lower on a tie."""
+        lam = self.clamped(mi.Float(lam))
+        k, _ = self.cell(lam)
+        e = k - (k & 1)
+        a = dr.gather(mi.Float, self.node_table, e)
+        b = dr.gather(mi.Float, self.node_table, e + 2)
+        return dr.select(lam + lam <= a + b, e, e + 2)
 
     def pdf_spectral(self, wi, wo, lam):
         """`Spectral::pdf`: `TwoScale::pdf` of the model nearest λ."""

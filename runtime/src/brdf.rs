@@ -385,8 +385,11 @@ pub struct ChannelBake {
     /// else the source is read directly.
     conv_baked: bool,
     /// The halo sampler's densities over the half-vector, from `conv`
-    /// (valid when `conv_baked`).
+    /// (valid when `conv_baked` and `halo_baked`).
     halo: HaloBake,
+    /// Whether `halo` holds the halo sampler (else the halo is drawn from
+    /// the spectrum, HP17 51–55).
+    halo_baked: bool,
 }
 
 impl ChannelBake {
@@ -410,10 +413,10 @@ impl ChannelBake {
         self.conv_baked.then_some(&self.conv)
     }
 
-    /// The halo sampler's densities, when C is baked.
+    /// The halo sampler's densities, when they are baked (C is).
     #[inline]
     fn halo(&self) -> Option<&HaloBake> {
-        self.conv_baked.then_some(&self.halo)
+        (self.conv_baked && self.halo_baked).then_some(&self.halo)
     }
 }
 
@@ -611,7 +614,7 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
         let shared = SurfaceBakes::new(tables, layer.surface);
         let mut model = Self::around(bake, tables, &shared, layer, lambda, eta, options);
         shared.bake_into(tables, model.bake.borrow_mut());
-        model.bake_wavelength(tables, &shared, eta);
+        model.bake_wavelength(tables, &shared, eta, NodeBakes::ALL);
         model
     }
 
@@ -670,7 +673,13 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
     /// Bakes, in place, what depends on the wavelength: the direction bake
     /// and its lobe weights, `1/M` and C (G1 and the visible-slope tables are
     /// [`SurfaceBakes::bake_into`]'s).
-    fn bake_wavelength(&mut self, tables: &Tables<'a>, shared: &SurfaceBakes<'a>, eta: Complex) {
+    fn bake_wavelength(
+        &mut self,
+        tables: &Tables<'a>,
+        shared: &SurfaceBakes<'a>,
+        eta: Complex,
+        what: NodeBakes,
+    ) {
         let (surface, big_b, q) = (self.surface, self.big_b, self.q);
         let white = self.white();
         let sigma_s = f64::from(surface.sigma_s);
@@ -688,11 +697,18 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
         } else {
             bake.radial_norm.clear();
         }
-        bake.conv_baked = match &shared.slice {
-            Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
-            None => false,
-        };
-        if bake.conv_baked {
+        if what.conv {
+            bake.conv_baked = match &shared.slice {
+                Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
+                None => false,
+            };
+        }
+        bake.halo_baked = bake.conv_baked && what.halo_sampler;
+        if !bake.halo_baked {
+            // Not read (`ChannelBake::halo`); zeroed so that exports are
+            // the same whatever the storage held.
+            bake.halo.zero();
+        } else {
             let (x_scale, sigma_s_sq, options) = (self.x_scale, self.sigma_s_sq, self.options);
             let (direction, masking) = (&bake.direction, &bake.masking);
             // The halo's factors besides C and the projections: Q̄ G (1 − A)/σrel².
@@ -901,6 +917,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 flag(self.options.halo_weight == HaloWeight::Incident),
             ),
             ("conv_baked", flag(self.bake().conv_baked)),
+            ("halo_baked", flag(self.bake().halo().is_some())),
         ] {
             v.scalar(name, value);
         }
@@ -1553,6 +1570,27 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 }
 
+/// What [`TwoScale::bake_wavelength`] bakes besides the direction bake:
+/// a model on its own bakes everything; models that serve only the eval of
+/// a model over λ between its sampler models skip the halo sampler (their
+/// own halo draws come from the spectrum, HP17 51–55) and may take C from
+/// a model at a shorter wavelength (whose bake covers their `u` range).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct NodeBakes {
+    /// Bake C (else the caller has copied a bake covering `[0, B]` in).
+    conv: bool,
+    /// Bake the halo sampler ([`HaloBake`]) from C.
+    halo_sampler: bool,
+}
+
+impl NodeBakes {
+    /// Everything.
+    const ALL: NodeBakes = NodeBakes {
+        conv: true,
+        halo_sampler: true,
+    };
+}
+
 /// The albedo estimates of the lobes at one incidence, for
 /// [`TwoScale::weights_at`].
 #[derive(Clone, Copy, Debug)]
@@ -1846,7 +1884,7 @@ impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
             bake.visible.clone_from(&first.visible);
         }
         for (channel, eta) in channels.iter_mut().zip(material.eta_rgb) {
-            channel.bake_wavelength(tables, &shared, eta);
+            channel.bake_wavelength(tables, &shared, eta, NodeBakes::ALL);
         }
         let [r, g, b] = &mut channels;
         share_lobe_weights([r, g, b]);

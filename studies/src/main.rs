@@ -244,7 +244,8 @@ enum Study {
     /// construction against the GGX baseline of benches/brdf.rs, counted by
     /// callgrind (docs/design/speed.md). Needs valgrind.
     BrdfInstructions {
-        /// Calls per operation (construction: a thousandth).
+        /// Calls per operation (construction: a thousandth, except with
+        /// `--operation`, which runs exactly this many).
         #[arg(long, default_value_t = 10_000)]
         calls: usize,
         /// Run this operation only, without valgrind (what the report runs

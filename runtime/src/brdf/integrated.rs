@@ -19,8 +19,8 @@
 //! out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
 use super::{
-    BakeVisitor, ChannelBake, ColourTerms, Geometry, Options, RgbSample, SurfaceBakes, Tables,
-    TwoScale, finite_or_zero,
+    BakeVisitor, ChannelBake, ColourTerms, Geometry, NodeBakes, Options, RgbSample, SurfaceBakes,
+    Tables, TwoScale, finite_or_zero,
 };
 use crate::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use crate::fresnel::fresnel;
@@ -123,13 +123,19 @@ impl ColourBake {
 
 /// The models of `material` at `wavelengths`, with `η(λ_k)`, baked into
 /// `bakes` in place; G1 and the visible-slope tables (wavelength
-/// independent) are baked once and copied.
+/// independent) are baked once and copied. Only the models `samplers`
+/// lists bake the halo sampler (the others draw the halo from the
+/// spectrum); with `share_conv`, a model not in `samplers` takes C from the
+/// model before it, which must be at a shorter wavelength (its bake covers
+/// `u ≤ b/λ_{k−1}`, hence `b/λ_k`).
 pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
     bakes: [B; N],
     tables: &Tables<'a>,
     material: &SpectralMaterial<'_>,
     options: Options,
     wavelengths: &[f32; N],
+    samplers: &[usize],
+    share_conv: bool,
 ) -> [TwoScale<'a, B>; N] {
     let shared = SurfaceBakes::new(tables, material.layer.surface);
     let mut k = 0;
@@ -154,8 +160,21 @@ pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
         bake.masking.clone_from(&first.masking);
         bake.visible.clone_from(&first.visible);
     }
-    for (node, &lambda) in nodes.iter_mut().zip(wavelengths) {
-        node.bake_wavelength(tables, &shared, material.eta.at(lambda));
+    for k in 0..N {
+        let sampler = samplers.contains(&k);
+        let what = NodeBakes {
+            conv: sampler || !share_conv || k == 0,
+            halo_sampler: sampler,
+        };
+        let (before, rest) = nodes.split_at_mut(k);
+        let node = &mut rest[0];
+        if !what.conv {
+            debug_assert!(wavelengths[k - 1] <= wavelengths[k]);
+            let (from, to) = (before[k - 1].bake(), node.bake.borrow_mut());
+            to.conv.clone_from(&from.conv);
+            to.conv_baked = from.conv_baked;
+        }
+        node.bake_wavelength(tables, &shared, material.eta.at(wavelengths[k]), what);
     }
     nodes
 }
@@ -195,7 +214,15 @@ impl<'a, B: BorrowMut<ChannelBake>> IntegratedRgb<'a, B> {
         material: &SpectralMaterial<'_>,
         options: Options,
     ) -> Self {
-        let nodes = models_at(bakes, tables, material, options, &INTEGRATED_WAVELENGTHS);
+        let nodes = models_at(
+            bakes,
+            tables,
+            material,
+            options,
+            &INTEGRATED_WAVELENGTHS,
+            &SAMPLER_NODES,
+            false,
+        );
         let colour = ColourBake::new(material, options.colour == ColourTerms::White);
         let diffuse = nodes.iter().any(|node| node.has_lobes().1);
         IntegratedRgb {

@@ -16,7 +16,9 @@
 //! F in closed form); Q̄/F and σrel are smooth in λ. C depends on λ only
 //! through `u`, and model k's bake covers `[0, b/λ_k] ⊇ [0, b/λ]`: one C
 //! lookup per wavelength. `sample` and `pdf` at λ are those of the model
-//! nearest λ.
+//! nearest λ among every other one (`SAMPLER_NODES`, 0.04–0.07 µm apart).
+//! Only these bake C and the halo sampler; each model between them takes C
+//! from the one before it (a bake at a shorter λ covers a longer λ's u).
 
 use super::integrated::models_at;
 use super::{
@@ -37,6 +39,19 @@ pub const SPECTRAL_WAVELENGTHS: [f32; SPECTRAL_COUNT] = [
     0.36, 0.40, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54, 0.56, 0.58, 0.60, 0.62, 0.64, 0.67, 0.70, 0.73,
     0.76, 0.795, 0.83,
 ];
+
+/// The models whose samplers [`Spectral::sample`] uses: every other one
+/// (the first and last among them: `nearest` reads node `e + 2`).
+const SAMPLER_NODES: [usize; SPECTRAL_COUNT.div_ceil(2)] = {
+    let mut nodes = [0; SPECTRAL_COUNT.div_ceil(2)];
+    let mut j = 0;
+    while j < nodes.len() {
+        nodes[j] = 2 * j;
+        j += 1;
+    }
+    nodes
+};
+const _: () = assert!(SPECTRAL_COUNT % 2 == 1);
 
 /// Nodes of the 1 nm table of η (finer than the measured indices' rows:
 /// linear in λ every 5 nm cost a rough gold up to 1% of ρ at 0.496 µm).
@@ -177,7 +192,15 @@ impl<'a, B: BorrowMut<ChannelBake>> Spectral<'a, B> {
         material: &SpectralMaterial<'_>,
         options: Options,
     ) -> Self {
-        let nodes = models_at(bakes, tables, material, options, &SPECTRAL_WAVELENGTHS);
+        let nodes = models_at(
+            bakes,
+            tables,
+            material,
+            options,
+            &SPECTRAL_WAVELENGTHS,
+            &SAMPLER_NODES,
+            true,
+        );
         Spectral {
             diffuse: nodes.iter().any(|node| node.has_lobes().1),
             nodes,
@@ -350,10 +373,17 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     }
 
     /// The model whose sampler serves `lambda`: the nearest of
-    /// [`SPECTRAL_WAVELENGTHS`].
+    /// [`SAMPLER_NODES`] (the even ones), the lower on a tie.
     fn nearest(&self, lambda: f32) -> &TwoScale<'_, B> {
-        let (k, f) = cell(Self::clamped(lambda));
-        &self.nodes[if f < 0.5 { k } else { k + 1 }]
+        let lambda = Self::clamped(lambda);
+        // The even nodes around λ: `e` at or below the hats' cell, `e + 2`.
+        let e = cell(lambda).0 & !1;
+        let w = &SPECTRAL_WAVELENGTHS;
+        &self.nodes[if lambda + lambda <= w[e] + w[e + 2] {
+            e
+        } else {
+            e + 2
+        }]
     }
 
     /// The density of [`Spectral::sample`] at `lambda`.
