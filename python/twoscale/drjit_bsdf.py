@@ -29,7 +29,7 @@ Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
 :meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes stacked along
 a node axis, the two models around each of the path's four wavelengths
 interpolated in λ, with F(θd) at λ in closed form; ``pdf`` and ``sample``
-those of the model nearest the hero wavelength).
+those of the sampler model, every other one, nearest the hero wavelength).
 
 **Gradients.** The bakes are fixed per material (the runtime interprets the
 tables; a lookup's node positions have no useful derivative), so
@@ -1215,7 +1215,7 @@ class SpectralModel(Model):
         return dr.select(lam + lam <= a + b, e, e + 2)
 
     def pdf_spectral(self, wi, wo, lam):
-        """`Spectral::pdf`: `TwoScale::pdf` of the model nearest λ."""
+        """`Spectral::pdf`: `TwoScale::pdf` of the sampler model nearest λ."""
         valid, geo = self.geometry(wi, wo)
         wi, wo = geo["wi"], geo["wo"]
         node = self.stack.at(self.nearest(lam))
@@ -1230,7 +1230,7 @@ class SpectralModel(Model):
 
     def sample_spectral(self, wi, u, lam):
         """`Spectral::sample`'s direction: `TwoScale::sample_direction` of
-        the model nearest λ (the lobe picked with `u[0]`, its direction
+        the sampler model nearest λ (the lobe picked with `u[0]`, its direction
         from `u[1], u[2]`). Returns the direction and whether one was drawn."""
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
         wi_f = mi.Vector3f(wi)

@@ -392,7 +392,7 @@ impl<B: Borrow<ChannelBake>> Spectral<'_, B> {
     }
 
     /// Samples an outgoing direction for the (hero) wavelength `lambda`
-    /// with the sampler of the nearest model; the value is
+    /// with the sampler of the nearest sampler model; the value is
     /// [`Spectral::eval`] at `lambda`.
     pub fn sample(&self, i: [f32; 3], u: [f32; 3], lambda: f32) -> Option<Sample> {
         let node = self.nearest(lambda);
