@@ -556,8 +556,8 @@ impl Material {
     }
 
     /// pdf_spectral(wi, wo, lam): the density (sr⁻¹) of `sample_spectral(wi,
-    /// ·, lam)` at `wo`: that of the sampler model nearest `lam`, every
-    /// other model (`Spectral::pdf`). Arguments and errors as `eval_spectral`'s.
+    /// ·, lam)` at `wo`: that of the nearest of the sampler models, every
+    /// other one (`Spectral::pdf`). Arguments and errors as `eval_spectral`'s.
     fn pdf_spectral<'py>(
         &self,
         py: Python<'py>,

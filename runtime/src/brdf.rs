@@ -385,10 +385,10 @@ pub struct ChannelBake {
     /// else the source is read directly.
     conv_baked: bool,
     /// The halo sampler's densities over the half-vector, from `conv`
-    /// (valid when `conv_baked` and `halo_baked`).
+    /// (valid when `halo_baked`).
     halo: HaloBake,
-    /// Whether `halo` holds the halo sampler (else the halo is drawn from
-    /// the spectrum, HP17 51–55).
+    /// Whether `halo` holds the halo sampler (implies `conv_baked`; else
+    /// the halo is drawn from the spectrum, HP17 51–55).
     halo_baked: bool,
 }
 
@@ -413,10 +413,10 @@ impl ChannelBake {
         self.conv_baked.then_some(&self.conv)
     }
 
-    /// The halo sampler's densities, when they are baked (C is).
+    /// The halo sampler's densities, when they are baked.
     #[inline]
     fn halo(&self) -> Option<&HaloBake> {
-        (self.conv_baked && self.halo_baked).then_some(&self.halo)
+        self.halo_baked.then_some(&self.halo)
     }
 }
 
@@ -917,7 +917,6 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                 flag(self.options.halo_weight == HaloWeight::Incident),
             ),
             ("conv_baked", flag(self.bake().conv_baked)),
-            ("halo_baked", flag(self.bake().halo().is_some())),
         ] {
             v.scalar(name, value);
         }

@@ -40,8 +40,9 @@ pub const SPECTRAL_WAVELENGTHS: [f32; SPECTRAL_COUNT] = [
     0.76, 0.795, 0.83,
 ];
 
-/// The models whose samplers [`Spectral::sample`] uses: every other one
-/// (the first and last among them: `nearest` reads node `e + 2`).
+/// The models whose samplers [`Spectral::sample`] uses: every other one,
+/// the first and the last included (an odd count, so that `nearest`'s
+/// `e + 2` exists).
 const SAMPLER_NODES: [usize; SPECTRAL_COUNT.div_ceil(2)] = {
     let mut nodes = [0; SPECTRAL_COUNT.div_ceil(2)];
     let mut j = 0;
