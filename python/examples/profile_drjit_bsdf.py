@@ -5,8 +5,10 @@
 
     python python/examples/profile_drjit_bsdf.py [--against OLD.py] [--rounds 15] [MATERIAL ...]
 
-MATERIAL is a preset or ``beckmann`` (the render benchmark's p = 1, σs = 0
-gold conductor); default ``beckmann gold-hp17-geometry``. ``--against``
+MATERIAL is a preset, ``beckmann`` (the render benchmark's p = 1, σs = 0
+gold conductor) or ``roughconductor`` (Mitsuba's, Beckmann, α 0.1, visible
+normals, the same index: its ``eval``, ``pdf`` and ``sample``, which also
+returns the weight); default ``beckmann gold-hp17-geometry``. ``--against``
 times the same three calls of another copy of ``drjit_bsdf.py`` (e.g.
 ``git show main:python/twoscale/drjit_bsdf.py > /tmp/old.py``) in
 alternation with this one, rounds interleaved, so that a change is
@@ -38,6 +40,24 @@ def material(name):
     # `Model` is the paper's wavelengths (the presets' default, integrated
     # RGB, evaluates eight such models per pair).
     return twoscale.Material.preset(name, rgb_mode="paper-wavelengths")
+
+
+def roughconductor_calls(wi, wo, u):
+    """Mitsuba's `roughconductor` at the `beckmann` material's α and index."""
+    bsdf = mi.load_dict({
+        "type": "roughconductor", "distribution": "beckmann", "alpha": 0.1, "sample_visible": True,
+        "eta": {"type": "rgb", "value": [e[0] for e in GOLD]},
+        "k": {"type": "rgb", "value": [e[1] for e in GOLD]},
+    })
+    si = dr.zeros(mi.SurfaceInteraction3f, LANES)
+    si.wi, si.n = wi, mi.Normal3f(0, 0, 1)
+    si.sh_frame = mi.Frame3f(si.n)
+    ctx = mi.BSDFContext()
+    return {
+        "eval": lambda: bsdf.eval(ctx, si, wo),
+        "pdf": lambda: bsdf.pdf(ctx, si, wo),
+        "sample (with its weight)": lambda: bsdf.sample(ctx, si, u.x, mi.Point2f(u.y, u.z)),
+    }
 
 
 def best_times(calls, rounds):
@@ -79,6 +99,11 @@ def main():
     wid, wod = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
     dr.eval(wi, wo, u, wid, wod)
     for name in args.materials:
+        if name == "roughconductor":
+            calls = roughconductor_calls(wi, wo, u)
+            for key, t in best_times(calls, args.rounds).items():
+                print(f"{name:20s} {key:36s} {t / LANES * 1e9:8.1f} ns/lane")
+            continue
         m = material(name)
         calls = {}
         for label, module in modules.items():

@@ -9,9 +9,17 @@ sampler used before (by quadrature). Prints a Markdown table per comparison
 prints instead the variance of the presets and of materials with strong
 halos (σs up to 0.1 µm, b 1–20 µm, β 0.01–0.5) at 0°/45°/70°/85°, against
 the issue's targets (≤ 0.1 at θi ≤ 70°, ≤ 0.5 at 85°;
-docs/design/halo-sampling.md).
+docs/design/halo-sampling.md). `--spectral` prints the variance of the
+spectral sampler's weight (`Material.sample_spectral`, one wavelength) at
+the sampler models' wavelengths, where the sampler is the model at λ, and
+at the models between them, where it is the nearest sampler model's
+(docs/design/rgb-integration.md). `--equal-noise` prints, for a few
+presets, the variance (green) beside that of `roughconductor` (Beckmann,
+α = β, η = 1 + 6.6i) at the same incidence: with the cost ratio of
+`studies brdf-timing`, the time to equal noise
+(docs/design/halo-sampling.md).
 
-    python python/examples/sampler_variance.py [--samples N] [--quick] [--halo]
+    python python/examples/sampler_variance.py [--samples N] [--quick] [--halo | --spectral | --equal-noise]
 """
 
 import argparse
@@ -58,14 +66,25 @@ def material_variance(mat, theta, n, seed=1):
 GOLD = twoscale.Material.preset("gold-rough").eta
 
 
-def halo_materials():
+def gold_spectrum():
+    """Gold's measured index as `eta=(lam, n, k)`: the 1 nm table of the
+    preset's spectral model."""
+    bakes = twoscale.Material.preset("gold-rough").spectral_bakes()
+    eta = np.asarray(bakes["eta"], dtype=np.float64)
+    lam = bakes["eta_first"] + bakes["eta_step"] * np.arange(len(eta))
+    return (lam, eta[:, 0], eta[:, 1])
+
+
+def halo_materials(spectral=False):
     """(name, Material): the presets and gold with strong halos, the
-    issue's (β 0.1, p 1, σs 0.1, b 3, c 1.6) first."""
+    issue's (β 0.1, p 1, σs 0.1, b 3, c 1.6) first; with `spectral`, gold's
+    index over the spectrum rather than at the paper's wavelengths."""
     out = [(name, twoscale.Material.preset(name)) for name in twoscale.Material.presets()]
+    eta = gold_spectrum() if spectral else GOLD
     for beta, sigma_s, b, c in [(0.1, 0.1, 3.0, 1.6), (0.01, 0.1, 1.0, 2.0), (0.01, 0.1, 20.0, 2.0),
                                 (0.5, 0.1, 1.0, 2.0), (0.5, 0.1, 20.0, 2.0), (0.1, 0.05, 10.0, 3.0)]:
         name = f"strong halo (β {beta}, p 1, σs {sigma_s}, b {b:g}, c {c}, gold)"
-        out.append((name, twoscale.Material(beta=beta, p=1.0, sigma_s=sigma_s, b=b, c=c, eta=GOLD)))
+        out.append((name, twoscale.Material(beta=beta, p=1.0, sigma_s=sigma_s, b=b, c=c, eta=eta)))
     return out
 
 
@@ -83,6 +102,61 @@ def halo_rows(thetas, n, materials=None):
             cells.append(channels(v) + ("" if np.all(v <= target) else " ✗"))
             rows.append((name, theta, v, target))
         print(f"| {name} | " + " | ".join(cells) + " |")
+    return rows
+
+
+def spectral_variance(mat, theta, lam, n, seed=1):
+    """Of `mat.sample_spectral` at incidence θi and wavelength `lam` µm, the
+    weight `eval_spectral · cos θo / pdf` (0 where it fails)."""
+    rng = np.random.default_rng(seed)
+    wi = np.ascontiguousarray(np.broadcast_to(direction(theta).astype(np.float32), (n, 3)))
+    u = rng.random((n, 3), dtype=np.float32)
+    lams = np.full(n, lam, dtype=np.float32)
+    wo, pdf = mat.sample_spectral(wi, u, lams)
+    ok = pdf > 0
+    rho = mat.eval_spectral(wi, np.where(ok[:, None], wo, [0, 0, 1]).astype(np.float32), lams)
+    w = np.where(ok, rho * wo[:, 2] / np.where(ok, pdf, 1.0), 0.0)
+    return relative_variance(w[:, None])[0]
+
+
+def spectral_rows(thetas, n, materials=None):
+    """Per material and θi, the weight's variance at each model between two
+    sampler models (where the sampler is up to 0.04 µm away) against the
+    variance interpolated linearly in λ between those two (where it is the
+    model at λ): the largest ratio, and the variances at the worst model."""
+    lams = twoscale.Material.preset("gold-rough").spectral_bakes()["wavelengths"]
+    print("| material | θi | largest ratio, between / sampler models (at λ) | variance there: between, sampler models around |")
+    print("|---|---|---|---|")
+    rows = []
+    for name, mat in materials or halo_materials(spectral=True):
+        for theta in thetas:
+            v = [spectral_variance(mat, theta, float(lam), n) for lam in lams]
+            worst = (0.0, 0.0, 0.0, 0.0, 0.0)
+            for k in range(1, len(lams) - 1, 2):
+                f = (lams[k] - lams[k - 1]) / (lams[k + 1] - lams[k - 1])
+                expected = (1 - f) * v[k - 1] + f * v[k + 1]
+                ratio = v[k] / expected if expected > 0 else np.inf
+                if ratio > worst[0]:
+                    worst = (ratio, lams[k], v[k], v[k - 1], v[k + 1])
+            ratio, lam, vk, va, vb = worst
+            print(f"| {name} | {theta}° | {ratio:.3f} ({lam:.3f} µm) | {fmt(vk)}: {fmt(va)}, {fmt(vb)} |")
+            rows.append((name, theta, ratio))
+    return rows
+
+
+def equal_noise_rows(n):
+    """Per (preset, θi): the variance of the green weight of the preset and
+    of `roughconductor` at α = β."""
+    print("| preset (β) | θi | twoscale relvar (green) | roughconductor relvar (green) |")
+    print("|---|---|---|---|")
+    rows = []
+    for name, theta in [("gold-hp17-geometry", 45), ("gold-hp17-geometry", 85), ("gold-rough", 45),
+                        ("gold-rough", 85), ("aluminium", 85), ("silver", 85)]:
+        mat = twoscale.Material.preset(name)
+        ts = material_variance(mat, theta, n)[1]
+        rc = mitsuba_variance(mat.beta, theta, n)[1]
+        print(f"| {name} ({mat.beta:.2g}, p {mat.p:g}) | {theta}° | {fmt(ts)} | {fmt(rc)} |")
+        rows.append((name, theta, ts, rc))
     return rows
 
 
@@ -207,9 +281,16 @@ def main():
     parser.add_argument("--samples", type=int, default=1_000_000)
     parser.add_argument("--quick", action="store_true", help="a few rows")
     parser.add_argument("--halo", action="store_true", help="the presets and strong halos")
+    parser.add_argument("--spectral", action="store_true",
+                        help="the spectral sampler between its sampler models")
+    parser.add_argument("--equal-noise", action="store_true",
+                        help="a few presets beside roughconductor")
     args = parser.parse_args()
     if args.halo:
         halo_rows([0, 45, 70, 85], args.samples)
+        return
+    if args.spectral:
+        spectral_rows([0, 45, 70, 85], args.samples)
         return
     llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
     if os.path.exists(llvm):
@@ -217,6 +298,9 @@ def main():
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
+    if args.equal_noise:
+        equal_noise_rows(args.samples)
+        return
     if args.quick:
         beckmann_rows([0.2, 0.5], [45, 85], args.samples)
         print()
