@@ -95,7 +95,14 @@ impl C64 {
         if x == 0.0 && y == 0.0 {
             return C64::real(0.0);
         }
-        let r = math::hypot(x, y);
+        // |z| as √(x² + y²) where that is exact to rounding (every `Index`
+        // gives such z), `hypot` where the squares would under- or overflow.
+        let n = x * x + y * y;
+        let r = if (1e-290..=1e300).contains(&n) {
+            math::sqrt(n)
+        } else {
+            math::hypot(x, y)
+        };
         if x >= 0.0 {
             let t = math::sqrt(0.5 * (r + x));
             C64::new(t, y / (2.0 * t))
@@ -190,9 +197,13 @@ impl Index {
     fn reflectance(&self, cos: f64) -> f64 {
         let c = self.c(cos);
         let cos_c = C64::real(cos);
-        // |a − c|² / |a + c|²: no complex division.
-        let ratio = |a: C64| (a - c).norm_sqr() / (a + c).norm_sqr();
-        0.5 * (ratio(cos_c) + ratio(self.eta_sq * cos))
+        // Fs + Fp = |a − c|²/|a + c|² + |b − c|²/|b + c|² over one division
+        // (the denominators lie in [1e-20, 1e36]: their product is finite).
+        let a = cos_c;
+        let b = self.eta_sq * cos;
+        let (na, da) = ((a - c).norm_sqr(), (a + c).norm_sqr());
+        let (nb, db) = ((b - c).norm_sqr(), (b + c).norm_sqr());
+        0.5 * (na * db + nb * da) / (da * db)
     }
 }
 
