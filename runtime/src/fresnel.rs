@@ -426,15 +426,15 @@ impl QConstants {
         [1.0 / sum.norm_sqr(), u.re, u.im, w.re, w.im]
     }
 
-    /// Q̄ from both directions' factors and `sin θi sin θo (cos φ, sin φ)`
-    /// (its length is `sin θi sin θo`; φ is normalised out, φ = 0 when either
-    /// sine is 0).
     /// `(|η² − 1|², η²)` of [`QConstants::combine`].
     pub(crate) fn combine_constants(&self) -> (f64, [f64; 2]) {
         let eta_sq = self.index.eta_sq;
         (self.e_norm_sqr, [eta_sq.re, eta_sq.im])
     }
 
+    /// Q̄ from both directions' factors and `sin θi sin θo (cos φ, sin φ)`
+    /// (its length is `sin θi sin θo`; φ is normalised out, φ = 0 when either
+    /// sine is 0).
     pub(crate) fn combine(&self, fi: &QFactors, fo: &QFactors, along: f64, across: f64) -> f64 {
         // With s² = along² + across² = (sin θi sin θo)², the bracket times s²
         // is a_i a_o along² + (a_i |U_o|² + |U_i|² a_o) across²
