@@ -196,10 +196,11 @@ impl Index {
     /// F of [`fresnel`] at `cos θ ∈ [0, 1]`, in f64 (not clamped).
     fn reflectance(&self, cos: f64) -> f64 {
         let c = self.c(cos);
-        let cos_c = C64::real(cos);
-        // Fs + Fp = |a − c|²/|a + c|² + |b − c|²/|b + c|² over one division
-        // (the denominators lie in [1e-20, 1e36]: their product is finite).
-        let a = cos_c;
+        // Fs + Fp = |a − c|²/|a + c|² + |b − c|²/|b + c|² over one division:
+        // each |·|² lies within ≈ [1e-40, 2.3e36] (|η| ∈ [INDEX_MIN,
+        // INDEX_MAX]; 2·10⁶ sampled indices and angles), so the products are
+        // finite and not 0.
+        let a = C64::real(cos);
         let b = self.eta_sq * cos;
         let (na, da) = ((a - c).norm_sqr(), (a + c).norm_sqr());
         let (nb, db) = ((b - c).norm_sqr(), (b + c).norm_sqr());
