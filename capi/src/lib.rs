@@ -23,7 +23,7 @@ use twoscale::brdf::{
     BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material,
     MultipleScattering, Options, RGB_WAVELENGTHS, RgbMode, RgbModel, SigmaRelMode, Surface,
 };
-use twoscale::brdf::{SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::brdf::{BoxedSpectral, SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
 use twoscale::format::{FormatError, TableId, aligned_copy};
 use twoscale::materials::PRESETS;
@@ -118,7 +118,7 @@ pub struct ts_material {
     spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first
     /// `ts_eval_spectral`; borrows `_tables` as `rgb` does.
-    spectral_model: OnceLock<Spectral<'static, Box<ChannelBake>>>,
+    spectral_model: OnceLock<BoxedSpectral<'static>>,
     options: Options,
     _tables: Arc<OwnedTableSet>,
 }
@@ -1219,12 +1219,7 @@ pub unsafe extern "C" fn ts_eval_spectral(
             // SAFETY: as in `new_material_with`: the model borrows only the
             // `TableSet` inside the `Arc` the handle keeps (`_tables`,
             // declared after `spectral_model`, so dropped after it).
-            unsafe {
-                std::mem::transmute::<
-                    Spectral<'_, Box<ChannelBake>>,
-                    Spectral<'static, Box<ChannelBake>>,
-                >(model)
-            }
+            unsafe { std::mem::transmute::<BoxedSpectral<'_>, BoxedSpectral<'static>>(model) }
         });
         let values = model.eval4(i, o, lambdas);
         for (k, v) in values.iter().enumerate() {

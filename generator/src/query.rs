@@ -11,7 +11,9 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use twoscale::brdf::{ChannelBake, MultipleScattering, RgbMode, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::brdf::{
+    BoxedSpectral, ChannelBake, MultipleScattering, RgbMode, SPECTRAL_WAVELENGTHS, Spectral,
+};
 use twoscale::desc::OwnedMaterialDesc;
 use twoscale::optical::SpectralMaterial;
 use twoscale::{
@@ -532,7 +534,7 @@ enum MaterialModel<'a> {
     /// Rows of [`SPECTRAL_COLUMNS`]: the spectral model, and the reference's
     /// parameters with `n`, `k`, `λ` set per row from the material's index.
     Spectral {
-        model: Box<Spectral<'a, Box<ChannelBake>>>,
+        model: Box<BoxedSpectral<'a>>,
         spectral: SpectralMaterial<'a>,
         params: brdf::Params,
         options: twoscale::brdf::Options,

@@ -28,7 +28,7 @@ use twoscale::brdf::{
     BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
     MultipleScattering, Options, SigmaRelMode, Surface,
 };
-use twoscale::brdf::{RgbMode, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::brdf::{BoxedSpectral, RgbMode, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
 use twoscale::desc::{self, DescError, DescErrorKind, Eta, Keywords, MaterialDesc};
 use twoscale::optical::{OwnedSpectralMaterial, SpectralMaterial};
 use twoscale::validate::{self, Invalid, Named};
@@ -280,7 +280,7 @@ struct Material {
     /// preset's measured one, or the one index of every channel.
     spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first `eval_spectral`.
-    spectral_model: OnceLock<Box<Spectral<'static, Box<ChannelBake>>>>,
+    spectral_model: OnceLock<Box<BoxedSpectral<'static>>>,
 }
 
 impl Material {
@@ -300,10 +300,7 @@ impl Material {
 
     /// The model at any wavelength of `spectral` (this material's index over
     /// the spectrum), built by the first call.
-    fn spectral_model(
-        &self,
-        spectral: &OwnedSpectralMaterial,
-    ) -> &Spectral<'static, Box<ChannelBake>> {
+    fn spectral_model(&self, spectral: &OwnedSpectralMaterial) -> &BoxedSpectral<'static> {
         self.spectral_model.get_or_init(|| {
             Box::new(Spectral::boxed(
                 &TABLES.brdf_tables(),
@@ -323,7 +320,7 @@ impl Material {
         method: &str,
         arrays: [(&str, &Bound<'py, PyAny>); 2],
         lam: &Bound<'py, PyAny>,
-    ) -> PyResult<(Vectors<3>, &Spectral<'static, Box<ChannelBake>>)> {
+    ) -> PyResult<(Vectors<3>, &BoxedSpectral<'static>)> {
         let Some(spectral) = &self.spectral else {
             return Err(value_error(format!(
                 "{method} needs an index over the spectrum: a preset, eta=(lam, n, k), or one (n, k) for every channel"
@@ -365,7 +362,7 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
-        f: impl Fn(&Spectral<'static, Box<ChannelBake>>, [f32; 3], [f32; 3], f32) -> f32 + Sync,
+        f: impl Fn(&BoxedSpectral<'static>, [f32; 3], [f32; 3], f32) -> f32 + Sync,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
         let (v, model) = self.spectral_rows(py, method, [("wi", wi), ("wo", wo)], lam)?;
         let [wi, wo, lam] = &v.rows;
@@ -729,7 +726,8 @@ impl Material {
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
     /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),
-    /// `eta` (n, k every `eta_step` µm from `eta_first`), `white`, `models`
+    /// `fresnel` (F over λ every `eta_step` µm from `eta_first` and √cos θ),
+    /// `eta` (n, k at those λ), `white`, `models`
     /// (one dict with the names of `bakes()`: a quantity equal in the 19
     /// models once, as `bakes()` gives it; the others stacked along a
     /// leading node axis of 19, scalars as float64 arrays of 19) and

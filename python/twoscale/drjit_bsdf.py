@@ -28,7 +28,7 @@ its density and weight ``eval / pdf``. Particle tracing is not supported.
 Spectral variants: :class:`SpectralModel` (``brdf::Spectral``, from
 :meth:`twoscale.Material.spectral_bakes`: the 19 models' bakes stacked along
 a node axis, the two models around each of the path's four wavelengths
-interpolated in λ, with F(θd) at λ in closed form; ``pdf`` and ``sample``
+interpolated in λ, with F(θd) at λ from the runtime's table; ``pdf`` and ``sample``
 those of the sampler model, every other one, nearest the hero wavelength).
 
 **Gradients.** The bakes are fixed per material (the runtime interprets the
@@ -965,34 +965,6 @@ def _draw(model, selected, w, pick, wi, u1, u2, valid):
     return o, ok
 
 
-def _fresnel(n, k, cos):
-    """`fresnel::fresnel`: F of the index `n + ik` (f32) at `cos θ` (f32),
-    unpolarised (HP17 3-4): `(|a_s − c|²/|a_s + c|² + |a_p − c|²/|a_p + c|²)/2`
-    with one division, computed in f64 as the runtime; 0 for η² = 1."""
-    n = dr.minimum(dr.abs(mi.Float64(n)), 1e9)
-    k = dr.minimum(dr.abs(mi.Float64(k)), 1e9)
-    n = dr.select(n * n + k * k < 1e-20, 1e-10, n)
-    e_re, e_im = (n - 1.0) * (n + 1.0) - k * k, 2.0 * n * k
-    cos = dr.clip(mi.Float64(cos), 0.0, 1.0)
-    # c = √(η² − 1 + cos²θ), the runtime's principal root (`C64::sqrt`).
-    x, y = e_re + cos * cos, e_im
-    r = dr.sqrt(x * x + y * y)
-    t = dr.sqrt(0.5 * (r + dr.abs(x)))
-    t_safe = dr.select(t > 0.0, t, 1.0)
-    c_re = dr.select(x >= 0.0, t, dr.abs(y) / (2.0 * t_safe))
-    c_im = dr.select(x >= 0.0, y / (2.0 * t_safe), dr.select(y < 0.0, -t, t))
-
-    def ratio(a_re, a_im):
-        """|a − c|² and |a + c|²."""
-        return ((a_re - c_re) ** 2 + (a_im - c_im) ** 2, (a_re + c_re) ** 2 + (a_im + c_im) ** 2)
-
-    num_s, den_s = ratio(cos, 0.0)
-    num_p, den_p = ratio((n * n - k * k) * cos, e_im * cos)
-    f = 0.5 * (num_s * den_p + num_p * den_s) / (den_s * den_p)
-    f = dr.select((e_re == 0.0) & (e_im == 0.0), 0.0, f)
-    return dr.clip(mi.Float(f), 0.0, 1.0)
-
-
 class _NodeScalars:
     """A stack's scalars at per-lane model `k`: a quantity of `arrays` (one
     value per model) gathered at `k` (once per view), the others those of
@@ -1090,8 +1062,8 @@ class SpectralModel(Model):
     """The model at any wavelength of a :class:`twoscale.Material`
     (``brdf::Spectral``, ``Material.eval_spectral``) in Dr.Jit: the 19
     models of ``Material.spectral_bakes()`` sharing the surface; at λ the
-    surface lobes at λ itself (F(θd) in closed form, η linear between 1 nm
-    nodes; C from the lower model's bake at u = b cos θd/λ) with σrel/σs and
+    surface lobes at λ itself (F(θd) from the table over λ and √cos θ,
+    ``FresnelBake``; C from the lower model's bake at u = b cos θd/λ) with σrel/σs and
     Q̄/F(θd) interpolated linearly in λ between the two models; the base
     lobes interpolated in λ (docs/model.md §2.12). ``pdf`` and
     ``sample_direction`` at λ are those of the nearest of the sampler
@@ -1111,8 +1083,10 @@ class SpectralModel(Model):
         self.stack = _NodeChannel(models, per_node, len(spectral["wavelengths"]))
         self.nodes = [float(np.float32(x)) for x in spectral["wavelengths"]]
         self.node_table = mi.Float(spectral["wavelengths"])
-        self.eta = _upload(np.asarray(spectral["eta"], np.float32))
-        self.eta_nodes = spectral["eta"].shape[0]
+        self.fresnel = _upload(np.asarray(spectral["fresnel"], np.float32))
+        self.fresnel_shape = spectral["fresnel"].shape
+        # The direction bake's √cos θ nodes (`DirectionCell`'s axis).
+        self.mu_nodes = self.channels[0].shapes["direction_rows"][0]
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
         self.white = spectral["white"] != 0.0
@@ -1131,18 +1105,25 @@ class SpectralModel(Model):
         f = (lam - a) / (b - a)
         return k, dr.select(f > 0.0, dr.minimum(f, 1.0), 0.0)
 
-    def eta_at(self, lam):
-        """`Spectral::eta_at`: η at λ (f32), linear between the 1 nm nodes."""
+    def fresnel_at(self, lam, cos):
+        """`FresnelBake::at`: F at λ (f32) and `cos θ` (f32), bilinear on the
+        table's 1 nm rows and its `√cos θ` nodes (the cell of `cos θ` on the
+        direction bake's axis, `DirectionCell::coarser`)."""
+        rows, cols = self.fresnel_shape
         t = (lam - self.eta_first) / self.eta_step
-        j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), self.eta_nodes - 2)
+        j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), rows - 2)
         f = dr.clip(t - mi.Float(j), 0.0, 1.0)
+        n = self.mu_nodes
+        i, frac = _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+        m, g = _cell_at((mi.Float(i) + frac) * (1.0 / ((n - 1) // (cols - 1))), cols)
 
-        def at(col):
-            a = dr.gather(mi.Float, self.eta, 2 * j + col)
-            b = dr.gather(mi.Float, self.eta, 2 * j + 2 + col)
-            return a + f * (b - a)
+        def row(r):
+            a = dr.gather(mi.Float, self.fresnel, r * cols + m)
+            b = dr.gather(mi.Float, self.fresnel, r * cols + m + 1)
+            return a + g * (b - a)
 
-        return at(0), at(1)
+        low, high = row(j), row(j + 1)
+        return low + f * (high - low)
 
     def eval_spectral(self, wi, wo, lams):
         """ρ(wi, wo) at each wavelength of `lams` (µm; a sequence of
@@ -1174,7 +1155,7 @@ class SpectralModel(Model):
                             else mi.Float(0.0))
             a_spec, one_minus_a_over = _exp_and_one_minus_over(x_scale * pair["cos_d_sq"],
                                                                 sigma_rel_sq)
-            fl = mi.Float(1.0) if self.white else _fresnel(*self.eta_at(lam), cos_d)
+            fl = mi.Float(1.0) if self.white else self.fresnel_at(lam, cos_d)
             specular = a_spec * fl * pair["rho_geo"]
             if lower.diffraction:
                 if self.white:

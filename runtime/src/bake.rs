@@ -139,6 +139,14 @@ impl DirectionCell {
         let (index, fraction) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
         DirectionCell { index, fraction }
     }
+
+    /// The cell and fraction of the same `cos θ` on an axis of `N` nodes of
+    /// `√cos θ` (`MU_NODES − 1` a multiple of `N − 1`).
+    #[inline]
+    pub fn coarser<const N: usize>(self) -> (usize, f32) {
+        let step = ((MU_NODES - 1) / (N - 1)) as f32;
+        cell_at((self.index as f32 + self.fraction) * (1.0 / step), N)
+    }
 }
 
 /// Interpolated [`DirectionBake`] row at one `cos θ`.

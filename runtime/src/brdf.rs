@@ -78,7 +78,9 @@ use zerocopy::FromZeros;
 mod integrated;
 mod spectral;
 pub use integrated::{INTEGRATED_COUNT, INTEGRATED_WAVELENGTHS, IntegratedRgb, RgbMode, RgbModel};
-pub use spectral::{SPECTRAL_COUNT, SPECTRAL_WAVELENGTHS, Spectral};
+#[cfg(feature = "std")]
+pub use spectral::BoxedSpectral;
+pub use spectral::{FresnelBake, SPECTRAL_COUNT, SPECTRAL_WAVELENGTHS, Spectral};
 
 /// The default RGB wavelengths in µm, red, green, blue (HP15 §5.5; docs/model.md §1).
 pub const RGB_WAVELENGTHS: [f32; 3] = [0.645, 0.526, 0.444];

@@ -15,8 +15,8 @@ use std::process::Command;
 use suite::cost::{self, Inputs};
 use twoscale::TableSet;
 use twoscale::brdf::{
-    BaseLayer, ChannelBake, IntegratedRgb, Layer, MultipleScattering, Options, Rgb, Spectral,
-    TwoScale,
+    BaseLayer, BoxedSpectral, ChannelBake, IntegratedRgb, Layer, MultipleScattering, Options, Rgb,
+    Spectral, TwoScale,
 };
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 
@@ -103,7 +103,7 @@ pub struct Workload<'a> {
     /// The RGB preset by integration over the spectrum (issue 26).
     integrated: IntegratedRgb<'a, Box<ChannelBake>>,
     /// HP17's nickel geometry at any wavelength (the `nickel` preset).
-    spectral: Spectral<'a, Box<ChannelBake>>,
+    spectral: BoxedSpectral<'a>,
     inputs: Inputs,
 }
 
