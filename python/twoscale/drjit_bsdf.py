@@ -1085,8 +1085,6 @@ class SpectralModel(Model):
         self.node_table = mi.Float(spectral["wavelengths"])
         self.fresnel = _upload(np.asarray(spectral["fresnel"], np.float32))
         self.fresnel_shape = spectral["fresnel"].shape
-        # The direction bake's √cos θ nodes (`DirectionCell`'s axis).
-        self.mu_nodes = self.channels[0].shapes["direction_rows"][0]
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
         self.white = spectral["white"] != 0.0
@@ -1113,8 +1111,9 @@ class SpectralModel(Model):
         t = (lam - self.eta_first) / self.eta_step
         j = dr.minimum(mi.UInt32(dr.floor(dr.maximum(t, 0.0))), rows - 2)
         f = dr.clip(t - mi.Float(j), 0.0, 1.0)
-        n = self.mu_nodes
-        i, frac = _cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
+        ch = self.channels[0]
+        n = ch.shapes["direction_rows"][0]
+        i, frac = ch.direction_cell(cos)
         m, g = _cell_at((mi.Float(i) + frac) * (1.0 / ((n - 1) // (cols - 1))), cols)
 
         def row(r):

@@ -13,7 +13,7 @@
 //!
 //! As for [`super::IntegratedRgb`], a metal's fast colour is in F, which is
 //! read at λ per call from a per-material table ([`FresnelBake`]: the closed
-//! form at η every 1 nm and 65 nodes of √cos θd, bilinear); Q̄/F and σrel
+//! form on a grid of λ and √cos θd, bilinear); Q̄/F and σrel
 //! are smooth in λ. C depends on λ only
 //! through `u`, and model k's bake covers `[0, b/λ_k] ⊇ [0, b/λ]`: one C
 //! lookup per wavelength. `sample` and `pdf` at λ are those of the model
@@ -101,14 +101,21 @@ impl FresnelBake {
         }
     }
 
+    /// The λ row below `lambda` (clamped to the table) and the fraction
+    /// towards the next.
+    #[inline]
+    fn row(lambda: f32) -> (usize, f32) {
+        let t = (lambda - ETA_FIRST) / ETA_STEP;
+        // ⌊t⌋ for t ≥ 0 (`as` truncates; NaN → 0).
+        let j = (t.max(0.0) as usize).min(ETA_NODES - 2);
+        (j, (t - j as f32).max(0.0).min(1.0))
+    }
+
     /// F at `lambda` (clamped to the table) and at the `cos θ` of `cell`,
     /// bilinear.
     #[inline]
     fn at(&self, lambda: f32, cell: DirectionCell) -> f32 {
-        let t = (lambda - ETA_FIRST) / ETA_STEP;
-        // ⌊t⌋ for t ≥ 0 (`as` truncates; NaN → 0).
-        let j = (t.max(0.0) as usize).min(ETA_NODES - 2);
-        let f = (t - j as f32).max(0.0).min(1.0);
+        let (j, f) = Self::row(lambda);
         let (m, g) = cell.coarser::<FRESNEL_COS_NODES>();
         let (a, b) = (&self.rows[j], &self.rows[j + 1]);
         let low = a[m] + g * (a[m + 1] - a[m]);
@@ -491,9 +498,7 @@ mod tests {
                 let lambda = (0.36 + 0.47 * rng.next()) as f32;
                 let cos = rng.next() as f32;
                 let table = f64::from(bake.at(lambda, DirectionCell::new(cos)));
-                let t = (lambda - ETA_FIRST) / ETA_STEP;
-                let j = (t as usize).min(ETA_NODES - 2);
-                let f = t - j as f32;
+                let (j, f) = FresnelBake::row(lambda);
                 let [a, b] = [bake.eta[j], bake.eta[j + 1]];
                 let linear = Complex::new(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]));
                 let relative = |eta: Complex| (table / f64::from(fresnel(eta, cos)) - 1.0).abs();
