@@ -211,6 +211,12 @@ def _finite_or_zero(x):
     return dr.select(dr.isfinite(x), x, 0.0)
 
 
+def _c_of_ln(ln_c):
+    """`bake::c_of_ln`: `e^ln C`, 0 below −104 or where not finite."""
+    value = dr.exp(ln_c)
+    return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+
+
 def _exp_and_one_minus_over(x, srs):
     """`brdf::exp_and_one_minus_over`: `(e^−t, (1 − e^−t)/s)`, `t = x s`, in
     the type of `x` (f32 in the lobes). Below `t = 0.1` the second is
@@ -306,6 +312,10 @@ class _Channel:
     # -- C over (u, θh) ------------------------------------------------
     def conv(self, sin_h, cos_h, u):
         """`ConvBake::at`."""
+        return _c_of_ln(self.ln_conv(sin_h, cos_h, u))
+
+    def ln_conv(self, sin_h, cos_h, u):
+        """`ConvBake::ln_at`."""
         s, f = self.s, self.f
         n_u, n_s = self.shapes["conv_ln_c"]
         nodes_u, nodes_s = n_u - 2, n_s - 2
@@ -331,8 +341,7 @@ class _Channel:
             for b in range(4):
                 inner += ws[b] * quad[b]
             ln_c += wu[a] * inner
-        value = dr.exp(ln_c)
-        return dr.select((ln_c > -104.0) & dr.isfinite(value), value, 0.0)
+        return ln_c
 
     # -- the sampler's densities ---------------------------------------
     def lobe_weights(self, cos_i):
@@ -708,12 +717,14 @@ class _Channel:
             refracted(cos_i) + refracted(cos_o), 1e-12)
         return single + t * multi + lambertian
 
-    def lobes(self, pair, params):
+    def lobes(self, pair, params, c_value=None):
         """`TwoScale::lobes`: (specular, diffraction, base, multiple) at a pair
         (:meth:`Model.pair`'s terms), in f32, the diffraction lobe times
         `params["halo_factor"]` and the base layer's with `params`' albedo and
         k_d (:meth:`base_value`). ρ_spec = A_spec F(θd) · `g D/(4 cos θi cos θo)`
-        (the pair's), ρ_CTD = Q̄ G halo (1 − A)/σrel² C (HP17 22, 37)."""
+        (the pair's), ρ_CTD = Q̄ G halo (1 − A)/σrel² C (HP17 22, 37); C
+        from this model's bake unless `c_value` is given
+        (``TwoScale::surface_terms_with``)."""
         s, f = self.s, self.f
         cos_i, cos_o, cos_d = pair["cos_i"], pair["cos_o"], pair["cos_d"]
         at_i = self.direction(self.direction_cell(cos_i), range(8))
@@ -741,7 +752,9 @@ class _Channel:
             if s["halo_incident"]:
                 one_minus_a_over = _exp_and_one_minus_over(f["x_scale"] * cos_i * cos_i,
                                                            sigma_rel_sq)[1]
-            c_value = dr.maximum(self.conv(pair["sin_h"], pair["cos_h"], f["big_b"] * cos_d), 0.0)
+            if c_value is None:
+                c_value = dr.maximum(self.conv(pair["sin_h"], pair["cos_h"], f["big_b"] * cos_d),
+                                     0.0)
             g = pair["g"]
             diffraction = dr.select(g > 0.0, (q * g) * (f["halo_scale"] * one_minus_a_over)
                                     * c_value, 0.0) * params["halo_factor"]
@@ -1253,6 +1266,9 @@ class IntegratedModel(Model):
         self.surface = _upload(np.pad(surface, ((0, 0), (0, 4 * self.surface_packets
                                                          - surface.shape[1]))))
         self.plain = [[dr.opaque(mi.Float, float(x)) for x in row] for row in integrated["plain"]]
+        # C read at `conv_nodes`, ln C at every node by `conv_weights` over those.
+        self.conv_nodes = [int(k) for k in integrated["conv_nodes"]]
+        self.conv_weights = [[float(w) for w in row] for row in integrated["conv_weights"]]
 
     def surface_weights(self, cos_d):
         """``ColourBake::surface_at``: `R_kc` at `cos θd`, linear in
@@ -1268,15 +1284,34 @@ class IntegratedModel(Model):
         return [[dr.fma(f, b[3 * k + c] - a[3 * k + c], a[3 * k + c]) for c in range(3)]
                 for k in range(len(self.nodes))]
 
+    def conv_values(self, pair):
+        """``IntegratedRgb::ln_conv`` and its interpolation: C at every node
+        from ln C at ``conv_nodes`` (a list over the nodes; ``None`` each
+        when the surface has no diffraction lobe)."""
+        if not self.nodes[0].diffraction:
+            return [None] * len(self.nodes)
+        ln = []
+        for k in self.conv_nodes:
+            node = self.nodes[k]
+            ln.append(node.ln_conv(pair["sin_h"], pair["cos_h"], node.f["big_b"] * pair["cos_d"]))
+        values = []
+        for row in self.conv_weights:
+            x = row[0] * ln[0]
+            for w, v in zip(row[1:], ln[1:]):
+                x = dr.fma(w, v, x) if w != 0.0 else x
+            values.append(_c_of_ln(x))
+        return values
+
     def eval(self, wi, wo):
         """ρ(wi, wo) in linear sRGB (sr⁻¹) as an ``mi.Color3f``
         (``IntegratedRgb::eval``; arguments as :meth:`Model.eval`'s)."""
         valid, geo = self.geometry(wi, wo)
         pair = self.pair(geo)
         r = self.surface_weights(pair["cos_d"])
+        c_values = self.conv_values(pair)
         out = [mi.Float(0.0)] * 3
         for k, node in enumerate(self.nodes):
-            spec, diff, base, multiple = node.lobes(pair, self.params)
+            spec, diff, base, multiple = node.lobes(pair, self.params, c_values[k])
             surface = spec + diff
             # The compensation lobe's colour is F_avg's, per node: plain weights.
             rest = base + multiple

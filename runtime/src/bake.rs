@@ -576,6 +576,12 @@ impl ConvBake {
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
+        c_of_ln(self.ln_at(sin_h, cos_h, u))
+    }
+
+    /// `ln C` of [`ConvBake::at`] (finite: the bake's floor bounds it below).
+    #[inline]
+    pub fn ln_at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
         let u = u.max(0.0).min(self.big_b);
         // 1/cos θh and tan θh do not wait for `w(u)`: only a multiply-add does.
         let sec_h = 1.0 / cos_h.max(COS_H_MIN as f32);
@@ -594,13 +600,19 @@ impl ConvBake {
             let taps = &row[ks..ks + 4];
             ln_c += wa * (taps[0] * ws[0] + taps[1] * ws[1] + taps[2] * ws[2] + taps[3] * ws[3]);
         }
-        // e^x is 0 in f32 below x ≈ −103.3.
-        if !(ln_c > -104.0) {
-            return 0.0;
-        }
-        let value = math::expf(ln_c);
-        if value.is_finite() { value } else { 0.0 }
+        ln_c
     }
+}
+
+/// `C = e^ln C` of [`ConvBake::ln_at`], 0 where it is not finite.
+#[inline]
+pub(crate) fn c_of_ln(ln_c: f32) -> f32 {
+    // e^x is 0 in f32 below x ≈ −103.3.
+    if !(ln_c > -104.0) {
+        return 0.0;
+    }
+    let value = math::expf(ln_c);
+    if value.is_finite() { value } else { 0.0 }
 }
 
 /// The θh axis's value at `cos θh = 10⁻³` (its last node) for `1/w`.

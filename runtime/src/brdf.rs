@@ -1048,16 +1048,23 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// terms (F = Q̄ = 1) when `white`.
     #[inline(always)]
     fn surface_terms(&self, pair: &Pair, white: bool) -> SurfaceTerms {
+        let g = &pair.geometry;
+        let u = (self.big_b * g.cos_d) as f32;
+        self.surface_terms_with(pair, white, || self.conv_at(g.sin_h, g.cos_h, u))
+    }
+
+    /// [`TwoScale::surface_terms`] with C(θh; u) from `conv` (called only
+    /// where the diffraction lobe is evaluated; `IntegratedRgb` hands in C
+    /// interpolated over its wavelengths).
+    #[inline(always)]
+    fn surface_terms_with(
+        &self,
+        pair: &Pair,
+        white: bool,
+        conv: impl FnOnce() -> f64,
+    ) -> SurfaceTerms {
         let Pair {
-            geometry:
-                Geometry {
-                    wi,
-                    wo,
-                    cos_d,
-                    cos_h,
-                    sin_h,
-                    ..
-                },
+            geometry: Geometry { wi, wo, cos_d, .. },
             d,
             g,
             cells,
@@ -1101,8 +1108,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
                     cos_i,
                     sigma_rel_sq,
                 );
-            let c_value = self.conv_at(sin_h, cos_h, (self.big_b * cos_d) as f32);
-            q * g * halo * c_value
+            q * g * halo * conv()
         } else {
             0.0
         };
@@ -1114,6 +1120,13 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             at_i,
             at_o,
         }
+    }
+
+    /// `ln C(θh; u)` of [`TwoScale::conv_at`] when C is baked.
+    #[inline(always)]
+    fn ln_conv_at(&self, sin_h: f64, cos_h: f64, u: f32) -> Option<f32> {
+        let bake = self.bake().conv()?;
+        Some(bake.ln_at(sin_h as f32, cos_h as f32, u))
     }
 
     /// C(θh; u) (≥ 0) from the bake, or from the source of C when it offers

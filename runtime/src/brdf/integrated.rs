@@ -15,13 +15,16 @@
 //! changes fast with λ (gold's edge at 0.47–0.55 µm), is integrated at the
 //! 85 CIE wavelengths; what is left is smooth in λ and interpolated from
 //! the 8. `R_kc` is tabulated per material over `√cos θd` (65 nodes,
-//! linear). White colour terms (F ≡ 1) make `R = P`. A channel that comes
-//! out negative (a spectrum outside the sRGB gamut) is clamped to 0.
+//! linear). White colour terms (F ≡ 1) make `R = P`. C is read at 4 of the
+//! 8 wavelengths ([`CONV_NODES`]) and `ln C` at the others is the cubic
+//! through those in `u = b cos θd/λ` ([`CONV_WEIGHTS`]). A channel that
+//! comes out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
 use super::{
     BakeVisitor, ChannelBake, ColourTerms, Geometry, NodeBakes, Options, RgbSample, SurfaceBakes,
     Tables, TwoScale, finite_or_zero,
 };
+use crate::bake::c_of_ln;
 use crate::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use crate::fresnel::fresnel;
 use crate::math::{self, BELOW_ONE};
@@ -41,6 +44,43 @@ pub const INTEGRATED_WAVELENGTHS: [f32; INTEGRATED_COUNT] =
 /// The nodes whose samplers [`IntegratedRgb::sample`] mixes: near the
 /// paper's red, green and blue (0.62, 0.52, 0.43 µm).
 const SAMPLER_NODES: [usize; 3] = [5, 3, 1];
+
+/// The models whose C [`IntegratedRgb::eval`] looks up (0.38, 0.47, 0.62,
+/// 0.72 µm); the others take `ln C` from the cubic through these
+/// ([`CONV_WEIGHTS`]; docs/design/rgb-integration.md).
+const CONV_NODES: [usize; 4] = [0, 2, 5, 7];
+
+/// `ln C_k = Σ_j CONV_WEIGHTS[k][j] ln C_{CONV_NODES[j]}`: the Lagrange
+/// weights of the cubic through the [`CONV_NODES`] in `u = b cos θd/λ`.
+/// `u_k ∝ 1/λ_k` at every pair, so the weights are constants; the rows of
+/// the `CONV_NODES` themselves are unit vectors.
+const CONV_WEIGHTS: [[f32; 4]; INTEGRATED_COUNT] = conv_weights();
+
+const fn conv_weights() -> [[f32; 4]; INTEGRATED_COUNT] {
+    const fn x(k: usize) -> f64 {
+        1.0 / INTEGRATED_WAVELENGTHS[k] as f64
+    }
+    let mut out = [[0.0; 4]; INTEGRATED_COUNT];
+    let mut k = 0;
+    while k < INTEGRATED_COUNT {
+        let mut j = 0;
+        while j < 4 {
+            let mut w = 1.0;
+            let mut m = 0;
+            while m < 4 {
+                if m != j {
+                    let (xj, xm) = (x(CONV_NODES[j]), x(CONV_NODES[m]));
+                    w *= (x(k) - xm) / (xj - xm);
+                }
+                m += 1;
+            }
+            out[k][j] = w as f32;
+            j += 1;
+        }
+        k += 1;
+    }
+    out
+}
 
 /// `√cos θd` nodes of [`ColourBake`].
 const COLOUR_NODES: usize = 65;
@@ -192,6 +232,8 @@ pub struct IntegratedRgb<'a, B = ChannelBake> {
     /// Whether the models have a base lobe, `k_d` or the compensation lobe
     /// (else their `ρ_base + ρ_ms` is 0 and is not evaluated).
     diffuse: bool,
+    /// Whether the surface has a diffraction lobe (σs > 0, b > 0).
+    halo: bool,
 }
 
 #[cfg(feature = "std")]
@@ -225,10 +267,12 @@ impl<'a, B: BorrowMut<ChannelBake>> IntegratedRgb<'a, B> {
         );
         let colour = ColourBake::new(material, options.colour == ColourTerms::White);
         let diffuse = nodes.iter().any(|node| node.has_lobes().1);
+        let halo = nodes[0].has_lobes().0;
         IntegratedRgb {
             nodes,
             colour,
             diffuse,
+            halo,
         }
     }
 }
@@ -244,8 +288,9 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     /// `Material.integrated_bakes()`): `wavelengths` ([`INTEGRATED_WAVELENGTHS`],
     /// µm), `surface` (`R_kc` at the `√cos θd` nodes, `[nodes, 8, 3]`),
     /// `plain` (`P_kc`, `[8, 3]`) and `sampler_nodes` (the nodes whose
-    /// samplers [`IntegratedRgb::sample`] mixes, as numbers). Each node's
-    /// bakes are its [`TwoScale::visit_bakes`].
+    /// samplers [`IntegratedRgb::sample`] mixes, as numbers), `conv_nodes`
+    /// (the models whose C `eval` reads, as numbers) and `conv_weights`
+    /// (`[8, 4]`: `ln C` at each model over those; module documentation). Each node's bakes are its [`TwoScale::visit_bakes`].
     #[doc(hidden)]
     pub fn visit_colour(&self, v: &mut dyn BakeVisitor) {
         v.array("wavelengths", &[INTEGRATED_COUNT], &INTEGRATED_WAVELENGTHS);
@@ -261,19 +306,56 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
             &[SAMPLER_NODES.len()],
             &SAMPLER_NODES.map(|k| k as f32),
         );
+        v.array(
+            "conv_nodes",
+            &[CONV_NODES.len()],
+            &CONV_NODES.map(|k| k as f32),
+        );
+        v.array(
+            "conv_weights",
+            &[INTEGRATED_COUNT, CONV_NODES.len()],
+            CONV_WEIGHTS.as_flattened(),
+        );
     }
 
-    /// ρ(i, o) per linear-sRGB channel (module documentation).
+    /// `ln C` at the [`CONV_NODES`]' wavelengths, when they are baked.
+    #[inline(always)]
+    fn ln_conv(&self, geometry: &Geometry) -> Option<[f32; 4]> {
+        let mut ln = [0.0; 4];
+        for (value, &k) in ln.iter_mut().zip(&CONV_NODES) {
+            let node = &self.nodes[k];
+            let u = (node.big_b * geometry.cos_d) as f32;
+            *value = node.ln_conv_at(geometry.sin_h, geometry.cos_h, u)?;
+        }
+        Some(ln)
+    }
+
+    /// ρ(i, o) per linear-sRGB channel (module documentation; C read at 4
+    /// of the wavelengths and interpolated at the others).
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 3];
         };
-        let r = self.colour.surface_at(pair.geometry.cos_d);
+        let g = &pair.geometry;
+        let ln_c = if self.halo && pair.g > 0.0 {
+            self.ln_conv(g)
+        } else {
+            None
+        };
+        let r = self.colour.surface_at(g.cos_d);
         let mut out = [0.0f64; 3];
-        let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
+        let (cos_i, cos_o) = (g.wi[2], g.wo[2]);
         for (k, node) in self.nodes.iter().enumerate() {
+            let conv = || match ln_c {
+                Some(ln) => {
+                    let w = &CONV_WEIGHTS[k];
+                    let x = w[0] * ln[0] + w[1] * ln[1] + w[2] * ln[2] + w[3] * ln[3];
+                    f64::from(c_of_ln(x))
+                }
+                None => node.conv_at(g.sin_h, g.cos_h, (node.big_b * g.cos_d) as f32),
+            };
             // `TwoScale::lobes` in f64, without rounding each lobe to f32.
-            let t = node.surface_terms(&pair, node.white());
+            let t = node.surface_terms_with(&pair, node.white(), conv);
             let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
             let surface = finite(t.a_spec * t.rho_ct + t.diffraction);
             if self.diffuse {
