@@ -326,17 +326,35 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
         }
     }
 
+    /// ρ at a wavelength [`Spectral::start`]ed.
+    #[inline(always)]
+    fn finish(&self, pair: &Pair, (lambda, fl, (k, f)): (f32, f64, (usize, f64))) -> f32 {
+        let (a, b) = self.terms(pair, k);
+        self.at_lambda(pair, lambda, fl, (k, f), &a, &b)
+    }
+
     /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
-    /// the pair's geometry, D and G once, then F at each wavelength
-    /// (`Spectral::start`), then each wavelength's models
-    /// (`Spectral::finish`).
+    /// the pair's geometry, D and G once, then three passes over the
+    /// wavelengths, so that the four wavelengths' table reads overlap:
+    /// [`Spectral::start`] (F), [`Spectral::terms`], [`Spectral::at_lambda`].
+    /// (Loops over arrays: `array::map` here was not inlined and cost 4%.)
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 4];
         };
-        // Every λ's cell and F first, then the models.
-        let started = lambdas.map(|lambda| self.start(&pair, lambda));
-        started.map(|s| self.finish(&pair, s))
+        let mut started = [(0.0, 0.0, (0, 0.0)); 4];
+        for (s, &lambda) in started.iter_mut().zip(&lambdas) {
+            *s = self.start(&pair, lambda);
+        }
+        let mut terms = [(NodeTerms::default(), NodeTerms::default()); 4];
+        for (t, &(_, _, (k, _))) in terms.iter_mut().zip(&started) {
+            *t = self.terms(&pair, k);
+        }
+        let mut out = [0.0; 4];
+        for ((o, &(lambda, fl, kf)), (a, b)) in out.iter_mut().zip(&started).zip(&terms) {
+            *o = self.at_lambda(&pair, lambda, fl, kf, a, b);
+        }
+        out
     }
 
     /// What comes first at `lambda`: λ clamped, its models' cell `(k, f)`
@@ -349,15 +367,15 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
         (lambda, fl, (k, f64::from(f)))
     }
 
-    /// ρ at a wavelength [`Spectral::start`]ed: its two models' terms
-    /// ([`NodeTerms`]; not shared between wavelengths: a renderer's
-    /// wavelengths rarely share a model, and a cache cost more than it
-    /// saved) and [`Spectral::at_lambda`].
+    /// The terms of the models `k` and `k + 1` ([`NodeTerms`]; not shared
+    /// between wavelengths: a renderer's wavelengths rarely share a model,
+    /// and a cache cost more than it saved).
     #[inline(always)]
-    fn finish(&self, pair: &Pair, (lambda, fl, (k, f)): (f32, f64, (usize, f64))) -> f32 {
-        let a = NodeTerms::new(&self.nodes[k], pair, self.white, self.diffuse);
-        let b = NodeTerms::new(&self.nodes[k + 1], pair, self.white, self.diffuse);
-        self.at_lambda(pair, lambda, fl, (k, f), &a, &b)
+    fn terms(&self, pair: &Pair, k: usize) -> (NodeTerms, NodeTerms) {
+        (
+            NodeTerms::new(&self.nodes[k], pair, self.white, self.diffuse),
+            NodeTerms::new(&self.nodes[k + 1], pair, self.white, self.diffuse),
+        )
     }
 
     /// F(η(λ), θd) at `lambda` (clamped) and the cell of `cos θd`
