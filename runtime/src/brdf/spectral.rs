@@ -336,7 +336,7 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// ρ(i, o) at four wavelengths (µm), as spectral renderers carry them:
     /// the pair's geometry, D and G once, then three passes over the
     /// wavelengths, so that the four wavelengths' table reads overlap:
-    /// [`Spectral::start`] (F), [`Spectral::terms`], [`Spectral::at_lambda`].
+    /// `Spectral::start` (F), `Spectral::terms`, `Spectral::at_lambda`.
     /// (Loops over arrays: `array::map` here was not inlined and cost 4%.)
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
