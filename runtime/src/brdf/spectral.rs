@@ -326,7 +326,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
         }
     }
 
-    /// ρ at a wavelength [`Spectral::start`]ed.
+    /// `eval`'s ρ at a wavelength [`Spectral::start`]ed (not `eval4`'s
+    /// passes, which made the one wavelength slower).
     #[inline(always)]
     fn finish(&self, pair: &Pair, (lambda, fl, (k, f)): (f32, f64, (usize, f64))) -> f32 {
         let (a, b) = self.terms(pair, k);
@@ -337,7 +338,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// the pair's geometry, D and G once, then three passes over the
     /// wavelengths, so that the four wavelengths' table reads overlap:
     /// `Spectral::start` (F), `Spectral::terms`, `Spectral::at_lambda`.
-    /// (Loops over arrays: `array::map` here was not inlined and cost 4%.)
+    /// (Plain loops: `array::map`'s closures here were not inlined;
+    /// docs/design/rgb-integration.md.)
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 4];
