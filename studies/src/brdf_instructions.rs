@@ -14,10 +14,8 @@ use std::hint::black_box;
 use std::process::Command;
 use suite::cost::{self, Inputs};
 use twoscale::TableSet;
-use twoscale::brdf::{
-    BaseLayer, BoxedSpectral, ChannelBake, IntegratedRgb, Layer, MultipleScattering, Options, Rgb,
-    Spectral, TwoScale,
-};
+use twoscale::brdf::{BoxedSpectral, ChannelBake, IntegratedRgb, Rgb, Spectral, TwoScale};
+use twoscale::material::{BaseLayer, Layer, MultipleScattering, Options};
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
@@ -109,7 +107,10 @@ pub struct Workload<'a> {
 
 impl<'a> Workload<'a> {
     /// The models of `suite::cost` on `set` (and T3a's fit, kept in `fit`).
-    pub fn new(set: &'a TableSet<'static>, fit: &'a twoscale::conv::ConvFitTable<'static>) -> Self {
+    pub fn new(
+        set: &'a TableSet<'static>,
+        fit: &'a twoscale::tables::convolution::ConvFitTable<'static>,
+    ) -> Self {
         let (rgb, rgb_eta) = cost::rgb_preset(set);
         Workload {
             set,

@@ -71,7 +71,7 @@ struct Layout {
 
 impl Layout {
     /// The parameter axes (and sets [`t3_angle::XI_COUNT`]).
-    fn grid(&self) -> Result<[twoscale::format::AxisHeader; 4], String> {
+    fn grid(&self) -> Result<[twoscale::tables::format::AxisHeader; 4], String> {
         if let Some(n) = self.xi {
             if n < 4 {
                 return Err(format!("--xi {n}: at least 4"));

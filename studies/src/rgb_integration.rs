@@ -2,7 +2,7 @@
 //! what the paper's three wavelengths miss, and how few wavelengths an
 //! integrating RGB model needs.
 //!
-//! The reference is the CIE 5 nm sum of `twoscale::colour` over 85
+//! The reference is the CIE 5 nm sum of `twoscale::spectrum::colour` over 85
 //! one-wavelength models, each built at its λ with the preset's measured
 //! η(λ). The candidates, evaluated at the same pairs, interpolate a spectrum
 //! from K wavelengths λ_k with a basis `L_k(λ)` and integrate the
@@ -23,10 +23,11 @@
 //! exceeds 1e-3 of the preset's largest value at the pairs.
 
 use twoscale::TableSet;
-use twoscale::brdf::{ChannelBake, Options, TwoScale};
-use twoscale::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
-use twoscale::fresnel::{fresnel, q_bar};
+use twoscale::brdf::{ChannelBake, TwoScale};
+use twoscale::material::Options;
 use twoscale::materials::SPECTRAL_PRESETS;
+use twoscale::model::fresnel::{fresnel, q_bar};
+use twoscale::spectrum::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use twoscale_reference::rng::SplitMix64;
 
 /// The candidate wavelength counts.

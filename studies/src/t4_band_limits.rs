@@ -1,13 +1,15 @@
 //! T4's band limits (`docs/design/t4-band-limits.md`): the error of the
 //! projected BRDF against band limit `L` — relative RMS of
 //! `f = ρ cos θi cos θo` and p99 / max of `|f_SH − f| / max f` over 20 000
-//! random pairs (`t4::verification_pairs`, seed 11) — and the asymmetry
+//! random pairs (`sh_brdf::verification_pairs`, seed 11) — and the asymmetry
 //! `‖M − Mᵀ‖/‖M‖` before symmetrising (WAT92 26–27).
 
 use generator::analytic::BeckmannCt;
 use generator::materials::Materials;
 use generator::sh::{IsotropicBrdf, default_quadrature, project};
-use generator::tables::t4::{ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verification_pairs};
+use generator::tables::sh_brdf::{
+    ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verification_pairs,
+};
 use std::path::Path;
 use std::time::Instant;
 

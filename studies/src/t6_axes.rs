@@ -2,20 +2,20 @@
 //! axis's power against the interpolated error, the file size and the build
 //! time (docs/design/t6-albedo-axes.md).
 //!
-//! Each layout is built by the generator's own `t6::build_with` (the
-//! shipped coordinates of `twoscale::albedo`), read by the runtime's
+//! Each layout is built by the generator's own `albedo::build_with` (the
+//! shipped coordinates of `twoscale::tables::albedo`), read by the runtime's
 //! `AlbedoTable`, and measured at `generator verify`'s kind of random points
-//! (`t6::verification_points`, seed 99) against `albedo_pair`, the build's
+//! (`albedo::verification_points`, seed 99) against `albedo_pair`, the build's
 //! fixed rule (within 3e-6 of the adaptive reference, its test): a table's
 //! error at many points in seconds. The points' p is snapped to 50 values so
 //! that 50 Λ curves serve them.
 
 use generator::reference::albedo::albedo_pair;
 use generator::reference::epd::LambdaCurve;
-use generator::tables::t6;
+use generator::tables::albedo;
 use rayon::prelude::*;
-use twoscale::brdf::Masking;
-use twoscale::format::{AxisHeader, Mapping};
+use twoscale::material::Masking;
+use twoscale::tables::format::{AxisHeader, Mapping};
 
 /// A layout `ny,nz,np,power` (p even in `p^power`).
 pub fn parse_layout(s: &str) -> Result<[f64; 4], String> {
@@ -28,7 +28,7 @@ pub fn parse_layout(s: &str) -> Result<[f64; 4], String> {
 
 /// Builds and measures each layout; prints one row per layout.
 pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
-    let samples = t6::verification_points(points, 99);
+    let samples = albedo::verification_points(points, 99);
     let ps: Vec<f64> = samples.iter().take(50).map(|s| s.0).collect();
     let curves: Vec<LambdaCurve> = ps
         .par_iter()
@@ -48,24 +48,24 @@ pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
         let axes = [
             AxisHeader {
                 nodes: ny as u32,
-                ..t6::Y_AXIS
+                ..albedo::Y_AXIS
             },
             AxisHeader {
                 nodes: nz as u32,
-                ..t6::Z_AXIS
+                ..albedo::Z_AXIS
             },
             AxisHeader {
                 nodes: np as u32,
                 mapping: Mapping::Power,
                 param: power,
-                ..t6::P_AXIS
+                ..albedo::P_AXIS
             },
         ];
         let start = std::time::Instant::now();
-        let bytes =
-            t6::build_with(axes, &indicatif::ProgressBar::hidden()).map_err(|e| e.to_string())?;
+        let bytes = albedo::build_with(axes, &indicatif::ProgressBar::hidden())
+            .map_err(|e| e.to_string())?;
         let seconds = start.elapsed().as_secs_f64();
-        let buf = twoscale::format::aligned_copy(&bytes);
+        let buf = twoscale::tables::format::aligned_copy(&bytes);
         let table = twoscale::AlbedoTable::from_bytes(buf.bytes()).map_err(|e| e.to_string())?;
         let mut errors: Vec<(f64, String)> = samples
             .par_iter()
