@@ -220,3 +220,36 @@ pub fn percentiles(v: &mut [f64], qs: &[f64]) -> String {
         .collect();
     cells.join(" ")
 }
+
+/// Fails early, before a study's work, when `path` (its `--markdown` file)
+/// could not be written: its directory does not exist.
+pub fn check_markdown(path: Option<&Path>) -> Result<(), String> {
+    let Some(path) = path else { return Ok(()) };
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{}: no directory {}",
+            path.display(),
+            dir.display()
+        ))
+    }
+}
+
+/// Writes a study's tables `body` (markdown) to `path` under `title` and the
+/// command that regenerates the file, `studies COMMAND --markdown PATH`, as
+/// `generator verify --markdown` writes docs/accuracy.md: the figures of a
+/// record live in a generated file under docs/figures/ instead of the
+/// record's text.
+pub fn write_markdown(path: &Path, title: &str, command: &str, body: &str) -> Result<(), String> {
+    let text = format!(
+        "# {title}\n\nWritten by `cargo run --release -p studies -- {command} --markdown {}` \
+         (do not edit: rerun the command).\n\n{body}",
+        path.display()
+    );
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}

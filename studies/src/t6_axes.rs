@@ -10,10 +10,13 @@
 //! error at many points in seconds. The points' p is snapped to 50 values so
 //! that 50 Λ curves serve them.
 
+use crate::common;
 use generator::reference::albedo::albedo_pair;
 use generator::reference::epd::LambdaCurve;
 use generator::tables::albedo;
 use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
 use twoscale::material::Masking;
 use twoscale::tables::format::{AxisHeader, Mapping};
 
@@ -26,8 +29,11 @@ pub fn parse_layout(s: &str) -> Result<[f64; 4], String> {
     <[f64; 4]>::try_from(v).map_err(|_| format!("{s}: a layout is ny,nz,np,power"))
 }
 
-/// Builds and measures each layout; prints one row per layout.
-pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
+/// Builds and measures each layout; prints one row per layout (and writes
+/// the table to `markdown` when given). Build times go to stderr: they are
+/// the machine's, not the layout's.
+pub fn run(layouts: &[[f64; 4]], points: usize, markdown: Option<&Path>) -> Result<(), String> {
+    common::check_markdown(markdown)?;
     let samples = albedo::verification_points(points, 99);
     let ps: Vec<f64> = samples.iter().take(50).map(|s| s.0).collect();
     let curves: Vec<LambdaCurve> = ps
@@ -41,8 +47,9 @@ pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
             albedo_pair(&curves[k % 50], beta, mu).map_err(|e| e.to_string())
         })
         .collect::<Result<_, _>>()?;
-    println!(
-        "ny nz np power | bytes | build s | max |ΔE| | p99 | p90 | median | worst at (masking, p, β, μ)"
+    let mut out = String::from(
+        "| ny nz np, p power | bytes | max \\|ΔE\\| | p99 | p90 | median | worst at (masking, p, β, μ) |\n\
+         |---|---:|---:|---:|---:|---:|---|\n",
     );
     for &[ny, nz, np, power] in layouts {
         let axes = [
@@ -89,8 +96,10 @@ pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
             .collect();
         errors.sort_by(|a, b| b.0.total_cmp(&a.0));
         let at = |q: f64| errors[((errors.len() - 1) as f64 * q) as usize].0;
-        println!(
-            "{ny} {nz} {np} {power} | {} | {seconds:.1} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {}",
+        eprintln!("{ny} {nz} {np} {power}: built in {seconds:.1} s");
+        let _ = writeln!(
+            out,
+            "| {ny} {nz} {np}, {power} | {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {} |",
             bytes.len(),
             errors[0].0,
             at(0.01),
@@ -99,5 +108,24 @@ pub fn run(layouts: &[[f64; 4]], points: usize) -> Result<(), String> {
             errors[0].1
         );
     }
-    Ok(())
+    print!("{out}");
+    let Some(path) = markdown else {
+        return Ok(());
+    };
+    let layouts: Vec<String> = layouts
+        .iter()
+        .map(|l| format!("--layout {},{},{},{}", l[0], l[1], l[2], l[3]))
+        .collect();
+    common::write_markdown(
+        path,
+        "T6's layouts: size and interpolated error",
+        &format!("t6-axes --points {points} {}", layouts.join(" ")),
+        &format!(
+            "Each layout (nodes of the incidence y, the width z and p; p even in \
+             `p^power`) built by the generator's `albedo::build_with` and read by the \
+             runtime's `AlbedoTable`, at {points} random points of `generator verify`'s \
+             kind (seed 99), each for both maskings, against `albedo_pair` (the build's \
+             rule); `|ΔE|` absolute.\n\n{out}"
+        ),
+    )
 }
