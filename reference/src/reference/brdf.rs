@@ -375,3 +375,48 @@ impl twoscale::Convolution for ExactConvolution {
         .unwrap_or(0.0)
     }
 }
+
+/// [`ExactConvolution`] whose profiles a model bakes: its per-material C
+/// bake holds the exact C at its 33 × 130 nodes (each row one
+/// [`conv::convolution_profile`]), so that the model's C differs from the
+/// exact one by the bake's interpolation only. Construction costs seconds
+/// of CPU per wavelength (docs/design/brdf-accuracy.md); pointwise lookups
+/// (a model without a bake) are [`ExactConvolution`]'s.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ExactProfiles;
+
+impl twoscale::Convolution for ExactProfiles {
+    fn convolution_sin_cos(&self, sin: f32, cos: f32, u: f32, c: f32, beta: f32, p: f32) -> f32 {
+        ExactConvolution.convolution_sin_cos(sin, cos, u, c, beta, p)
+    }
+
+    fn bakes_profiles(&self) -> bool {
+        true
+    }
+
+    fn ln_profile(&self, u: f32, c: f32, beta: f32, p: f32, tans: &[f32], out: &mut [f32]) {
+        let angles: Vec<f64> = tans
+            .iter()
+            .map(|&t| {
+                f64::from(t.max(0.0))
+                    .atan()
+                    .min(std::f64::consts::FRAC_PI_2)
+            })
+            .collect();
+        let values = conv::convolution_profile(
+            f64::from(u),
+            f64::from(c),
+            f64::from(beta),
+            f64::from(p),
+            &angles,
+        );
+        for (k, slot) in out.iter_mut().enumerate().take(tans.len()) {
+            let value = values.as_ref().map_or(0.0, |v| v[k]);
+            *slot = if value > 0.0 {
+                (value.ln() as f32).max(f32::MIN)
+            } else {
+                f32::MIN
+            };
+        }
+    }
+}

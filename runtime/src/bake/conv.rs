@@ -78,6 +78,24 @@ impl ConvBake {
     /// evaluated in f32 at the nodes); `beta`, `p` give the NDF's core width.
     /// `false` (and `self` left as it was) when `B` is not positive and finite.
     pub fn init(&mut self, slice: &ConvSlice<'_>, big_b: f32, beta: f32, p: f32) -> bool {
+        self.init_from(
+            |u, tans, row| slice.ln_profile_at_tans(u, tans, row),
+            big_b,
+            beta,
+            p,
+        )
+    }
+
+    /// [`ConvBake::init`] from any source of rows: `rows(u, tans, out)`
+    /// writes `ln C − ln s` at each `tan θh` of `tans` into `out` and
+    /// returns the factor `s` (`None`: the row is 0).
+    pub fn init_from(
+        &mut self,
+        mut rows: impl FnMut(f32, &[f32], &mut [f32]) -> Option<f32>,
+        big_b: f32,
+        beta: f32,
+        p: f32,
+    ) -> bool {
         if !(big_b > 0.0 && big_b.is_finite()) {
             return false;
         }
@@ -111,7 +129,7 @@ impl ConvBake {
             let tans = row_tans(inv_w);
             let row = &mut bake.ln_c[(j + 1) * PADDED_S + 1..(j + 1) * PADDED_S + 1 + CONV_S_NODES];
             // ln C = ln s + the profile (s = 1 inside T3's u range).
-            match slice.ln_profile_at_tans(u, &tans, row) {
+            match rows(u, &tans, row) {
                 Some(factor) if factor > 0.0 => {
                     let ln_factor = math::lnf(factor);
                     for v in row.iter_mut() {

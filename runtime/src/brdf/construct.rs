@@ -220,8 +220,20 @@ impl<'a, B: BorrowMut<ChannelBake>> TwoScale<'a, B> {
             bake.radial_norm.clear();
         }
         if what.conv {
+            let (c, beta, p) = (surface.c, surface.beta, surface.p);
+            let source = tables.convolution;
             bake.conv_baked = match &shared.slice {
-                Some(slice) => bake.conv.init(slice, big_b as f32, surface.beta, surface.p),
+                Some(slice) => bake.conv.init(slice, big_b as f32, beta, p),
+                // A source without a slice that bakes: sampled at the nodes.
+                None if sigma_s > 0.0 && source.bakes_profiles() => bake.conv.init_from(
+                    |u, tans, row| {
+                        source.ln_profile(u, c, beta, p, tans, row);
+                        Some(1.0)
+                    },
+                    big_b as f32,
+                    beta,
+                    p,
+                ),
                 None => false,
             };
         }

@@ -218,7 +218,8 @@ pub struct ChannelBake {
     radial_norm: RadialNormBake,
     /// `C` over `(u, θh)` for this material, valid when `conv_baked`.
     conv: ConvBake,
-    /// Whether `conv` holds C (the source of C offers a slice, as T3b does);
+    /// Whether `conv` holds C (the source of C offers a slice, as T3b does,
+    /// or bakes its profiles);
     /// else the source is read directly.
     conv_baked: bool,
     /// The halo sampler's densities over the half-vector, from `conv`

@@ -138,6 +138,30 @@ pub trait Convolution {
     fn material_slice(&self, _c: f32, _beta: f32, _p: f32) -> Option<ConvSlice<'_>> {
         None
     }
+
+    /// Whether the per-material bake of a model samples this source at its
+    /// nodes ([`Convolution::ln_profile`]) when it offers no
+    /// [`Convolution::material_slice`]; `false` by default, so that a model
+    /// reads a stand-in pointwise.
+    fn bakes_profiles(&self) -> bool {
+        false
+    }
+
+    /// `ln C` at every `tan θh` of `tans` for one `u` and material, into the
+    /// same positions of `out` (`f32::MIN` where C is not positive): what
+    /// the per-material bake samples when [`Convolution::bakes_profiles`].
+    /// By default `ln` of [`Convolution::convolution_sin_cos`] at each angle.
+    fn ln_profile(&self, u: f32, c: f32, beta: f32, p: f32, tans: &[f32], out: &mut [f32]) {
+        for (&tan, slot) in tans.iter().zip(out.iter_mut()) {
+            let sec = math::sqrtf(1.0 + tan * tan);
+            let value = self.convolution_sin_cos(tan / sec, 1.0 / sec, u, c, beta, p);
+            *slot = if value > 0.0 {
+                math::lnf(value)
+            } else {
+                f32::MIN
+            };
+        }
+    }
 }
 
 /// The K-correlation kernel shape `k(x) = (1 + x²)^(−(c+1)/2)` (HP17 14, 40),
