@@ -20,6 +20,7 @@
 pub use twoscale_reference::{bspline, fit, quad, reference, rng};
 
 pub mod analytic;
+pub mod brdf_accuracy;
 pub mod build;
 pub mod error;
 pub mod export;

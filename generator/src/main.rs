@@ -97,6 +97,12 @@ enum Command {
         /// and seed give the same bytes).
         #[arg(long, value_name = "FILE")]
         markdown: Option<PathBuf>,
+        /// Random materials of the BRDF section (24 direction pairs each).
+        #[arg(long, default_value_t = generator::brdf_accuracy::DEFAULT_SIZE.materials)]
+        brdf_materials: usize,
+        /// How many of them also get an exact-node C bake (seconds of CPU each).
+        #[arg(long, default_value_t = generator::brdf_accuracy::DEFAULT_SIZE.exact)]
+        brdf_exact: usize,
     },
     /// Recompute a spread of grid nodes of tables too expensive to rebuild
     /// in CI (T3) and compare their bits with the files in a directory.
@@ -261,6 +267,8 @@ fn main() -> ExitCode {
             seed,
             threads,
             markdown,
+            brdf_materials,
+            brdf_exact,
         } => set_threads(threads).and_then(|()| {
             let source = TableSource::new(dir);
             let t4 = t4_tables(materials.as_deref(), &source)?;
@@ -270,6 +278,11 @@ fn main() -> ExitCode {
                 points,
                 seed,
                 markdown: markdown.as_deref(),
+                brdf: generator::brdf_accuracy::Size {
+                    materials: brdf_materials,
+                    exact: brdf_exact.min(brdf_materials),
+                    ..generator::brdf_accuracy::DEFAULT_SIZE
+                },
             };
             generator::verify::verify(&kinds, &source, &args)
         }),

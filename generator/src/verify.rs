@@ -9,6 +9,7 @@ use std::time::Instant;
 use twoscale::Table;
 use twoscale::tables::format::write::write_atomic;
 
+use crate::brdf_accuracy;
 use crate::error::{Error, FileAction};
 use crate::report::{self, TableReport};
 use crate::spectral_accuracy;
@@ -27,12 +28,19 @@ pub struct VerifyArgs<'a> {
     pub seed: u64,
     /// Where to write the markdown report, if anywhere.
     pub markdown: Option<&'a Path>,
+    /// The size of the BRDF section ([`brdf_accuracy::DEFAULT_SIZE`] in CI).
+    pub brdf: brdf_accuracy::Size,
 }
 
-/// The spectral bakes' accuracy ([`spectral_accuracy`]) on the model tables
-/// of `source` (its directory's if it holds them all, else the embedded
-/// ones, as T4 reads them).
-fn spectral_report(source: &TableSource, seed: u64) -> TableReport {
+/// A section measured on the model tables of `source` (its directory's if
+/// it holds them all, else the embedded ones, as T4 reads them): `measure`
+/// of their [`twoscale::brdf::Tables`].
+fn model_report(
+    source: &TableSource,
+    stem: &str,
+    what: &str,
+    measure: impl FnOnce(&twoscale::brdf::Tables<'_>) -> Vec<crate::tables::Accuracy>,
+) -> TableReport {
     let start = Instant::now();
     let inputs = match source.dir() {
         Some(dir) => ModelInputs::for_dir(dir),
@@ -41,15 +49,12 @@ fn spectral_report(source: &TableSource, seed: u64) -> TableReport {
     let outcome = inputs
         .and_then(|inputs| {
             let set = inputs.parse()?;
-            Ok(spectral_accuracy::accuracy(&set.brdf_tables(), seed))
+            Ok(measure(&set.brdf_tables()))
         })
-        .map_err(Error::table(spectral_accuracy::STEM));
-    eprintln!(
-        "verified the spectral bakes in {:.1} s",
-        start.elapsed().as_secs_f64()
-    );
+        .map_err(Error::table(stem));
+    eprintln!("verified {what} in {:.1} s", start.elapsed().as_secs_f64());
     TableReport {
-        stem: spectral_accuracy::STEM.to_string(),
+        stem: stem.to_string(),
         bytes: 0,
         outcome,
     }
@@ -105,11 +110,29 @@ pub fn verify(
         });
     }
     if args.names.is_empty() {
-        reports.push(spectral_report(source, seed));
+        reports.push(model_report(
+            source,
+            spectral_accuracy::STEM,
+            "the spectral bakes",
+            |tables| spectral_accuracy::accuracy(tables, seed),
+        ));
+        reports.push(model_report(
+            source,
+            brdf_accuracy::STEM,
+            "the BRDF in the practical domain",
+            |tables| brdf_accuracy::accuracy(tables, args.brdf, seed),
+        ));
     }
     print!("{}", report::text(&reports));
     if let Some(file) = args.markdown {
         let mut command = format!("generator verify --points {points} --seed {seed}");
+        let size = args.brdf;
+        if size != brdf_accuracy::DEFAULT_SIZE {
+            command.push_str(&format!(
+                " --brdf-materials {} --brdf-exact {}",
+                size.materials, size.exact
+            ));
+        }
         for n in args.names {
             command.push_str(&format!(" --table {n}"));
         }

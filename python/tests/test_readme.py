@@ -61,7 +61,7 @@ def test_accuracy_figures_are_those_of_accuracy_md():
     text = section("Accuracy")
     points = re.search(r"verify --points (\d+) --seed (\d+)", report)
     assert f"{int(points[1]):,}".replace(",", " ") in text and f"seed {points[2]}" in text
-    rows = [line for line in text.splitlines() if line.startswith("| T")]
+    rows = [line for line in text.splitlines() if line.startswith(("| T", "| BRDF"))]
     assert rows
     figures = [n for row in rows for n in NUMBER.findall(row)]
     assert len(figures) > 20
