@@ -12,6 +12,7 @@
 
 mod brdf_instructions;
 mod common;
+mod exact_bake;
 mod rgb_integration;
 mod t3_angle;
 mod t3_axes;
@@ -297,6 +298,16 @@ enum Study {
         #[arg(long)]
         markdown: Option<PathBuf>,
     },
+    /// Construction CPU time of the C bake from exact nodes against the
+    /// default bake from T3b (docs/design/brdf-accuracy.md).
+    ExactBake {
+        /// Random materials of the practical domain.
+        #[arg(long, default_value_t = 40)]
+        materials: usize,
+        /// Seed of the materials.
+        #[arg(long, default_value_t = 45)]
+        seed: u64,
+    },
     /// T4's error against the band limit L
     /// (docs/design/t4-band-limits.md).
     T4BandLimits {
@@ -415,6 +426,10 @@ fn main() -> ExitCode {
             seed,
             markdown,
         } => rgb_integration::run(pairs, seed, markdown.as_deref()),
+        Study::ExactBake { materials, seed } => {
+            exact_bake::run(materials, seed);
+            Ok(())
+        }
         Study::BrdfTiming { rounds, batch } => brdf_instructions::timing(rounds, batch),
         Study::BrdfInstructions {
             calls,
