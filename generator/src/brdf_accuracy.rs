@@ -96,8 +96,8 @@ impl Sampled {
         )
     }
 
-    /// The model of the material over `tables`.
-    fn model<'a>(&self, tables: &Tables<'a>) -> TwoScale<'a, Box<ChannelBake>> {
+    /// The model of the material over `tables` (default options).
+    pub fn model<'a>(&self, tables: &Tables<'a>) -> TwoScale<'a, Box<ChannelBake>> {
         let layer = Layer {
             surface: self.surface,
             base: BaseLayer::Conductor,
@@ -236,7 +236,7 @@ fn ln_c_grid(model: &TwoScale<'_, Box<ChannelBake>>) -> LnC {
 
 /// `|C_bake − C_exact| / C_exact` at the bake's nodes (ghost nodes left
 /// out), where `C_exact ≥` [`FLOOR`] of its largest node.
-fn node_errors(m: &Sampled, table: &LnC, exact: &LnC) -> Vec<(f64, String)> {
+fn node_errors(at: &str, table: &LnC, exact: &LnC) -> Vec<(f64, String)> {
     if table.dims.len() != 2 || table.dims != exact.dims {
         return Vec::new();
     }
@@ -250,13 +250,22 @@ fn node_errors(m: &Sampled, table: &LnC, exact: &LnC) -> Vec<(f64, String)> {
                 continue;
             }
             let error = (f64::from(t) - f64::from(e)).exp_m1().abs();
-            out.push((
-                error,
-                format!("{}, node u {}, θh {}", m.describe(), j - 1, k - 1),
-            ));
+            out.push((error, format!("{at}, node u {}, θh {}", j - 1, k - 1)));
         }
     }
     out
+}
+
+/// The C bake of `table` against that of `exact`, a model of the same
+/// material whose bake holds the exact C ([`ExactProfiles`]), at the
+/// bake's nodes where the exact C is at least [`FLOOR`] of its largest:
+/// `|C − C_exact| / C_exact`, each with its node (after `at`).
+pub fn c_bake_errors(
+    at: &str,
+    table: &TwoScale<'_, Box<ChannelBake>>,
+    exact: &TwoScale<'_, Box<ChannelBake>>,
+) -> Vec<(f64, String)> {
+    node_errors(at, &ln_c_grid(table), &ln_c_grid(exact))
 }
 
 /// What one material contributes to each row.
@@ -292,7 +301,7 @@ pub fn accuracy(tables: &Tables<'_>, size: Size, seed: u64) -> Vec<Accuracy> {
             };
             if k < size.exact {
                 let exact = m.model(&exact_tables);
-                errors.nodes = node_errors(&m, &ln_c_grid(&model), &ln_c_grid(&exact));
+                errors.nodes = c_bake_errors(&m.describe(), &model, &exact);
                 errors.exact_brdf = brdf_errors(&m, &exact, &pairs, &references);
             }
             errors

@@ -4,9 +4,11 @@
 //! practical domain (`generator::brdf_accuracy::material`), one thread.
 //!
 //! CPU time is the thread's own (`/proc/thread-self/schedstat`, ns), so
-//! that a shared machine inflates it less than wall time.
+//! that a shared machine inflates it less than wall time. Each line also
+//! gives the default bake's error at its nodes against the exact one
+//! (`generator::brdf_accuracy::c_bake_errors`): p99 and max.
 
-use generator::brdf_accuracy::material;
+use generator::brdf_accuracy::{c_bake_errors, material};
 use twoscale::TableSet;
 use twoscale::brdf::{ChannelBake, TwoScale};
 use twoscale::material::{BaseLayer, Layer, Options};
@@ -38,7 +40,7 @@ pub fn run(materials: usize, seed: u64) {
     let exact = set.brdf_tables_with(&ExactProfiles);
     let mut bake = ChannelBake::boxed();
     let (mut t3, mut ex) = (Vec::new(), Vec::new());
-    println!("material,b_over_lambda,t3b_ms,exact_ms");
+    println!("material,beta,p,c,b_over_lambda,t3b_ms,exact_ms,bake_p99,bake_max");
     for k in 0..materials {
         let mut rng = SplitMix64::new(seed.wrapping_add(k as u64));
         let m = material(&mut rng);
@@ -53,12 +55,26 @@ pub fn run(materials: usize, seed: u64) {
             std::hint::black_box(model.eval([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]));
         };
         let a = cpu_per_call(20, || build(&tables, &mut bake));
-        let b = cpu_per_call(1, || build(&exact, &mut bake));
+        let start = thread_cpu();
+        let exact_model = m.model(&exact);
+        let b = thread_cpu() - start;
+        let mut errors: Vec<f64> = c_bake_errors("", &m.model(&tables), &exact_model)
+            .into_iter()
+            .map(|e| e.0)
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        let at = |q: f64| errors.get(((errors.len().max(1) - 1) as f64 * q).round() as usize);
+        let s = m.surface;
         println!(
-            "{k},{:.2},{:.3},{:.1}",
-            m.surface.b / m.lambda,
+            "{k},{:.4},{:.3},{:.3},{:.2},{:.3},{:.1},{:.2e},{:.2e}",
+            s.beta,
+            s.p,
+            s.c,
+            s.b / m.lambda,
             a * 1e3,
-            b * 1e3
+            b * 1e3,
+            at(0.99).copied().unwrap_or(f64::NAN),
+            at(1.0).copied().unwrap_or(f64::NAN)
         );
         t3.push(a);
         ex.push(b);
