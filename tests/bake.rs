@@ -146,7 +146,7 @@ fn random_materials_are_within_half_a_percent_at_p99() {
 /// the source pointwise: it would be 10⁴× slower here).
 #[test]
 fn exact_node_bake_matches_the_reference() {
-    use generator::brdf_accuracy::material;
+    use generator::brdf_accuracy::{material, pairs};
     use generator::reference::brdf::{self as reference, ExactProfiles};
     use twoscale::brdf::TwoScale;
     use twoscale::material::{BaseLayer, Layer};
@@ -174,18 +174,7 @@ fn exact_node_bake_matches_the_reference() {
             lambda: m.lambda.into(),
         };
         let mut rows = Vec::new();
-        for k in 0..200 {
-            let i = random_direction(&mut rng);
-            let o = if k % 2 == 0 {
-                random_direction(&mut rng)
-            } else {
-                // Within 5° of the mirror direction.
-                let r = [-i[0], -i[1], i[2]];
-                let d = random_direction(&mut rng).map(|x| x * 0.08);
-                let o = [r[0] + d[0], r[1] + d[1], r[2] + d[2]];
-                let len = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt();
-                o.map(|x| x / len)
-            };
+        for (i, o) in pairs(&mut rng, 200) {
             let wide = |v: [f32; 3]| v.map(f64::from);
             let exact = reference::two_scale(&params, wide(i), wide(o), &Options::default())
                 .expect("reference")

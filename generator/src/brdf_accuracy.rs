@@ -17,7 +17,7 @@
 //! c − 1 log-uniform in [0.01, 9], σs log-uniform in [0.002, 0.1] µm,
 //! b log-uniform in [0.5, 50] µm, λ uniform in [0.36, 0.83] µm, a
 //! conductor's η = n + ik with n ∈ [0.2, 2.5], k ∈ [2, 7]. For each, pairs
-//! of directions: `i` with `cos θ` uniform in [0.02, 1], `o` uniform the
+//! of directions ([`pairs`]): `i` with `cos θ` uniform in [0.02, 1], `o` uniform the
 //! same way for even pairs and within 5° of the mirror direction for odd
 //! ones (where the halo is). A point counts where `ρ_ref ≥ 1e-6` of the
 //! largest `ρ_ref` of its material; C's nodes count where `C ≥ 1e-6` of
@@ -25,6 +25,7 @@
 
 use crate::reference::brdf::{self as reference, ExactProfiles};
 use crate::rng::SplitMix64;
+use crate::spectral_accuracy::direction;
 use crate::tables::Accuracy;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -128,14 +129,6 @@ pub fn material(rng: &mut SplitMix64) -> Sampled {
     }
 }
 
-/// A direction with `cos θ` uniform over [0.02, 1].
-fn direction(rng: &mut SplitMix64) -> [f64; 3] {
-    let z = 0.02 + 0.98 * rng.uniform();
-    let phi = 2.0 * PI * rng.uniform();
-    let s = (1.0 - z * z).sqrt();
-    [s * phi.cos(), s * phi.sin(), z]
-}
-
 /// A direction uniform over the cap of half-angle [`MIRROR_CAP_DEG`]
 /// around the mirror direction of `i` (it may fall below the horizon).
 fn near_mirror(rng: &mut SplitMix64, i: [f64; 3]) -> [f64; 3] {
@@ -160,18 +153,19 @@ fn near_mirror(rng: &mut SplitMix64, i: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| ca * r[k] + sa * (cp * e1[k] + sp * e2[k]))
 }
 
-/// The pairs of directions of one material (module documentation).
-fn pairs(rng: &mut SplitMix64, count: usize) -> Vec<([f32; 3], [f32; 3])> {
-    let to_f32 = |v: [f64; 3]| v.map(|x| x as f32);
+/// The pairs of directions of one material (module documentation): `i`
+/// by [`direction`], `o` by [`direction`] for even pairs, else
+/// [`near_mirror`] of `i`.
+pub fn pairs(rng: &mut SplitMix64, count: usize) -> Vec<([f32; 3], [f32; 3])> {
     (0..count)
         .map(|k| {
             let i = direction(rng);
             let o = if k % 2 == 0 {
                 direction(rng)
             } else {
-                near_mirror(rng, i)
+                near_mirror(rng, i.map(f64::from)).map(|x| x as f32)
             };
-            (to_f32(i), to_f32(o))
+            (i, o)
         })
         .collect()
 }
