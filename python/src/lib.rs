@@ -691,7 +691,7 @@ impl Material {
     }
 
     /// bakes(): the model's per-channel constants and bakes as the runtime
-    /// built them, for ports of `eval` and `pdf` (`twoscale.drjit_bsdf`):
+    /// built them, for ports of `eval` and `pdf` (`twoscale.drjit`):
     /// a list of three dicts (red, green, blue) mapping names to float
     /// scalars and float32 or float64 arrays (the names and layouts of
     /// `TwoScale::visit_bakes` and `runtime/src/bake/`; not a stable
@@ -711,7 +711,7 @@ impl Material {
 
     /// integrated_bakes(): the colour weights and bakes of the integrated
     /// RGB model (`rgb_mode="integrated"`), for ports of `eval`, `pdf` and
-    /// `sample` (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 8
+    /// `sample` (`twoscale.drjit`): a dict of `wavelengths` (the 8
     /// models', µm), `surface` (`[nodes, 8, 3]`: the surface lobes' weights
     /// over `√cos θd`), `plain` (`[8, 3]`), `sampler_nodes` (the 3 models the
     /// sampler mixes) and `models`, a list of 8 dicts as `bakes()` gives
@@ -728,7 +728,7 @@ impl Material {
 
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
-    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),
+    /// (`twoscale.drjit`): a dict of `wavelengths` (the 19 models', µm),
     /// `fresnel` (F over λ every `eta_step` µm from `eta_first` and √cos θ),
     /// `eta` (n, k at those λ), `white`, `models`
     /// (one dict with the names of `bakes()`: a quantity equal in the 19
