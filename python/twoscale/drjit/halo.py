@@ -39,7 +39,8 @@ class Halo:
         """`[start, slope]` of row `row`'s cell `k` (f64)."""
         n_s = self.shapes["halo_zeta"][1]
         c = dr.gather(mi.Vector2f, self.t["halo_coef"], row * n_s + k)
-        return mi.Float64(c.x), mi.Float64(c.y)
+        column = self.columns["halo_coef"]
+        return mi.Float64(c[column["start"]]), mi.Float64(c[column["slope"]])
 
     @staticmethod
     def _azimuth(sin_i, cos_i, sin_h, cos_h):

@@ -10,7 +10,7 @@ import mitsuba as mi
 import numpy as np
 
 from .halo import Halo
-from .lookups import Bakes, gather4
+from .lookups import LOBES, Q_FACTORS, Bakes, gather4
 from .math import finite_or_zero
 from .visible import Visible
 
@@ -43,13 +43,15 @@ class Channel(Bakes, Visible, Halo):
         i, frac = self.direction_cell(mi.Float(cos_i))
         a = gather4(self.t["direction_weights"], i)
         b = gather4(self.t["direction_weights"], i + 1)
-        # Columns that are 0 at every node contribute exact zeros.
-        w = [mi.Float64(dr.maximum(dr.fma(frac, b[k] - a[k], a[k]), 0.0)) if k in columns
-             else mi.Float64(0.0) for k in range(4)]
+        col = self.weight_index
+        # Lobes whose weight is 0 at every node contribute exact zeros.
+        w = [mi.Float64(dr.maximum(dr.fma(frac, b[col[k]] - a[col[k]], a[col[k]]), 0.0))
+             if k in columns else mi.Float64(0.0) for k in range(len(LOBES))]
         total = sum(w[k] for k in columns)
         ok = total > 0.0
         return [dr.select(ok, w[0] / total, 1.0)] + [
-            dr.select(ok, w[k] / total, 0.0) if k in columns else w[k] for k in range(1, 4)]
+            dr.select(ok, w[k] / total, 0.0) if k in columns else w[k]
+            for k in range(1, len(LOBES))]
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf` where C is baked (the plugin requires
@@ -66,8 +68,10 @@ class Channel(Bakes, Visible, Halo):
 
     # -- the model (`TwoScale::lobes`, runtime/src/brdf/eval.rs) ---------
     def q_bar(self, fi, fo, along, across):
-        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`
-        at θi and θo and the pair's `along = −(wi·wo)ₜ`, `across`), f32."""
+        """`QConstants::combine` (Q̄ from the factors `[a, Re U, Im U, Re W, Im W]`,
+        :data:`~twoscale.drjit.lookups.Q_FACTORS`, at θi and θo and the
+        pair's `along = −(wi·wo)ₜ`, `across`), f32."""
+        fi, fo = [fi[n] for n in Q_FACTORS], [fo[n] for n in Q_FACTORS]
         s_sq = along * along + across * across
         ok = s_sq > 0.0
         along = dr.select(ok, along, 1.0)
@@ -96,11 +100,11 @@ class Channel(Bakes, Visible, Halo):
         `r = √(3(1 − α))`, `T = (1 − F(θi))(1 − F(θo))`; f32."""
         s, d = self.s, self.f
         lambertian = params["lambertian"] * (1.0 / math.pi)
-        if s["white"] != 0.0 or s["base"] == 0.0:
+        if s["colour"] == "white" or s["base"] == "conductor":
             return lambertian
         alpha = params["albedo"]
         t = (1.0 - f_i) * (1.0 - f_o)
-        if s["base"] == 1.0:
+        if s["base"] == "plastic":
             plastic = alpha * d["base_inv_n_sq"] / (math.pi * (1.0 - alpha * d["f_dr_int"]))
             return t * plastic + lambertian
 
@@ -124,29 +128,28 @@ class Channel(Bakes, Visible, Halo):
         (``TwoScale::surface_terms_with``)."""
         s, f = self.s, self.f
         cos_i, cos_o, cos_d = pair["cos_i"], pair["cos_o"], pair["cos_d"]
-        at_i = self.direction(self.direction_cell(cos_i), range(8))
-        at_o = self.direction(self.direction_cell(cos_o), range(8))
+        at_i, at_o = self.direction_values(cos_i), self.direction_values(cos_o)
         # A_spec and (1 − A)/σrel² from one exponential.
         if s["sigma_s"] > 0.0:
-            r_i, r_o = at_i[5], at_o[5]
-            ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
+            r_i, r_o = at_i["sigma_ratio"], at_o["sigma_ratio"]
+            ratio_sq = (0.5 * (r_i * r_i + r_o * r_o) if s["sigma_rel"] == "symmetrised"
+                        else r_i * r_i)
             sigma_rel_sq = f["sigma_s_sq"] * ratio_sq
         else:
             sigma_rel_sq = mi.Float(0.0)
         a_spec, one_minus_a_over = exp_and_one_minus_over(f["x_scale"] * pair["cos_d_sq"],
                                                            sigma_rel_sq)
-        fresnel_d = (mi.Float(1.0) if s["white"] else
-                     self.direction(self.direction_cell(cos_d), [6])[0])
+        fresnel_d = mi.Float(1.0) if s["colour"] == "white" else self.direction_fresnel(cos_d)
         specular = a_spec * fresnel_d * pair["rho_geo"]
 
         if self.diffraction:
-            if s["white"]:
+            if s["colour"] == "white":
                 q = mi.Float(1.0)
             elif s["has_q"]:
-                q = dr.maximum(self.q_bar(at_i[:5], at_o[:5], pair["along"], pair["across"]), 0.0)
+                q = dr.maximum(self.q_bar(at_i, at_o, pair["along"], pair["across"]), 0.0)
             else:
                 q = mi.Float(0.0)
-            if s["halo_incident"]:
+            if s["halo_weight"] == "incident":
                 one_minus_a_over = exp_and_one_minus_over(f["x_scale"] * cos_i * cos_i,
                                                            sigma_rel_sq)[1]
             if c_value is None:
@@ -157,9 +160,9 @@ class Channel(Bakes, Visible, Halo):
                                     * c_value, 0.0) * params["halo_factor"]
         else:
             diffraction = mi.Float(0.0)
-        base = self.base_value(at_i[6], at_o[6], cos_i, cos_o, params)
+        base = self.base_value(at_i["fresnel"], at_o["fresnel"], cos_i, cos_o, params)
         # ρ_ms = F_ms (1 − E_s(μi)) (1 − E_s(μo)) / (π (1 − E_avg)), docs/model.md §2.11.
-        multiple = (f["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+        multiple = (f["multiple_scale"] * at_i["lost"] * at_o["lost"] if self.has_multiple
                     else mi.Float(0.0))
         return (finite_or_zero(specular), finite_or_zero(diffraction), finite_or_zero(base),
                 finite_or_zero(multiple))
@@ -168,24 +171,25 @@ class Channel(Bakes, Visible, Halo):
         """`spectral::NodeTerms::new`: (σrel²/σs², Q̄, F(θd), ρ_base + k_d/π
         + ρ_ms) of this model at a pair (:meth:`Model.pair`'s terms), f32."""
         s, f = self.s, self.f
-        at_i = self.direction(self.direction_cell(pair["cos_i"]), range(8))
-        at_o = self.direction(self.direction_cell(pair["cos_o"]), range(8))
-        r_i, r_o = at_i[5], at_o[5]
-        ratio_sq = 0.5 * (r_i * r_i + r_o * r_o) if s["symmetrised"] else r_i * r_i
-        if s["white"]:
+        at_i, at_o = self.direction_values(pair["cos_i"]), self.direction_values(pair["cos_o"])
+        r_i, r_o = at_i["sigma_ratio"], at_o["sigma_ratio"]
+        ratio_sq = (0.5 * (r_i * r_i + r_o * r_o) if s["sigma_rel"] == "symmetrised"
+                    else r_i * r_i)
+        if s["colour"] == "white":
             q, fresnel_d = mi.Float(1.0), mi.Float(1.0)
         else:
-            q = (dr.maximum(self.q_bar(at_i[:5], at_o[:5], pair["along"], pair["across"]), 0.0)
+            q = (dr.maximum(self.q_bar(at_i, at_o, pair["along"], pair["across"]), 0.0)
                  if s["has_q"] else mi.Float(0.0))
-            fresnel_d = self.direction(self.direction_cell(pair["cos_d"]), [6])[0]
-        base = self.base_value(at_i[6], at_o[6], pair["cos_i"], pair["cos_o"], params)
-        multiple = (f["multiple_scale"] * at_i[7] * at_o[7] if self.has_multiple
+            fresnel_d = self.direction_fresnel(pair["cos_d"])
+        base = self.base_value(at_i["fresnel"], at_o["fresnel"], pair["cos_i"], pair["cos_o"],
+                               params)
+        multiple = (f["multiple_scale"] * at_i["lost"] * at_o["lost"] if self.has_multiple
                     else mi.Float(0.0))
         plain = finite_or_zero(base) + finite_or_zero(multiple)
         return ratio_sq, q, fresnel_d, plain
 
 def draw(model, selected, w, pick, wi, u1, u2, valid):
-    """`pick_lobe` of the weights `w` with `pick`, then `TwoScale::sample_lobe`'s
+    """`sample::pick_lobe` of the weights `w` with `pick`, then `TwoScale::sample_lobe`'s
     direction from `u1, u2`: a visible normal of the shared specular bake, the
     diffraction law of the channel (model) where `selected[n]`, the cosine lobe
     for the base and the compensation lobe. Returns the direction

@@ -10,6 +10,14 @@ import numpy as np
 from .math import log2_axis
 
 
+#: The lobes in the order of the port's weight lists and lobe numbers
+#: (`brdf::Lobe`'s): each the name of a `direction_weights` column.
+LOBES = ("specular", "diffraction", "base", "multiple")
+
+#: Q̄'s factors (`QFactors`): `direction_rows` columns.
+Q_FACTORS = ("q_a", "q_u_re", "q_u_im", "q_w_re", "q_w_im")
+
+
 def cell_at(t, n):
     """`bake::cell_at`: the cell `i ∈ [0, n − 2]` and fraction of position `t ≥ 0`."""
     t = dr.minimum(dr.maximum(t, 0.0), float(n - 1))
@@ -44,7 +52,7 @@ def gather4(table, k):
 
 
 def catmull_rom_weights(t):
-    """`conv::catmull_rom_weights`."""
+    """`convolution::catmull_rom_weights`."""
     t2 = t * t
     t3 = t2 * t
     return (
@@ -76,10 +84,15 @@ def c_of_ln(ln_c):
 
 
 class Bakes:
-    """One channel's constants (Python floats) and bakes (Dr.Jit arrays)."""
+    """One channel's constants (Python floats, and the names of the base
+    layer's kind and the options), bakes (Dr.Jit arrays) and the bakes'
+    columns by name (``columns``: array name → column name → index)."""
 
     def __init__(self, bakes):
-        self.s = {k: float(v) for k, v in bakes.items() if not isinstance(v, np.ndarray)}
+        self.columns = {name: {c: k for k, c in enumerate(names)}
+                        for name, names in bakes["columns"].items()}
+        self.s = {k: (v if isinstance(v, str) else float(v)) for k, v in bakes.items()
+                  if not isinstance(v, (np.ndarray, dict))}
         self.shapes = {k: v.shape for k, v in bakes.items() if isinstance(v, np.ndarray)}
         self.t = {k: upload(v) for k, v in bakes.items() if isinstance(v, np.ndarray)}
         s = self.s
@@ -114,11 +127,13 @@ class Bakes:
 
     def specialise(self, bakes):
         """What the traced code leaves out (Python-level branches, as
-        Mitsuba's own plugins): the lobe weights' columns that are 0 at every
-        node of `bakes` (any model's, stacked), the compensation lobe when
-        its scale is 0."""
+        Mitsuba's own plugins): the lobes (numbers in :data:`LOBES`) whose
+        weight is 0 at every node of `bakes` (any model's, stacked), the
+        compensation lobe when its scale is 0."""
         weights = np.asarray(bakes["direction_weights"])
-        self.weight_columns = [k for k in range(4) if np.any(weights[..., k] > 0.0)]
+        self.weight_index = [self.columns["direction_weights"][name] for name in LOBES]
+        self.weight_columns = [n for n, k in enumerate(self.weight_index)
+                               if np.any(weights[..., k] > 0.0)]
         self.has_multiple = bool(np.any(np.asarray(bakes["multiple_scale"]) != 0.0))
 
     def _node_row(self, i, n):
@@ -128,9 +143,21 @@ class Bakes:
 
     # -- the 1-D bakes -------------------------------------------------
     def direction_cell(self, cos):
+        """`DirectionCell::new`: the row and fraction of `cos θ` (clamped to [0, 1])."""
         n = self.shapes["direction_rows"][0]
         i, frac = cell_at(dr.sqrt(dr.maximum(cos, 0.0)) * float(n - 1), n)
         return self._node_row(i, n), frac
+
+    def direction_values(self, cos):
+        """`DirectionBake::at`: the row at `cos θ`, a dict by column name."""
+        names = list(self.columns["direction_rows"])
+        values = self.direction(self.direction_cell(cos), [self.columns["direction_rows"][n]
+                                                           for n in names])
+        return dict(zip(names, values))
+
+    def direction_fresnel(self, cos):
+        """`DirectionBake::fresnel_at`: F at `cos θ` alone."""
+        return self.direction(self.direction_cell(cos), [self.columns["direction_rows"]["fresnel"]])[0]
 
     def direction(self, cell, columns):
         """The direction bake's `columns` at `cell`, linear between its rows

@@ -46,7 +46,7 @@ class Model:
         self.p = dr.opaque(mi.Float, first["p"])
         self.epd_norm = dr.opaque(mi.Float, first["epd_norm"])
         self.epd_inv_beta_sq = dr.opaque(mi.Float, first["epd_inv_beta_sq"])
-        self.height_correlated = first["height_correlated"] != 0.0
+        self.height_correlated = first["masking"] == "height-correlated"
         self.channels_have_diffraction = any(ch.diffraction for ch in self.channels)
         self.diffraction_stack = diffraction_stack(self.channels, bakes)
 
@@ -112,9 +112,9 @@ class Model:
         }
 
     def eval(self, wi, wo):
-        """ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi`` towards the
-        light, ``wo`` towards the viewer (``Material.eval``'s convention); 0
-        below the horizon."""
+        """``Rgb::eval``: ρ(wi, wo) per channel (sr⁻¹) as an ``mi.Color3f``: ``wi``
+        towards the light, ``wo`` towards the viewer (``Material.eval``'s
+        convention); 0 below the horizon."""
         valid, geo = self.geometry(wi, wo)
         pair = self.pair(geo)
         values = []
@@ -189,8 +189,8 @@ class NodeChannel(Channel):
 
     # Read as Python floats (branches, literals), by `Model` from model 0
     # (D, G) or from the shared tables: one value for every model.
-    SHARED = {"sigma_s", "b", "white", "has_q", "symmetrised", "halo_incident", "base",
-              "conv_baked", "height_correlated", "conv_u0",
+    SHARED = {"sigma_s", "b", "colour", "has_q", "sigma_rel", "halo_weight", "base",
+              "conv_baked", "masking", "conv_u0",
               "conv_cos_h_min", "masking_beta", "masking_g1", "beta", "p", "epd_norm",
               "epd_inv_beta_sq"}
 
@@ -286,10 +286,10 @@ class SpectralModel(Model):
         self.fresnel_shape = spectral["fresnel"].shape
         self.eta_first = float(np.float32(spectral["eta_first"]))
         self.eta_step = float(np.float32(spectral["eta_step"]))
-        self.white = spectral["white"] != 0.0
+        self.white = spectral["colour"] == "white"
 
     def clamped(self, lam):
-        """λ (µm, f32) clamped to the models' range (NaN → the first)."""
+        """`Spectral::clamped`: λ (µm, f32) clamped to the models' range (NaN → the first)."""
         return dr.select(lam > self.nodes[0], dr.minimum(lam, self.nodes[-1]), self.nodes[0])
 
     def cell(self, lam):
@@ -368,7 +368,7 @@ class SpectralModel(Model):
                     q = dr.select(coloured,
                                   fl * ((1.0 - f) * qa * fb + f * qb * fa) / (fa * fb),
                                   lerp(1))
-                if s["halo_incident"]:
+                if s["halo_weight"] == "incident":
                     one_minus_a_over = exp_and_one_minus_over(x_scale * cos_i * cos_i,
                                                                sigma_rel_sq)[1]
                 halo = lower.f["halo_scale"] * ratio_sq * one_minus_a_over

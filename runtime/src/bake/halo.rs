@@ -155,7 +155,7 @@ impl HaloBake {
     }
 
     /// Hands the tables to `v` (`halo_zeta` `[33, 66]`, `halo_coef`
-    /// `[33, 66, 2]`; f64: `halo_cum` `[33, 66]`, `halo_u`, `halo_inv_du`,
+    /// `[33, 66, 2]`, columns `start`, `slope`; f64: `halo_cum` `[33, 66]`, `halo_u`, `halo_inv_du`,
     /// `halo_inv_total` `[33]`; rows as `conv_ln_c`'s without ghosts).
     pub fn visit(&self, v: &mut dyn BakeVisitor) {
         let shape = [CONV_U_NODES, NODES];
@@ -165,6 +165,7 @@ impl HaloBake {
             &[CONV_U_NODES, NODES, 2],
             self.coef.as_flattened().as_flattened(),
         );
+        v.columns("halo_coef", &["start", "slope"]);
         v.array_f64("halo_cum", &shape, self.cum.as_flattened());
         v.array_f64("halo_u", &[CONV_U_NODES], &self.u);
         v.array_f64("halo_inv_du", &[CONV_U_NODES], &self.inv_du);

@@ -30,6 +30,7 @@ use crate::bake::DirectionCell;
 use crate::material::{ColourTerms, Options};
 use crate::model::fresnel::fresnel;
 use crate::spectrum::optical::SpectralMaterial;
+use crate::validate::Named;
 use core::borrow::{Borrow, BorrowMut};
 use zerocopy::FromZeros;
 
@@ -295,7 +296,7 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// ([`SPECTRAL_WAVELENGTHS`], µm), `fresnel` ([`FresnelBake`],
     /// `[ETA_NODES, FRESNEL_COS_NODES]`: λ every `eta_step` µm from
     /// `eta_first`, `√cos θ` from 0 to 1), `eta` (`[ETA_NODES, 2]`: n, k at
-    /// those λ) and `white`. Each model's bakes are its node's
+    /// those λ, columns `n`, `k`) and `colour` ([`ColourTerms`]' name). Each model's bakes are its node's
     /// [`TwoScale::visit_bakes`].
     #[doc(hidden)]
     pub fn visit_index(&self, v: &mut dyn BakeVisitor) {
@@ -304,9 +305,15 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
         let shape = [ETA_NODES, FRESNEL_COS_NODES];
         v.array("fresnel", &shape, bake.rows.as_flattened());
         v.array("eta", &[ETA_NODES, 2], bake.eta.as_flattened());
+        v.columns("eta", &["n", "k"]);
         v.scalar("eta_first", f64::from(ETA_FIRST));
         v.scalar("eta_step", f64::from(ETA_STEP));
-        v.scalar("white", if self.white { 1.0 } else { 0.0 });
+        let colour = if self.white {
+            ColourTerms::White
+        } else {
+            ColourTerms::Physical
+        };
+        v.named(ColourTerms::OPTION, colour.name());
     }
 
     /// λ clamped to [0.36, 0.83] µm (NaN → 0.36).
