@@ -65,6 +65,8 @@ pub(crate) struct DirectionCell {
 
 impl DirectionCell {
     /// The cell of `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn new(cos: f32) -> Self {
         let (index, fraction) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
@@ -73,6 +75,8 @@ impl DirectionCell {
 
     /// The cell and fraction of the same `cos θ` on an axis of `N` nodes of
     /// `√cos θ` (`MU_NODES − 1` a multiple of `N − 1`).
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     pub fn coarser<const N: usize>(self) -> (usize, f32) {
         let step = ((MU_NODES - 1) / (N - 1)) as f32;
@@ -203,6 +207,8 @@ impl DirectionBake {
     }
 
     /// F alone at a cell.
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn fresnel_at(&self, at: DirectionCell) -> f32 {
         let (a, b) = (
@@ -213,12 +219,16 @@ impl DirectionBake {
     }
 
     /// The values at `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn at(&self, cos: f32) -> DirectionValues {
         self.at_cell(DirectionCell::new(cos))
     }
 
     /// The values at a cell.
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn at_cell(&self, at: DirectionCell) -> DirectionValues {
         let (a, b) = (&self.rows[at.index], &self.rows[at.index + 1]);
@@ -245,6 +255,8 @@ impl DirectionBake {
 
     /// The sampler's lobe weights `[specular, diffraction, base, multiple]`
     /// (sum 1) at `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     #[inline]
     pub fn lobe_weights(&self, cos: f32) -> [f64; 4] {
         let at = DirectionCell::new(cos);

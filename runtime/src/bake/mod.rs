@@ -50,6 +50,8 @@ fn cell(x: f32, n: usize) -> (usize, f32) {
 }
 
 /// [`cell`] of a position `t` in nodes (`t ≥ 0`, clamped to `n − 1`).
+///
+/// Mirrored in python/twoscale/drjit/lookups.py.
 #[inline]
 fn cell_at(t: f32, n: usize) -> (usize, f32) {
     let t = t.min((n - 1) as f32);
