@@ -281,6 +281,8 @@ struct Material {
     spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first `eval_spectral`.
     spectral_model: OnceLock<Box<BoxedSpectral<'static>>>,
+    /// The preset's name, for a material `Material.preset` built (its repr).
+    preset: Option<&'static str>,
 }
 
 impl Material {
@@ -295,7 +297,40 @@ impl Material {
             rgb_mode: desc.rgb_mode,
             spectral: desc.spectral.as_ref().map(OwnedSpectralMaterial::new),
             spectral_model: OnceLock::new(),
+            preset: None,
         }
+    }
+
+    /// The description the material was built from (rebuilding it gives
+    /// the same model).
+    fn desc(&self) -> MaterialDesc<'_> {
+        MaterialDesc {
+            material: self.material,
+            spectral: self.spectral.as_ref().map(OwnedSpectralMaterial::get),
+            options: self.options,
+            rgb_mode: self.rgb_mode,
+        }
+    }
+
+    /// `Material.preset(name, …)` with the options and `rgb_mode` that
+    /// differ from the preset's defaults.
+    fn preset_repr(&self, name: &str) -> String {
+        let mut args = vec![format!("{name:?}")];
+        let default = MaterialDesc::spectral(
+            twoscale::materials::spectral(name).expect("a preset's name"),
+            Options::default(),
+            None,
+        )
+        .expect("every preset validates");
+        let keys = self.desc().keys();
+        for ((key, value), (_, default)) in keys.iter().zip(default.keys()) {
+            if let desc::KeyValue::Name(v) = value
+                && *value != default
+            {
+                args.push(format!("{key}={v:?}"));
+            }
+        }
+        format!("twoscale.Material.preset({})", args.join(", "))
     }
 
     /// The model at any wavelength of `spectral` (this material's index over
@@ -369,6 +404,12 @@ impl Material {
         let values = py.detach(|| rows(v.len(), |k| f(model, wi[k], wo[k], lam[k][0])));
         Ok(shaped(py, &v.shape, values))
     }
+}
+
+/// `values` as a Python list of numbers (`desc::number`).
+fn py_list(values: impl Iterator<Item = f32>) -> String {
+    let items: Vec<String> = values.map(desc::number).collect();
+    format!("[{}]", items.join(", "))
 }
 
 /// `Material(eta=…)`: three (n, k) pairs, or `(lam, n, k)` arrays as rows.
@@ -502,7 +543,14 @@ impl Material {
         let rgb_mode = validate::named_or_none(rgb_mode).map_err(|e| value_error(e.to_string()))?;
         let desc = MaterialDesc::spectral(spectral, options, rgb_mode)
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(Material::build(&desc))
+        let preset = twoscale::materials::PRESETS
+            .iter()
+            .map(|(n, _)| *n)
+            .find(|n| *n == name);
+        Ok(Material {
+            preset,
+            ..Material::build(&desc)
+        })
     }
 
     /// presets(): the names of the shipped presets, for `Material.preset`.
@@ -863,20 +911,50 @@ impl Material {
         self.rgb_mode.name()
     }
 
+    /// to_toml(): the material file of this material: a `[material]` table
+    /// of every keyword (numbers as the shortest decimals that read back to
+    /// the same float32), which `from_toml_string` (and the C API and the
+    /// generator) read back to the same model, bit for bit.
+    fn to_toml(&self) -> String {
+        self.desc().to_toml()
+    }
+
+    /// `twoscale.Material.preset(name, …)` for a preset (the options and
+    /// `rgb_mode` that differ from its defaults), else
+    /// `twoscale.Material(beta=…, …)` with every keyword (`eta` as the
+    /// spectrum's `(lam, n, k)` lists when it was given over the spectrum):
+    /// evaluated with `twoscale` imported, it rebuilds the same model, bit
+    /// for bit.
     fn __repr__(&self) -> String {
-        let s = self.material.layer.surface;
-        format!(
-            "twoscale.Material(beta={}, p={}, sigma_s={}, b={}, c={}, eta={:?}, base='{}', albedo={:?}, lambertian={})",
-            s.beta,
-            s.p,
-            s.sigma_s,
-            s.b,
-            s.c,
-            self.eta(),
-            self.base(),
-            self.albedo(),
-            self.material.layer.lambertian,
-        )
+        if let Some(name) = self.preset {
+            return self.preset_repr(name);
+        }
+        let args: Vec<String> = self
+            .desc()
+            .keys()
+            .into_iter()
+            .map(|(key, value)| {
+                let text = match value {
+                    desc::KeyValue::Number(x) => desc::number(x),
+                    desc::KeyValue::Name(name) => format!("{name:?}"),
+                    desc::KeyValue::Pairs(pairs) => {
+                        let items: Vec<String> = pairs
+                            .iter()
+                            .map(|[n, k]| format!("({}, {})", desc::number(*n), desc::number(*k)))
+                            .collect();
+                        format!("[{}]", items.join(", "))
+                    }
+                    desc::KeyValue::Spectrum(rows) => format!(
+                        "({}, {}, {})",
+                        py_list(rows.iter().map(|r| r[0])),
+                        py_list(rows.iter().map(|r| r[1])),
+                        py_list(rows.iter().map(|r| r[2])),
+                    ),
+                };
+                format!("{key}={text}")
+            })
+            .collect();
+        format!("twoscale.Material({})", args.join(", "))
     }
 }
 

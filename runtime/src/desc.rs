@@ -311,6 +311,123 @@ impl OwnedMaterialDesc {
     }
 }
 
+/// A key's value as [`MaterialDesc::keys`] gives it.
+#[cfg(feature = "std")]
+#[derive(Clone, Debug, PartialEq)]
+pub enum KeyValue<'a> {
+    /// A number.
+    Number(f32),
+    /// An option's or the base's name.
+    Name(&'static str),
+    /// `eta` as `(n, k)` per channel.
+    Pairs([[f32; 2]; 3]),
+    /// `eta` as `(λ, n, k)` rows of a spectrum.
+    Spectrum(&'a [[f32; 3]]),
+}
+
+/// The shortest decimal of `x` that reads back to `x` the way the readers
+/// read numbers (as `f64`, rounded to `f32`): Rust's shortest `f32` form,
+/// else the exact `f64` one.
+#[cfg(feature = "std")]
+pub fn number(x: f32) -> std::string::String {
+    let short = std::format!("{x:?}");
+    let reads_back = short.parse::<f64>().map(|v| (v as f32).to_bits()) == Ok(x.to_bits());
+    if reads_back {
+        short
+    } else {
+        std::format!("{:?}", f64::from(x))
+    }
+}
+
+#[cfg(feature = "std")]
+impl<'a> MaterialDesc<'a> {
+    /// Every key of the description with its value, in the order of the
+    /// module documentation's file (`albedo` only for a base that has
+    /// one): the keywords that rebuild the same model bit for bit
+    /// ([`Keywords::material`]). `eta` is the spectrum's rows when the
+    /// material was given over the spectrum, else the three `(n, k)` pairs.
+    pub fn keys(&self) -> std::vec::Vec<(&'static str, KeyValue<'a>)> {
+        use crate::validate::Named;
+        let layer = self.material.layer;
+        let eta = match self.spectral.map(|s| s.eta) {
+            Some(Ior::Tabulated(t)) => KeyValue::Spectrum(t.rows()),
+            _ => KeyValue::Pairs(self.material.eta_rgb.map(|e| [e.re, e.im])),
+        };
+        let s = layer.surface;
+        let mut keys = std::vec![
+            ("beta", KeyValue::Number(s.beta)),
+            ("p", KeyValue::Number(s.p)),
+            ("eta", eta),
+            ("sigma_s", KeyValue::Number(s.sigma_s)),
+            ("b", KeyValue::Number(s.b)),
+            ("c", KeyValue::Number(s.c)),
+            ("base", KeyValue::Name(layer.base.kind().name())),
+        ];
+        if let crate::brdf::BaseLayer::Plastic { albedo }
+        | crate::brdf::BaseLayer::Subsurface { albedo } = layer.base
+        {
+            keys.push(("albedo", KeyValue::Number(albedo)));
+        }
+        let o = self.options;
+        keys.extend([
+            ("lambertian", KeyValue::Number(layer.lambertian)),
+            (
+                crate::brdf::Masking::OPTION,
+                KeyValue::Name(o.masking.name()),
+            ),
+            (
+                crate::brdf::SigmaRelMode::OPTION,
+                KeyValue::Name(o.sigma_rel.name()),
+            ),
+            (
+                crate::brdf::ColourTerms::OPTION,
+                KeyValue::Name(o.colour.name()),
+            ),
+            (
+                crate::brdf::HaloWeight::OPTION,
+                KeyValue::Name(o.halo_weight.name()),
+            ),
+            (
+                crate::brdf::MultipleScattering::OPTION,
+                KeyValue::Name(o.multiple_scattering.name()),
+            ),
+            (RgbMode::OPTION, KeyValue::Name(self.rgb_mode.name())),
+        ]);
+        keys
+    }
+
+    /// The material file of the description: a `[material]` table of
+    /// every key ([`MaterialDesc::keys`], numbers by [`number`]), which
+    /// [`MaterialDesc::from_toml_str`] reads back to the same description.
+    pub fn to_toml(&self) -> std::string::String {
+        use core::fmt::Write;
+        let list = |values: &mut dyn Iterator<Item = f32>| {
+            let items: std::vec::Vec<_> = values.map(number).collect();
+            std::format!("[{}]", items.join(", "))
+        };
+        let mut out = std::string::String::from("[material]\n");
+        for (key, value) in self.keys() {
+            let text = match value {
+                KeyValue::Number(x) => number(x),
+                KeyValue::Name(name) => std::format!("\"{name}\""),
+                KeyValue::Pairs(pairs) => {
+                    let items: std::vec::Vec<_> =
+                        pairs.iter().map(|p| list(&mut p.iter().copied())).collect();
+                    std::format!("[{}]", items.join(", "))
+                }
+                KeyValue::Spectrum(rows) => std::format!(
+                    "{{ lambda = {}, n = {}, k = {} }}",
+                    list(&mut rows.iter().map(|r| r[0])),
+                    list(&mut rows.iter().map(|r| r[1])),
+                    list(&mut rows.iter().map(|r| r[2])),
+                ),
+            };
+            let _ = writeln!(out, "{key} = {text}");
+        }
+        out
+    }
+}
+
 #[cfg(feature = "toml")]
 pub use self::file::{DescError, DescErrorKind, EtaTable, KeywordTable};
 
@@ -522,6 +639,69 @@ mod tests {
             eta: Eta::Channels(&GOLD),
             ..Keywords::default()
         }
+    }
+
+    /// `to_toml` writes every key: reading it back gives the same
+    /// description (every preset over the spectrum and at the paper's
+    /// wavelengths, with options; pairs, plastic, subsurface, a Lambertian
+    /// term, numbers that f32's shortest decimal would not read back).
+    #[cfg(feature = "toml")]
+    #[test]
+    fn a_written_file_reads_back_to_the_same_description() {
+        let options = Options {
+            masking: Masking::HeightCorrelated,
+            colour: ColourTerms::White,
+            multiple_scattering: MultipleScattering::KullaConty,
+            ..Options::default()
+        };
+        let mut descs = std::vec::Vec::new();
+        for preset in crate::materials::SPECTRAL_PRESETS.iter() {
+            for rgb_mode in [None, Some(RgbMode::PaperWavelengths)] {
+                for options in [Options::default(), options] {
+                    descs.push(MaterialDesc::spectral(preset.material, options, rgb_mode).unwrap());
+                }
+            }
+        }
+        let plastic = Keywords {
+            base: Some("plastic"),
+            albedo: Some(0.8),
+            lambertian: Some(0.125),
+            eta: Eta::Channels(&[[1.5, 0.0]; 3]),
+            sigma_s: Some(0.0273),
+            b: Some(4.8418),
+            c: Some(2.3),
+            ..gold()
+        };
+        let subsurface = Keywords {
+            base: Some("subsurface"),
+            albedo: Some(0.3),
+            beta: 0.1 + 0.2,
+            p: 1.0 / 3.0,
+            ..plastic
+        };
+        for k in [gold(), plastic, subsurface] {
+            descs.push(k.material().unwrap());
+        }
+        for want in descs {
+            let text = want.to_toml();
+            let back = MaterialDesc::from_toml_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            assert_eq!(back.get(), want, "{text}");
+        }
+    }
+
+    #[cfg(feature = "std")]
+    #[test]
+    fn numbers_read_back_through_f64() {
+        let mut x = 1e-7f32;
+        while x < 1e7 {
+            for v in [x, -x, f32::from_bits(x.to_bits() + 1)] {
+                let back = number(v).parse::<f64>().unwrap() as f32;
+                assert_eq!(back.to_bits(), v.to_bits(), "{v:?} written {}", number(v));
+            }
+            x *= 1.001;
+        }
+        assert_eq!(number(0.5), "0.5");
+        assert_eq!(number(2.0), "2.0");
     }
 
     #[test]
