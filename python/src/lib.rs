@@ -1449,6 +1449,8 @@ fn brdf<'py>(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Material>()?;
+    // The workspace's version: the `twoscale` crate's, the package's.
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("RGB_WAVELENGTHS", twoscale::brdf::RGB_WAVELENGTHS.to_vec())?;
     let options = BTreeMap::from([
         (Masking::OPTION, names::<Masking>()),

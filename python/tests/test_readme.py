@@ -128,3 +128,18 @@ def test_accuracy_figures_are_those_of_accuracy_md():
     assert len(figures) > 20
     missing = [n for n in figures if n not in report]
     assert not missing, f"README's accuracy table has figures docs/accuracy.md lacks: {missing}"
+
+
+def test_what_installing_needs_comes_first():
+    """A newcomer reads what a source install needs before the quick starts:
+    the Rust toolchain, cbindgen (the version CI installs) and the LLVM that
+    Mitsuba's llvm variants load (also in docs/python.md)."""
+    titles = re.findall(r"^## (.+)$", README, re.M)
+    assert titles.index("What installing needs") < titles.index("Quick start"), titles
+    text = section("What installing needs")
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    (cbindgen,) = set(re.findall(r"cargo install cbindgen --version [\d.]+ --locked", ci))
+    for needed in ("Rust toolchain", cbindgen, "DRJIT_LIBLLVM_PATH", "maturin build"):
+        assert needed in text, needed
+    assert cbindgen in (REPO / "capi" / "tests" / "c" / "run.sh").read_text(encoding="utf-8")
+    assert "DRJIT_LIBLLVM_PATH" in (REPO / "docs" / "python.md").read_text(encoding="utf-8")

@@ -15,7 +15,7 @@ values (the default first), ``BASES`` lists the base layers and
 ``RGB_MODES`` the RGB models (``rgb_mode``: the paper's wavelengths, the
 default of (n, k) pairs, or the integral over the spectrum, the default of
 a preset and of a spectrum): the runtime's one list of each
-(``twoscale::validate::Named``).
+(``twoscale::validate::Named``). ``__version__`` is the crates' version.
 """
 
 import importlib
@@ -29,6 +29,11 @@ __all__ = [
     "BASES", "Material", "OPTIONS", "RGB_MODES", "RGB_WAVELENGTHS", "fit", "lookup", "merl",
     "reference",
 ]
+
+# The crates' version (Cargo's), which is also the package's.
+from ._native import __version__  # noqa: E402
+
+__all__.append("__version__")
 
 
 def __getattr__(name: str) -> ModuleType:

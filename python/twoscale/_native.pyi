@@ -31,6 +31,7 @@ __all__ = [
     "MERL_FILE_BYTES",
 ]
 
+__version__: str
 RGB_WAVELENGTHS: list[float]
 OPTIONS: dict[str, tuple[str, ...]]
 BASES: tuple[str, ...]
