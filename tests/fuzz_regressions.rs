@@ -21,8 +21,11 @@ mod query_csv;
 use generator::rng::SplitMix64;
 use std::path::Path;
 
+/// A harness: runs one input, true if the parser accepted it.
+type Harness = fn(&[u8]) -> bool;
+
 /// Every target: its name and its harness (what `fuzz/fuzz_targets/NAME.rs` runs).
-const TARGETS: [(&str, fn(&[u8]) -> bool); 5] = [
+const TARGETS: [(&str, Harness); 5] = [
     ("table_loader", harness::run),
     ("merl_decode", merl_decode::run),
     ("material_toml", material_toml::run),
@@ -32,7 +35,7 @@ const TARGETS: [(&str, fn(&[u8]) -> bool); 5] = [
 
 /// Runs `run` on every file of `dir` (if it exists): (inputs, those the
 /// harness accepted).
-fn replay(dir: &Path, run: fn(&[u8]) -> bool) -> (usize, usize) {
+fn replay(dir: &Path, run: Harness) -> (usize, usize) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return (0, 0);
     };

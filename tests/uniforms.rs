@@ -4,8 +4,9 @@
 //! 1, NaN reads 0), so a sample with such `u` is the sample at the clamped
 //! `u`, bit for bit, in every model. (The C API and Python refuse them.)
 
-use twoscale::brdf::{Options, Spectral};
-use twoscale::hp15::{Energy, Hp15, Hp15Params};
+use twoscale::brdf::Spectral;
+use twoscale::brdf::hp15::{Energy, Hp15, Hp15Params};
+use twoscale::material::Options;
 use twoscale::{Bxdf, ShBrdfTable, TableSet};
 
 /// `x` clamped as the contract says.

@@ -1,4 +1,4 @@
-//! The material-file fuzz harness (`twoscale::desc::MaterialDesc::from_toml_str`,
+//! The material-file fuzz harness (`twoscale::io::desc::MaterialDesc::from_toml_str`,
 //! what Rust, Python's `Material.from_toml_string`, C and the generator
 //! read), shared by the libFuzzer target (`fuzz/fuzz_targets/material_toml.rs`)
 //! and the stable-Rust replay (`tests/fuzz_regressions.rs`).
@@ -10,7 +10,7 @@
 //! `sample` give finite values at a few directions.
 
 use twoscale::brdf::RgbModel;
-use twoscale::desc::MaterialDesc;
+use twoscale::io::desc::MaterialDesc;
 use twoscale::{Bxdf, TableSet};
 
 /// Runs one input (module documentation); true if the text read.

@@ -14,7 +14,7 @@
 
 use generator::query::{self, Options};
 use generator::table_source::TableSource;
-use twoscale::desc::MaterialDesc;
+use twoscale::io::desc::MaterialDesc;
 
 /// A conductor by three (n, k), as the fit writes it.
 const PAIRS: &str = "[material]\nbeta = 0.12\np = 1.4\neta = [[0.2, 3.9], [0.45, 2.5], [1.4, 1.9]]\n\
@@ -31,7 +31,7 @@ pub fn run(data: &[u8]) -> bool {
         ("brdf", 1) => Some(MaterialDesc::from_toml_str(PAIRS).expect("a valid file")),
         ("brdf", 2) => {
             let spectral = twoscale::materials::spectral("nickel").expect("a preset");
-            let options = twoscale::brdf::Options::default();
+            let options = twoscale::material::Options::default();
             let desc = MaterialDesc::spectral(spectral, options, None).expect("a preset validates");
             Some(desc.to_owned_desc())
         }
