@@ -38,7 +38,8 @@ import numpy as np
 from scipy.special import expit, gammainccinv, gammaincinv
 
 import twoscale
-from twoscale._cli import positive_int, run
+from twoscale import _cli
+from twoscale._cli import positive_int
 
 ETA = [(1.0, 6.6)] * 3
 
@@ -369,4 +370,4 @@ def run(args):
 
 
 if __name__ == "__main__":
-    run(main)
+    _cli.run(main)

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "__version__",
     "Material",
     "RGB_WAVELENGTHS",
     "OPTIONS",
