@@ -1,4 +1,4 @@
-//! libFuzzer target of material files (`twoscale::desc`) (the input format
+//! libFuzzer target of material files (`twoscale::io::desc`) (the input format
 //! is documented in `fuzz/parsers/material_toml.rs`).
 #![no_main]
 

@@ -1,6 +1,6 @@
 """Material files (TOML: a ``[material]`` table of ``twoscale.Material``'s
 keywords and an optional ``[metrics]`` table, what ``python -m twoscale.fit``
-writes) are one schema read by one parser (``twoscale::desc``): Python
+writes) are one schema read by one parser (``twoscale::io::desc``): Python
 (``Material.from_toml``), C (``ts_material_desc_from_toml_file``, through
 ``capi/tests/c/material_file.c``) and Rust (``generator query brdf
 --material``) give the same BRDF values bit for bit and refuse a bad file
