@@ -143,3 +143,20 @@ def test_what_installing_needs_comes_first():
         assert needed in text, needed
     assert cbindgen in (REPO / "capi" / "tests" / "c" / "run.sh").read_text(encoding="utf-8")
     assert "DRJIT_LIBLLVM_PATH" in (REPO / "docs" / "python.md").read_text(encoding="utf-8")
+
+
+def test_ci_installs_with_the_readme_s_commands():
+    """CI installs the package with nothing but the README's commands (issue
+    47): every `pip install …`, `maturin build …` and `python -m pytest …` the
+    README prints is a command line of .ci/run, verbatim, and .ci/run's pip
+    installs no package by hand besides them."""
+    printed = set(re.findall(r"`((?:pip install|maturin build|python -m pytest) [^`]+?)`", README))
+    printed = {part.strip() for command in printed for part in command.split("&&")}
+    assert len(printed) >= 6, printed
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    lines = [line.split("#")[0].strip() for line in ci.splitlines()]
+    for command in printed:
+        assert any(line.startswith(command) for line in lines), command
+    installs = {line for line in lines if re.match(r"(python3? -m )?pip3? install", line)}
+    extra = {line for line in installs if not any(line.startswith(c) for c in printed)}
+    assert extra == {'pip install "$wheel[test]"'}, extra
