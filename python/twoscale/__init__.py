@@ -1,6 +1,6 @@
 """The Holzschuch–Pacanowski two-scale BRDF from precomputed tables.
 
-``Material`` is the RGB model of one material (at 0.645, 0.526, 0.444 µm)
+``Material`` is the RGB model of one material (linear sRGB; ``rgb_mode`` below)
 evaluated over NumPy arrays of directions; ``lookup`` holds the table
 lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
 registers a Mitsuba 3 BSDF (imported on first use of ``twoscale.mitsuba``:
