@@ -53,7 +53,7 @@ def main():
                         help="a preset or beckmann (default gold-hp17-geometry)")
     name = parser.parse_args().material
     mi.set_variant("llvm_ad_spectral")
-    import twoscale.drjit_bsdf as tb
+    import twoscale.drjit as tb
 
     material = (twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0, eta=[(0.584, 2.15)] * 3)
                 if name == "beckmann" else twoscale.Material.preset(name))
