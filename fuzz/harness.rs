@@ -4,22 +4,23 @@
 //!
 //! Random bytes almost never pass a table's header checks and checksum, so
 //! the input is a mutation of a real table: byte 0 picks the table (T1, T2,
-//! T3, T5 of the embedded set, or a shipped T4), byte 1 holds flags, and the
-//! rest is a list of 5-byte patches (a little-endian u32 position, a byte to
-//! XOR there). Flags: bit 0 recomputes the checksum after patching (so the
+//! T3, T5 of the embedded set, a shipped T4, or T6), byte 1 holds flags, and
+//! the rest is a list of 5-byte patches (a little-endian u32 position, a byte
+//! to XOR there). Flags: bit 0 recomputes the checksum after patching (so the
 //! checks past it are reached), bit 1 truncates the file to `len · ((flags >>
 //! 3) & 15) / 16`, bit 2 confines the patches to the header, bit 7 also
-//! loads the file into a `TableSet::from_bytes` (with the other three tables
-//! intact) and evaluates, samples and takes the pdf of a preset with it (tens
-//! of ms under ASan, hence optional). The patched bytes go through the
-//! table's typed reader and the generic `Table::from_bytes`; whatever loads
+//! loads the file (not a T4) into a `TableSet::from_bytes` (with the other
+//! tables intact) and evaluates, samples and takes the pdf of a preset with
+//! it (tens of ms under ASan, hence optional; for T6 also with energy
+//! compensation, which reads it). The patched bytes go through the table's
+//! typed reader and the generic `Table::from_bytes`; whatever loads
 //! is looked up at finite inputs, which must give finite values.
 
-use twoscale::material::Options;
+use twoscale::material::{Masking, MultipleScattering, Options};
 use twoscale::tables::format::{HEADER_SIZE, Header, aligned_copy, checksum};
 use twoscale::{
-    ConvTable, Convolution, DiffuseFresnelTable, ShBrdfTable, SigmaRatioTable, SmithG1Table, Table,
-    TableSet,
+    AlbedoTable, ConvTable, Convolution, DiffuseFresnelTable, ShBrdfTable, SigmaRatioTable,
+    SmithG1Table, Table, TableSet,
 };
 
 /// A shipped T4 (the smallest).
@@ -35,13 +36,14 @@ pub fn run(data: &[u8]) -> bool {
         return false;
     };
     let set = TableSet::embedded_bytes();
-    let which = usize::from(*selector % 5);
+    let which = usize::from(*selector % 6);
     let original: &[u8] = [
         set.smith,
         set.sigma_ratio,
         set.convolution,
         set.diffuse_fresnel,
         T4,
+        set.albedo,
     ][which];
     let mut bytes = original.to_vec();
     let span = if flags & 4 != 0 {
@@ -120,6 +122,21 @@ pub fn run(data: &[u8]) -> bool {
             }
             table.is_ok()
         }
+        5 => {
+            let table = AlbedoTable::from_bytes(file);
+            if let Ok(t) = &table {
+                for masking in [Masking::Separable, Masking::HeightCorrelated] {
+                    for cos in INPUTS {
+                        for beta in INPUTS {
+                            for p in INPUTS {
+                                finite(t.albedo(cos, beta, p, masking), "albedo", &[cos, beta, p]);
+                            }
+                        }
+                    }
+                }
+            }
+            table.is_ok()
+        }
         _ => {
             let table = ShBrdfTable::from_bytes(file);
             if let Ok(t) = &table {
@@ -133,32 +150,39 @@ pub fn run(data: &[u8]) -> bool {
             table.is_ok()
         }
     };
-    if which < 4 && flags & 0x80 != 0 {
+    if which != 4 && flags & 0x80 != 0 {
         let mut set_bytes = set;
         let slot = [
             &mut set_bytes.smith,
             &mut set_bytes.sigma_ratio,
             &mut set_bytes.convolution,
             &mut set_bytes.diffuse_fresnel,
+            &mut set_bytes.albedo,
         ];
-        let slot = slot.into_iter().nth(which);
+        let slot = slot.into_iter().nth(which.min(4));
         if let Some(slot) = slot {
             *slot = file;
         }
         if let Ok(tables) = TableSet::from_bytes(set_bytes) {
             let presets = twoscale::materials::PRESETS;
-            evaluate(
-                &tables,
-                &presets[usize::from(*selector / 5) % presets.len()].1,
-            );
+            let material = &presets[usize::from(*selector / 6) % presets.len()].1;
+            evaluate(&tables, material, Options::default());
+            if which == 5 {
+                // Energy compensation reads T6 (0.2 s under ASan: only here).
+                let compensated = Options {
+                    multiple_scattering: MultipleScattering::KullaConty,
+                    ..Options::default()
+                };
+                evaluate(&tables, material, compensated);
+            }
         }
     }
     loaded
 }
 
-/// `material` from the set, evaluated and sampled.
-fn evaluate(tables: &TableSet<'_>, material: &twoscale::material::Material) {
-    let model = tables.rgb(material, Options::default());
+/// `material` from the set with `options`, evaluated and sampled.
+fn evaluate(tables: &TableSet<'_>, material: &twoscale::material::Material, options: Options) {
+    let model = tables.rgb(material, options);
     for (i, o) in [
         ([0.6, 0.1, 0.8], [-0.55, -0.05, 0.83]),
         ([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]),

@@ -12,8 +12,9 @@
  *   ts_last_status() its code (thread-local: failures on other threads do
  *   not overwrite them). A success leaves them unchanged.
  * - Misuse is reported, never undefined behaviour, for: NULL pointers,
- *   float pointers not aligned to 4 bytes, NaN or infinite numbers, unknown
- *   names or enumeration values, truncated or corrupted table bytes. The
+ *   float pointers not aligned to 4 bytes, NaN or infinite numbers, uniforms
+ *   outside [0, 1), unknown names or enumeration values, truncated or
+ *   corrupted table bytes. The
  *   library cannot check array lengths: pass arrays of the documented size.
  * - Lifetimes: every handle is freed with its own ts_*_free, in any order. A
  *   material keeps its tables alive (reference-counted), so freeing a tables
@@ -183,12 +184,12 @@ typedef struct ts_material ts_material;
 typedef struct ts_material_file ts_material_file;
 
 /**
- * A validated set of the four tables (T1, T2, T3, T5). Opaque.
+ * A validated set of the five tables the BRDF reads (T1, T2, T3, T5, T6). Opaque.
  */
 typedef struct ts_tables ts_tables;
 
 /**
- * The bytes of the four table files, for `ts_tables_from_bytes`.
+ * The bytes of the five table files, for `ts_tables_from_bytes`.
  */
 typedef struct {
   /**
@@ -377,9 +378,9 @@ int ts_last_status(void);
 ts_tables *ts_tables_embedded(void);
 
 /**
- * Memory-maps and validates the four table files of directory `dir`
+ * Memory-maps and validates the five table files of directory `dir`
  * (`t1-smith-g1.tbl`, `t2-sigma-ratio.tbl`, `t3-convolution.tbl`,
- * `t5-diffuse-fresnel.tbl`). The maps are released by `ts_tables_free` (and
+ * `t5-diffuse-fresnel.tbl`, `t6-albedo.tbl`). The maps are released by `ts_tables_free` (and
  * the last material made from them). Files must not be modified in place
  * while mapped. NULL on failure.
  *
@@ -390,7 +391,7 @@ ts_tables *ts_tables_embedded(void);
 ts_tables *ts_tables_open(const char *dir);
 
 /**
- * Validates the four tables in `bytes` and makes a handle holding a copy of
+ * Validates the five tables in `bytes` and makes a handle holding a copy of
  * them (64-byte aligned): the caller's buffers may be freed after the call
  * and need no particular alignment. NULL on failure (a NULL pointer, or
  * bytes that are truncated, corrupted or of the wrong table).
@@ -601,7 +602,10 @@ int ts_pdf(const ts_material *m,
 /**
  * Samples an outgoing direction for `wi` with the uniform numbers `u` in
  * [0, 1) (`u[0]` picks the channel and lobe, `u[1]`, `u[2]` the direction).
- * `out->pdf == 0` if no direction was sampled (not an error).
+ * `out->pdf == 0` if no direction was sampled (not an error). A component
+ * of `u` outside [0, 1) (1 included) or not finite is `TS_ERR_INVALID`, as
+ * a non-finite `wi` is: the C API checks every argument (a renderer whose
+ * generator can round up to 1 clamps to `nextafterf(1, 0)` first).
  *
  * # Safety
  *
@@ -646,7 +650,9 @@ int ts_pdf_batch(const ts_material *m,
 
 /**
  * `ts_sample_rgb` over `n` directions: `wi`, `u` hold `3 n` floats, `out`
- * `n` samples.
+ * `n` samples. On a non-finite direction or a uniform outside [0, 1),
+ * stops with `TS_ERR_INVALID` (the message gives the entry; samples before
+ * it are written).
  *
  * # Safety
  *

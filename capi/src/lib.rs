@@ -97,7 +97,7 @@ pub const TS_RGB_MODE_PAPER_WAVELENGTHS: i32 = 1;
 /// every channel.
 pub const TS_RGB_MODE_INTEGRATED: i32 = 2;
 
-/// A validated set of the four tables (T1, T2, T3, T5). Opaque.
+/// A validated set of the five tables the BRDF reads (T1, T2, T3, T5, T6). Opaque.
 pub struct ts_tables {
     inner: Arc<OwnedTableSet>,
 }
@@ -125,7 +125,7 @@ pub struct ts_material {
     _tables: Arc<OwnedTableSet>,
 }
 
-/// The bytes of the four table files, for `ts_tables_from_bytes`.
+/// The bytes of the five table files, for `ts_tables_from_bytes`.
 #[repr(C)]
 pub struct ts_table_bytes {
     /// `t1-smith-g1.tbl`.
@@ -359,6 +359,24 @@ unsafe fn read3(ptr: *const f32, j: usize, what: &str) -> Result<[f32; 3], Fail>
         return Err(Fail::new(
             TS_ERR_INVALID,
             format!("{what} (entry {j}) has a non-finite component: {v:?}"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Reads entry `j` of a checked array of uniforms: three floats in [0, 1)
+/// (a NaN, an infinity, a negative number or one ≥ 1 is `TS_ERR_INVALID`).
+///
+/// # Safety
+///
+/// As [`read3`]'s.
+unsafe fn read_uniforms(ptr: *const f32, j: usize, what: &str) -> Result<[f32; 3], Fail> {
+    // SAFETY: forwarded caller contract.
+    let v = unsafe { read3(ptr, j, what) }?;
+    if !v.iter().all(|x| (0.0..1.0).contains(x)) {
+        return Err(Fail::new(
+            TS_ERR_INVALID,
+            format!("{what} (entry {j}) has a component outside [0, 1) (uniforms): {v:?}"),
         ));
     }
     Ok(v)
@@ -767,9 +785,9 @@ pub extern "C" fn ts_tables_embedded() -> *mut ts_tables {
     })
 }
 
-/// Memory-maps and validates the four table files of directory `dir`
+/// Memory-maps and validates the five table files of directory `dir`
 /// (`t1-smith-g1.tbl`, `t2-sigma-ratio.tbl`, `t3-convolution.tbl`,
-/// `t5-diffuse-fresnel.tbl`). The maps are released by `ts_tables_free` (and
+/// `t5-diffuse-fresnel.tbl`, `t6-albedo.tbl`). The maps are released by `ts_tables_free` (and
 /// the last material made from them). Files must not be modified in place
 /// while mapped. NULL on failure.
 ///
@@ -785,7 +803,7 @@ pub unsafe extern "C" fn ts_tables_open(dir: *const c_char) -> *mut ts_tables {
     })
 }
 
-/// Validates the four tables in `bytes` and makes a handle holding a copy of
+/// Validates the five tables in `bytes` and makes a handle holding a copy of
 /// them (64-byte aligned): the caller's buffers may be freed after the call
 /// and need no particular alignment. NULL on failure (a NULL pointer, or
 /// bytes that are truncated, corrupted or of the wrong table).
@@ -1255,7 +1273,10 @@ pub unsafe extern "C" fn ts_pdf(
 
 /// Samples an outgoing direction for `wi` with the uniform numbers `u` in
 /// [0, 1) (`u[0]` picks the channel and lobe, `u[1]`, `u[2]` the direction).
-/// `out->pdf == 0` if no direction was sampled (not an error).
+/// `out->pdf == 0` if no direction was sampled (not an error). A component
+/// of `u` outside [0, 1) (1 included) or not finite is `TS_ERR_INVALID`, as
+/// a non-finite `wi` is: the C API checks every argument (a renderer whose
+/// generator can round up to 1 clamps to `nextafterf(1, 0)` first).
 ///
 /// # Safety
 ///
@@ -1344,7 +1365,9 @@ pub unsafe extern "C" fn ts_pdf_batch(
 }
 
 /// `ts_sample_rgb` over `n` directions: `wi`, `u` hold `3 n` floats, `out`
-/// `n` samples.
+/// `n` samples. On a non-finite direction or a uniform outside [0, 1),
+/// stops with `TS_ERR_INVALID` (the message gives the entry; samples before
+/// it are written).
 ///
 /// # Safety
 ///
@@ -1370,7 +1393,7 @@ pub unsafe extern "C" fn ts_sample_rgb_batch(
         }
         for j in 0..n {
             // SAFETY: checked pointers; the caller gives 3 n floats each.
-            let (i, u) = unsafe { (read3(wi, j, "wi")?, read3(u, j, "u")?) };
+            let (i, u) = unsafe { (read3(wi, j, "wi")?, read_uniforms(u, j, "u")?) };
             let sample = match Bxdf::sample(&m.rgb, i, u) {
                 Some(s) => ts_sample {
                     wo: s.o,
@@ -1612,8 +1635,9 @@ mod tests {
             // SAFETY: a live material and three-float arrays.
             let status = unsafe { ts_eval_rgb(m, i.as_ptr(), o.as_ptr(), out.as_mut_ptr()) };
             assert_eq!(status, TS_OK);
-            let expected = Bxdf::eval(&set.preset(name).expect("preset"), i, o);
-            assert_eq!(out, expected, "{name}");
+            // `TableSet::material`: the integrated RGB, as the handle gives.
+            let expected = set.material(name).expect("preset").eval(i, o);
+            assert_eq!(out.map(f32::to_bits), expected.map(f32::to_bits), "{name}");
             // SAFETY: live handles, freed once.
             unsafe { ts_material_free(m) };
         }

@@ -72,8 +72,9 @@ enum Command {
     /// Check headers and checksums of a table directory, then measure every
     /// table against the reference at random off-grid points.
     Verify {
-        /// Table directory (T4 files included). Default: the tables compiled
-        /// into the binary (T1, T2, T3, T5).
+        /// Table directory (T4 files included; the spectral bakes' row reads
+        /// its T1, T2, T3, T5, T6). Default: the tables compiled into the
+        /// binary (T1, T2, T3, T5, T6).
         dir: Option<PathBuf>,
         /// Materials file (T4: one table per material). Default: the
         /// shipped presets.
@@ -168,7 +169,7 @@ enum Command {
         /// npy or c.
         #[arg(long, default_value = "npy")]
         format: String,
-        /// Tables to export (names or prefixes: t1, t2, t3, t5); all four if none.
+        /// Tables to export (names or prefixes: t1, t2, t3, t5, t6); all five if none.
         #[arg(long = "table")]
         tables: Vec<String>,
         /// f32, unorm16 or f16. Default: every precision whose rounding is

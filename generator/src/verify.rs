@@ -32,9 +32,10 @@ pub struct VerifyArgs<'a> {
     pub brdf: brdf_accuracy::Size,
 }
 
-/// A section measured on the model tables of `source` (its directory's if
-/// it holds them all, else the embedded ones, as T4 reads them): `measure`
-/// of their [`twoscale::brdf::Tables`].
+/// A section measured on the model tables of `source`: its directory's (an
+/// error if one is missing: a directory's report never holds figures of the
+/// embedded tables), or the embedded ones; `measure` of their
+/// [`twoscale::brdf::Tables`].
 fn model_report(
     source: &TableSource,
     stem: &str,
@@ -43,7 +44,7 @@ fn model_report(
 ) -> TableReport {
     let start = Instant::now();
     let inputs = match source.dir() {
-        Some(dir) => ModelInputs::for_dir(dir),
+        Some(dir) => ModelInputs::load(dir),
         None => ModelInputs::embedded(),
     };
     let outcome = inputs
@@ -73,6 +74,14 @@ pub fn verify(
         return Err(Error::Usage(
             "--points 0: verify needs at least one point per table".into(),
         ));
+    }
+    if let Some(dir) = source.dir()
+        && !dir.is_dir()
+    {
+        let source = std::fs::metadata(dir).err().unwrap_or_else(|| {
+            std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a directory")
+        });
+        return Err(Error::file(FileAction::Read, dir)(source));
     }
     let mut reports = Vec::new();
     for kind in kinds {

@@ -226,6 +226,73 @@ fn help_shows_no_source_path() {
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
 
+/// `help export` and `help verify` name every table of the set (T6 was
+/// missing, and export said "all four" of the five it writes).
+#[test]
+fn help_names_every_table_of_the_set() {
+    let dir = scratch("help-tables");
+    let count = twoscale::table_set::TABLES.len();
+    assert_eq!(count, 5, "update the help texts' count");
+    for sub in ["export", "verify"] {
+        let out = run_in(&dir, &["help", sub], "");
+        assert!(out.status.success(), "{sub}");
+        let help = text(&out.stdout).to_lowercase();
+        for id in twoscale::table_set::TABLES {
+            let tag = format!("t{}", id.number());
+            assert!(
+                help.contains(&tag),
+                "help {sub} does not name {tag}: {help}"
+            );
+        }
+        assert!(!help.contains("all four"), "help {sub}: {help}");
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
+/// `verify DIR` reads DIR: a directory that does not exist is an error,
+/// and no row (the spectral bakes' included) is computed from the embedded
+/// tables instead.
+#[test]
+fn verify_of_a_missing_directory_fails_and_marks_nothing_ok() {
+    let dir = scratch("verify-missing");
+    let missing = dir.join("nonexistent");
+    let out = run_in(
+        &dir,
+        &["verify", missing.to_str().expect("utf-8"), "--points", "10"],
+        "",
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(stderr.contains("nonexistent"), "{stderr}");
+    assert!(
+        !stdout.lines().any(|line| line.contains(" ok")),
+        "rows marked ok: {stdout}"
+    );
+    // A directory that holds only some of the tables: the spectral row
+    // fails too (it read the embedded ones).
+    let some = dir.join("some");
+    std::fs::create_dir_all(&some).expect("dir");
+    let t1 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/t1-smith-g1.tbl");
+    std::fs::copy(&t1, some.join("t1-smith-g1.tbl")).expect("copy T1");
+    let out = run_in(
+        &dir,
+        &["verify", some.to_str().expect("utf-8"), "--points", "10"],
+        "",
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let spectral: Vec<_> = stdout
+        .lines()
+        .filter(|line| line.to_lowercase().contains("spectral"))
+        .collect();
+    assert!(!spectral.is_empty(), "{stdout}");
+    assert!(
+        spectral.iter().all(|line| !line.contains(" ok")),
+        "{stdout}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
+
 /// From an empty directory, `query`, `verify`, `inspect` read the embedded
 /// tables and `build --out x` writes to `x`: the same bytes as the committed
 /// file.

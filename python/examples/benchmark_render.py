@@ -22,6 +22,7 @@ import os
 import subprocess
 import sys
 import time
+from twoscale._cli import positive_int, run
 
 LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 
@@ -107,10 +108,10 @@ def measure(variant, size, spp, repeat, evaluated):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=256)
-    parser.add_argument("--spp", type=int, default=64)
-    parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--variant")
+    parser.add_argument("--size", type=positive_int, default=256)
+    parser.add_argument("--spp", type=positive_int, default=64)
+    parser.add_argument("--repeat", type=positive_int, default=3)
+    parser.add_argument("--variant", choices=["scalar_rgb", "llvm_ad_rgb", "llvm_ad_spectral"])
     parser.add_argument("--evaluated", action="store_true")
     args = parser.parse_args()
     if args.variant:
@@ -126,4 +127,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

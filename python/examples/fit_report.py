@@ -21,6 +21,7 @@ import twoscale
 from twoscale import merl
 from twoscale.fit import _sample_metrics as sample_metrics
 from twoscale.fit import fit, grazing, predict
+from twoscale._cli import positive_int, run
 
 #: The domain of the random materials (log-uniform between the bounds).
 DOMAIN = {
@@ -200,7 +201,7 @@ def lobe_plot(path, title, values, materials, theta_i_deg=(20, 45, 70)):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--materials", type=int, default=6)
+    parser.add_argument("--materials", type=positive_int, default=6)
     parser.add_argument("--img", default="docs/img")
     parser.add_argument("--seed", type=int, default=28)
     parser.add_argument("--skip-mitsuba", action="store_true")
@@ -253,4 +254,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -31,6 +31,7 @@ import numpy as np  # noqa: E402
 mi.set_variant("llvm_ad_rgb")
 import twoscale  # noqa: E402
 import twoscale.drjit as tb  # noqa: E402
+from twoscale._cli import positive_int, run  # noqa: E402
 
 LANES = 1 << 18
 GOLD = [(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)]
@@ -79,9 +80,11 @@ def best_times(calls, rounds):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("materials", nargs="*", default=["beckmann", "gold-hp17-geometry"])
+    parser.add_argument("materials", nargs="*", default=["beckmann", "gold-hp17-geometry"],
+                        choices=["beckmann", "roughconductor", *twoscale.Material.presets()],
+                        metavar="MATERIAL", help="a preset, beckmann or roughconductor")
     parser.add_argument("--against")
-    parser.add_argument("--rounds", type=int, default=15)
+    parser.add_argument("--rounds", type=positive_int, default=15)
     args = parser.parse_args()
     dr.set_thread_count(1)
     modules = {"this": tb}
@@ -134,4 +137,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

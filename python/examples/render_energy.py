@@ -22,6 +22,7 @@ import numpy as np  # noqa: E402
 
 import twoscale  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
+from twoscale._cli import positive_int, run  # noqa: E402
 
 #: Gold (the presets' index) on a wide EPD lobe without nano-roughness.
 WIDE = dict(beta=0.8, p=1.5, eta=[(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)])
@@ -38,8 +39,8 @@ def materials():
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=REPO / "docs" / "img")
-    parser.add_argument("--size", type=int, default=160)
-    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--size", type=positive_int, default=160)
+    parser.add_argument("--spp", type=positive_int, default=64)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     tm.register()
@@ -50,4 +51,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -37,6 +37,7 @@ import twoscale.mitsuba as tm  # noqa: E402
 from fit_report import degrade, mitsuba_cases  # noqa: E402
 from render_presets import scene, write_png  # noqa: E402
 from twoscale import merl  # noqa: E402
+from twoscale._cli import positive_int, run  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 CASES = ("roughconductor beckmann α=0.2", "roughconductor ggx α=0.3")
@@ -45,8 +46,8 @@ CASES = ("roughconductor beckmann α=0.2", "roughconductor ggx α=0.3")
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=REPO / "docs" / "img")
-    parser.add_argument("--size", type=int, default=192)
-    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--size", type=positive_int, default=192)
+    parser.add_argument("--spp", type=positive_int, default=64)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     tm.register()
@@ -90,4 +91,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -46,6 +46,7 @@ mi.set_variant("llvm_ad_rgb")
 
 import twoscale  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
+from twoscale._cli import positive_int, run, unit_interval  # noqa: E402
 
 import benchmark_render  # noqa: E402  (this directory: the sphere scene, the Beckmann pair)
 
@@ -232,11 +233,11 @@ def preset_rows(size, spp, seeds, ref_renders):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=64)
-    parser.add_argument("--spp", type=int, default=16)
-    parser.add_argument("--seeds", type=int, default=16)
-    parser.add_argument("--ref-renders", type=int, default=64)
-    parser.add_argument("--alphas", type=float, nargs="*", default=[0.05, 0.2, 0.5])
+    parser.add_argument("--size", type=positive_int, default=64)
+    parser.add_argument("--spp", type=positive_int, default=16)
+    parser.add_argument("--seeds", type=positive_int, default=16)
+    parser.add_argument("--ref-renders", type=positive_int, default=64)
+    parser.add_argument("--alphas", type=unit_interval, nargs="*", default=[0.05, 0.2, 0.5])
     parser.add_argument("--presets", action="store_true")
     parser.add_argument("--where", action="store_true")
     args = parser.parse_args()
@@ -250,4 +251,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -22,6 +22,7 @@ mi.set_variant("llvm_ad_rgb")
 
 import twoscale  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
+from twoscale._cli import positive_int, run  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 CAMERA = [0.0, 0.0, 4.5]
@@ -61,8 +62,8 @@ def write_png(image, path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=REPO / "docs" / "img")
-    parser.add_argument("--size", type=int, default=256)
-    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--size", type=positive_int, default=256)
+    parser.add_argument("--spp", type=positive_int, default=64)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     tm.register()
@@ -84,4 +85,4 @@ def highlight_point(lamp, camera):
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

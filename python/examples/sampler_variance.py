@@ -38,6 +38,8 @@ import numpy as np
 from scipy.special import expit, gammainccinv, gammaincinv
 
 import twoscale
+from twoscale import _cli
+from twoscale._cli import positive_int
 
 ETA = [(1.0, 6.6)] * 3
 
@@ -287,7 +289,7 @@ def shape_rows(ps, betas, thetas, n):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=1_000_000)
+    parser.add_argument("--samples", type=positive_int, default=1_000_000)
     parser.add_argument("--quick", action="store_true", help="a few rows")
     parser.add_argument("--halo", action="store_true", help="the presets and strong halos")
     parser.add_argument("--spectral", action="store_true",
@@ -368,4 +370,4 @@ def run(args):
 
 
 if __name__ == "__main__":
-    main()
+    _cli.run(main)

@@ -10,6 +10,7 @@ and the best of seven rounds of wall time per call.
 p = 1, σs = 0, η = 0.584 + 2.15i); 2¹⁶ random pairs, uniform wavelengths.
 """
 
+import argparse
 import os
 import re
 import sys
@@ -21,6 +22,7 @@ os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-1
 import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 import numpy as np  # noqa: E402
+from twoscale._cli import run  # noqa: E402
 
 
 def logged(run):
@@ -43,11 +45,16 @@ def logged(run):
 
 
 def main():
-    mi.set_variant("llvm_ad_spectral")
     import twoscale
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("material", nargs="?", default="gold-hp17-geometry",
+                        choices=["beckmann", *twoscale.Material.presets()], metavar="MATERIAL",
+                        help="a preset or beckmann (default gold-hp17-geometry)")
+    name = parser.parse_args().material
+    mi.set_variant("llvm_ad_spectral")
     import twoscale.drjit as tb
 
-    name = sys.argv[1] if len(sys.argv) > 1 else "gold-hp17-geometry"
     material = (twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0, eta=[(0.584, 2.15)] * 3)
                 if name == "beckmann" else twoscale.Material.preset(name))
     model = tb.SpectralModel(material)
@@ -79,4 +86,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

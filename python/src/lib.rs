@@ -71,6 +71,56 @@ impl<const K: usize> Vectors<K> {
     }
 }
 
+/// What the rows of a `(…, 3)` argument must hold, checked as the C API
+/// checks them (`capi/src/lib.rs`, docs/c-api.md): a `ValueError` names the
+/// argument, the row (`entry`, in C order) and its values.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rows {
+    /// Directions: finite components.
+    Directions,
+    /// Uniforms: each component in [0, 1).
+    Uniforms,
+    /// Not checked here (the caller checks them).
+    Any,
+}
+
+impl Rows {
+    /// The first row of `values` (shape `(…, 3)`) outside the domain, as
+    /// a `ValueError`.
+    fn check(self, name: &str, values: &ArrayD<f32>) -> PyResult<()> {
+        if self == Rows::Any {
+            return Ok(());
+        }
+        let lead = &values.shape()[..values.ndim() - 1];
+        for (k, row) in values.rows().into_iter().enumerate() {
+            let v = [row[0], row[1], row[2]];
+            let what = if !v.iter().all(|x| x.is_finite()) {
+                "has a non-finite component"
+            } else if self == Rows::Uniforms && !v.iter().all(|x| (0.0..1.0).contains(x)) {
+                "has a component outside [0, 1) (uniforms)"
+            } else {
+                continue;
+            };
+            // The row's index in the array as given, beside its C-order number.
+            let index = if lead.len() > 1 {
+                let mut index = vec![0; lead.len()];
+                let mut rest = k;
+                for (axis, n) in lead.iter().enumerate().rev() {
+                    index[axis] = rest % n;
+                    rest /= n;
+                }
+                format!(", index {index:?}")
+            } else {
+                String::new()
+            };
+            return Err(value_error(format!(
+                "{name} (entry {k}{index}) {what}: {v:?}"
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// `array` as an f32 array of shape `(…, 3)`: float32 and float64 arrays as
 /// they are, anything else through `numpy.asarray(array, dtype=float64)`.
 fn vector_array(name: &str, array: &Bound<'_, PyAny>) -> PyResult<ArrayD<f32>> {
@@ -104,13 +154,15 @@ fn vector_array(name: &str, array: &Bound<'_, PyAny>) -> PyResult<ArrayD<f32>> {
     }
 }
 
-/// The arrays of shape `(…, 3)` broadcast together as NumPy does (the
-/// leading shapes aligned on the right, each axis of length 1 or the
-/// common length).
-fn vectors<const K: usize>(arrays: [(&str, &Bound<'_, PyAny>); K]) -> PyResult<Vectors<K>> {
+/// The arrays of shape `(…, 3)`, each checked ([`Rows`]), broadcast
+/// together as NumPy does (the leading shapes aligned on the right, each
+/// axis of length 1 or the common length).
+fn vectors<const K: usize>(arrays: [(&str, &Bound<'_, PyAny>, Rows); K]) -> PyResult<Vectors<K>> {
     let mut values = Vec::with_capacity(K);
-    for (name, array) in arrays {
-        values.push(vector_array(name, array)?);
+    for (name, array, rows) in arrays {
+        let array = vector_array(name, array)?;
+        rows.check(name, &array)?;
+        values.push(array);
     }
     let leading = |a: &ArrayD<f32>| a.shape()[..a.ndim() - 1].to_vec();
     let ndim = values.iter().map(|a| a.ndim() - 1).max().unwrap_or(0);
@@ -124,7 +176,7 @@ fn vectors<const K: usize>(arrays: [(&str, &Bound<'_, PyAny>); K]) -> PyResult<V
                 let shapes: Vec<String> = arrays
                     .iter()
                     .zip(&values)
-                    .map(|((name, _), a)| format!("{name} of shape {:?}", a.shape()))
+                    .map(|((name, _, _), a)| format!("{name} of shape {:?}", a.shape()))
                     .collect();
                 return Err(value_error(format!(
                     "{} do not broadcast together",
@@ -284,6 +336,8 @@ struct Material {
     spectral: Option<OwnedSpectralMaterial>,
     /// `spectral`'s model at any wavelength, built by the first `eval_spectral`.
     spectral_model: OnceLock<Box<BoxedSpectral<'static>>>,
+    /// The preset's name, for a material `Material.preset` built (its repr).
+    preset: Option<&'static str>,
 }
 
 impl Material {
@@ -298,7 +352,40 @@ impl Material {
             rgb_mode: desc.rgb_mode,
             spectral: desc.spectral.as_ref().map(OwnedSpectralMaterial::new),
             spectral_model: OnceLock::new(),
+            preset: None,
         }
+    }
+
+    /// The description the material was built from (rebuilding it gives
+    /// the same model).
+    fn desc(&self) -> MaterialDesc<'_> {
+        MaterialDesc {
+            material: self.material,
+            spectral: self.spectral.as_ref().map(OwnedSpectralMaterial::get),
+            options: self.options,
+            rgb_mode: self.rgb_mode,
+        }
+    }
+
+    /// `Material.preset(name, …)` with the options and `rgb_mode` that
+    /// differ from the preset's defaults.
+    fn preset_repr(&self, name: &str) -> String {
+        let mut args = vec![format!("{name:?}")];
+        let default = MaterialDesc::spectral(
+            twoscale::materials::spectral(name).expect("a preset's name"),
+            Options::default(),
+            None,
+        )
+        .expect("every preset validates");
+        let keys = self.desc().keys();
+        for ((key, value), (_, default)) in keys.iter().zip(default.keys()) {
+            if let desc::KeyValue::Name(v) = value
+                && *value != default
+            {
+                args.push(format!("{key}={v:?}"));
+            }
+        }
+        format!("twoscale.Material.preset({})", args.join(", "))
     }
 
     /// The model at any wavelength of `spectral` (this material's index over
@@ -321,7 +408,7 @@ impl Material {
         &self,
         py: Python<'py>,
         method: &str,
-        arrays: [(&str, &Bound<'py, PyAny>); 2],
+        arrays: [(&str, &Bound<'py, PyAny>, Rows); 2],
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<(Vectors<3>, &BoxedSpectral<'static>)> {
         let Some(spectral) = &self.spectral else {
@@ -342,7 +429,7 @@ impl Material {
             (np.call_method1("expand_dims", (lam, -1))?, 3, -1),
         )?;
         let [a, b] = arrays;
-        let v = vectors([a, b, ("lam", &lam3)])?;
+        let v = vectors([a, b, ("lam", &lam3, Rows::Any)])?;
         let (lo, hi) = (
             SPECTRAL_WAVELENGTHS[0],
             SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
@@ -367,11 +454,22 @@ impl Material {
         lam: &Bound<'py, PyAny>,
         f: impl Fn(&BoxedSpectral<'static>, [f32; 3], [f32; 3], f32) -> f32 + Sync,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let (v, model) = self.spectral_rows(py, method, [("wi", wi), ("wo", wo)], lam)?;
+        let (v, model) = self.spectral_rows(
+            py,
+            method,
+            [("wi", wi, Rows::Directions), ("wo", wo, Rows::Directions)],
+            lam,
+        )?;
         let [wi, wo, lam] = &v.rows;
         let values = py.detach(|| rows(v.len(), |k| f(model, wi[k], wo[k], lam[k][0])));
         Ok(shaped(py, &v.shape, values))
     }
+}
+
+/// `values` as a Python list of numbers (`desc::number`).
+fn py_list(values: impl Iterator<Item = f32>) -> String {
+    let items: Vec<String> = values.map(desc::number).collect();
+    format!("[{}]", items.join(", "))
 }
 
 /// `Material(eta=…)`: three (n, k) pairs, or `(lam, n, k)` arrays as rows.
@@ -505,7 +603,14 @@ impl Material {
         let rgb_mode = validate::named_or_none(rgb_mode).map_err(|e| value_error(e.to_string()))?;
         let desc = MaterialDesc::spectral(spectral, options, rgb_mode)
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(Material::build(&desc))
+        let preset = twoscale::materials::PRESETS
+            .iter()
+            .map(|(n, _)| *n)
+            .find(|n| *n == name);
+        Ok(Material {
+            preset,
+            ..Material::build(&desc)
+        })
     }
 
     /// presets(): the names of the shipped presets, for `Material.preset`.
@@ -524,14 +629,16 @@ impl Material {
     /// `wi` (towards the light) and `wo` (towards the viewer) are unit
     /// vectors in the local frame (normal +z), arrays of shape `(..., 3)`
     /// that broadcast together as NumPy's do; a single direction `(3,)`
-    /// gives `(3,)`. 0 where either is below the horizon.
+    /// gives `(3,)`. 0 where either is below the horizon. A direction with
+    /// a NaN or infinite component raises `ValueError` naming the argument
+    /// and the entry (as the C API refuses it); so do the other methods.
     fn eval<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let v = vectors([("wi", wi, Rows::Directions), ("wo", wo, Rows::Directions)])?;
         let ([wi, wo], model) = (&v.rows, &*self.model);
         let values = py.detach(|| rows(v.len(), |k| Bxdf::eval(model, wi[k], wo[k])));
         Ok(shaped_vectors(py, &v.shape, values))
@@ -569,7 +676,7 @@ impl Material {
     }
 
     /// sample_spectral(wi, u, lam): `(wo, pdf)`, a direction drawn for the
-    /// wavelength `lam` (µm) from three uniforms `u` (`Spectral::sample`: the
+    /// wavelength `lam` (µm) from three uniforms `u` in [0, 1) (`Spectral::sample`: the
     /// sampler of the model nearest `lam`) and its density; `(0, 0, 0)` and 0
     /// where none is drawn. Arguments and errors as `eval_spectral`'s.
     fn sample_spectral<'py>(
@@ -579,7 +686,12 @@ impl Material {
         u: &Bound<'py, PyAny>,
         lam: &Bound<'py, PyAny>,
     ) -> PyResult<SpectralSampleArrays<'py>> {
-        let (v, model) = self.spectral_rows(py, "sample_spectral", [("wi", wi), ("u", u)], lam)?;
+        let (v, model) = self.spectral_rows(
+            py,
+            "sample_spectral",
+            [("wi", wi, Rows::Directions), ("u", u, Rows::Uniforms)],
+            lam,
+        )?;
         let [wi, u, lam] = &v.rows;
         let samples = py.detach(|| {
             rows(v.len(), |k| match model.sample(wi[k], u[k], lam[k][0]) {
@@ -603,7 +715,7 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let v = vectors([("wi", wi, Rows::Directions), ("wo", wo, Rows::Directions)])?;
         let ([wi, wo], model) = (&v.rows, &*self.model);
         let values = py.detach(|| rows(v.len(), |k| Bxdf::pdf(model, wi[k], wo[k])));
         Ok(shaped(py, &v.shape, values))
@@ -611,7 +723,9 @@ impl Material {
 
     /// sample(wi, u) -> (wo, pdf, weight): samples `wo` given `wi` (towards
     /// the light) with three uniform numbers in [0, 1) per row `u`; `wi` and
-    /// `u` are `(..., 3)` and broadcast together.
+    /// `u` are `(..., 3)` and broadcast together. A row of `u` with a
+    /// component outside [0, 1) (or not finite) raises `ValueError` naming
+    /// the entry, as the C API's `ts_sample_rgb` refuses it.
     ///
     /// Returns `wo` `(..., 3)`, its density `pdf` `(...)` in sr⁻¹ and
     /// `weight = ρ(wi, wo) cos θo / pdf` `(..., 3)`, float32; rows where
@@ -622,7 +736,7 @@ impl Material {
         wi: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<SampleArrays<'py>> {
-        let v = vectors([("wi", wi), ("u", u)])?;
+        let v = vectors([("wi", wi, Rows::Directions), ("u", u, Rows::Uniforms)])?;
         let ([wi, u], model) = (&v.rows, &*self.model);
         let samples = py.detach(|| {
             rows(v.len(), |k| match Bxdf::sample(model, wi[k], u[k]) {
@@ -666,7 +780,7 @@ impl Material {
         let compensation = py
             .detach(|| ref_brdf::Compensation::rgb(&params, &options))
             .map_err(|e| value_error(e.to_string()))?;
-        let v = vectors([("wi", wi), ("wo", wo)])?;
+        let v = vectors([("wi", wi, Rows::Directions), ("wo", wo, Rows::Directions)])?;
         let [wi, wo] = &v.rows;
         let values = py.detach(|| {
             (0..v.len() * 3)
@@ -868,20 +982,50 @@ impl Material {
         self.rgb_mode.name()
     }
 
+    /// to_toml(): the material file of this material: a `[material]` table
+    /// of every keyword (numbers as the shortest decimals that read back to
+    /// the same float32), which `from_toml_string` (and the C API and the
+    /// generator) read back to the same model, bit for bit.
+    fn to_toml(&self) -> String {
+        self.desc().to_toml()
+    }
+
+    /// `twoscale.Material.preset(name, …)` for a preset (the options and
+    /// `rgb_mode` that differ from its defaults), else
+    /// `twoscale.Material(beta=…, …)` with every keyword (`eta` as the
+    /// spectrum's `(lam, n, k)` lists when it was given over the spectrum):
+    /// evaluated with `twoscale` imported, it rebuilds the same model, bit
+    /// for bit.
     fn __repr__(&self) -> String {
-        let s = self.material.layer.surface;
-        format!(
-            "twoscale.Material(beta={}, p={}, sigma_s={}, b={}, c={}, eta={:?}, base='{}', albedo={:?}, lambertian={})",
-            s.beta,
-            s.p,
-            s.sigma_s,
-            s.b,
-            s.c,
-            self.eta(),
-            self.base(),
-            self.albedo(),
-            self.material.layer.lambertian,
-        )
+        if let Some(name) = self.preset {
+            return self.preset_repr(name);
+        }
+        let args: Vec<String> = self
+            .desc()
+            .keys()
+            .into_iter()
+            .map(|(key, value)| {
+                let text = match value {
+                    desc::KeyValue::Number(x) => desc::number(x),
+                    desc::KeyValue::Name(name) => format!("{name:?}"),
+                    desc::KeyValue::Pairs(pairs) => {
+                        let items: Vec<String> = pairs
+                            .iter()
+                            .map(|[n, k]| format!("({}, {})", desc::number(*n), desc::number(*k)))
+                            .collect();
+                        format!("[{}]", items.join(", "))
+                    }
+                    desc::KeyValue::Spectrum(rows) => format!(
+                        "({}, {}, {})",
+                        py_list(rows.iter().map(|r| r[0])),
+                        py_list(rows.iter().map(|r| r[1])),
+                        py_list(rows.iter().map(|r| r[2])),
+                    ),
+                };
+                format!("{key}={text}")
+            })
+            .collect();
+        format!("twoscale.Material({})", args.join(", "))
     }
 }
 
@@ -1295,7 +1439,9 @@ fn brdf<'py>(
     reference: bool,
     clamp: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let v = vectors([("wi", wi), ("wo", wo)])?;
+    // Unchecked with clamp=True, as the other domains are.
+    let directions = if clamp { Rows::Any } else { Rows::Directions };
+    let v = vectors([("wi", wi, directions), ("wo", wo, directions)])?;
     let [wi, wo] = &v.rows;
     let options = Options::default();
     if reference {
@@ -1351,6 +1497,8 @@ fn brdf<'py>(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Material>()?;
+    // The workspace's version: the `twoscale` crate's, the package's.
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(
         "RGB_WAVELENGTHS",
         twoscale::material::RGB_WAVELENGTHS.to_vec(),

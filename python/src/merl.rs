@@ -5,7 +5,8 @@
 
 use numpy::ndarray::{Array1, Array2, Array4};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray4,
+    IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArrayDyn,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -41,23 +42,44 @@ fn merl_decode<'py>(
 }
 
 /// merl_encode(values, scaled): the bytes of a file of a (3, 90, 90, 180)
-/// float64 array; `scaled` takes BRDF values (NaN or negative: missing) and
-/// stores `merl::raw_for` of each, else the array is stored as it is.
+/// float64 array; `scaled` takes BRDF values (NaN: missing) and stores
+/// `merl::raw_for` of each, else the array is stored as it is (negative:
+/// missing; any bit pattern, so that raw files round-trip byte for byte).
+/// Refused with `ValueError`: another shape, and (`scaled`) a negative or
+/// infinite BRDF value, which a file cannot hold (a missing sample is NaN);
+/// the message gives the first one's index.
 #[pyfunction]
 fn merl_encode<'py>(
     py: Python<'py>,
-    values: PyReadonlyArray4<'py, f64>,
+    values: PyReadonlyArrayDyn<'py, f64>,
     scaled: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let view = values.as_array();
-    if view.dim() != SHAPE {
+    let shape = [SHAPE.0, SHAPE.1, SHAPE.2, SHAPE.3];
+    if view.shape() != shape {
         return Err(value_error(format!(
-            "MERL values must have shape {SHAPE:?}, got {:?}",
+            "MERL values must have shape {SHAPE:?} (channel, θh bin, θd bin, φd bin), got {:?}",
             view.shape()
         )));
     }
     // Iteration of an ndarray view is in logical (C) order whatever its strides.
     let mut stored: Vec<f64> = view.iter().copied().collect();
+    let bad = scaled
+        .then(|| stored.iter().position(|v| *v < 0.0 || v.is_infinite()))
+        .flatten();
+    if let Some(k) = bad {
+        let (c, rest) = (k / merl::BINS, k % merl::BINS);
+        let (h, d, phi) = (
+            rest / (SHAPE.2 * SHAPE.3),
+            rest / SHAPE.3 % SHAPE.2,
+            rest % SHAPE.3,
+        );
+        return Err(value_error(format!(
+            "values[{c}, {h}, {d}, {phi}] = {}: a BRDF value must be finite and ≥ 0 \
+             (NaN marks a missing sample; raw=True writes stored values as they are)",
+            stored[k]
+        )));
+    }
     if scaled {
         for (k, v) in stored.iter_mut().enumerate() {
             *v = merl::raw_for(*v, k / merl::BINS);

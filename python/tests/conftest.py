@@ -1,8 +1,11 @@
-"""Shared fixtures: the `generator query` CLI (built once per session)."""
+"""Shared fixtures: Rust builds of the repository (skipped without a Rust
+toolchain, as for an installed wheel's tests) and the `generator query` CLI
+(built once per session)."""
 
 import csv
 import io
 import pathlib
+import shutil
 import subprocess
 
 import numpy as np
@@ -12,16 +15,39 @@ REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="session")
-def generator_query():
+def cargo():
+    """The path of ``cargo``. The tests that use it (through ``cargo_build``
+    too) are skipped where it is not on PATH, as for a wheel installed
+    without the Rust toolchain: they build Rust code of this source tree."""
+    found = shutil.which("cargo")
+    if found is None:
+        pytest.skip("needs the Rust toolchain (cargo) to build from the source tree")
+    return found
+
+
+@pytest.fixture(scope="session")
+def cargo_build(cargo):
+    """``build(package)``: ``cargo build --release --locked -p package`` in
+    the repository (once per package), returning ``target/release``."""
+    built = set()
+
+    def build(package):
+        if package not in built:
+            subprocess.run(
+                [cargo, "build", "--release", "--locked", "-p", package], cwd=REPO, check=True
+            )
+            built.add(package)
+        return REPO / "target" / "release"
+
+    return build
+
+
+@pytest.fixture(scope="session")
+def generator_query(cargo_build):
     """``query(quantity, columns)``: runs ``generator query`` on the rows
     given as a dict of equal-length columns and returns the output columns
     (float64 arrays by name). Fails if any row is reported bad."""
-    subprocess.run(
-        ["cargo", "build", "--release", "--locked", "-p", "generator"],
-        cwd=REPO,
-        check=True,
-    )
-    binary = REPO / "target" / "release" / "generator"
+    binary = cargo_build("generator") / "generator"
 
     def query(quantity, columns):
         names = list(columns)

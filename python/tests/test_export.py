@@ -9,19 +9,16 @@ import numpy as np
 import pytest
 
 import twoscale
-from conftest import REPO
 
 
 @pytest.fixture(scope="session")
-def exported(tmp_path_factory):
+def exported(tmp_path_factory, cargo_build):
     """``(directory, tables.json)`` of an npy export of T1, T2, T3 (every
     precision each allows)."""
-    subprocess.run(
-        ["cargo", "build", "--release", "--locked", "-p", "generator"], cwd=REPO, check=True
-    )
+    generator = cargo_build("generator") / "generator"
     out = tmp_path_factory.mktemp("export")
     subprocess.run(
-        [REPO / "target" / "release" / "generator", "export", "--points", "0",
+        [generator, "export", "--points", "0",
          "--table", "t1", "--table", "t2", "--table", "t3", "--out", out],
         check=True,
     )

@@ -1,6 +1,6 @@
 """Material files (TOML: a ``[material]`` table of ``twoscale.Material``'s
 keywords and an optional ``[metrics]`` table, what ``python -m twoscale.fit``
-writes) are one schema read by one parser (``twoscale::desc``): Python
+writes) are one schema read by one parser (``twoscale::io::desc``): Python
 (``Material.from_toml``), C (``ts_material_desc_from_toml_file``, through
 ``capi/tests/c/material_file.c``) and Rust (``generator query brdf
 --material``) give the same BRDF values bit for bit and refuse a bad file
@@ -74,10 +74,9 @@ def files(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def c_reader(tmp_path_factory):
+def c_reader(tmp_path_factory, cargo_build):
     """``capi/tests/c/material_file.c`` built against the release library."""
-    subprocess.run(["cargo", "build", "--release", "--locked", "-p", "twoscale-capi"], cwd=REPO, check=True)
-    lib = REPO / "target" / "release"
+    lib = cargo_build("twoscale-capi")
     binary = tmp_path_factory.mktemp("c") / "material_file"
     subprocess.run(
         ["cc", "-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-I", REPO / "capi" / "include",
@@ -89,9 +88,8 @@ def c_reader(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def generator():
-    subprocess.run(["cargo", "build", "--release", "--locked", "-p", "generator"], cwd=REPO, check=True)
-    return REPO / "target" / "release" / "generator"
+def generator(cargo_build):
+    return cargo_build("generator") / "generator"
 
 
 @pytest.fixture(scope="module")

@@ -184,8 +184,31 @@ def test_malformed_files_are_rejected(tmp_path):
         merl.decode(struct.pack("<3i", 180, 90, 90) + good[12:])
     with pytest.raises(ValueError, match="shape"):
         merl.encode(np.zeros((3, 90, 90, 179)))
+    # The expected shape is named (it was "dimensionality mismatch: from=3, to=4").
+    with pytest.raises(ValueError, match=r"must have shape \(3, 90, 90, 180\) .*got \[3, 90, 90\]"):
+        merl.write(tmp_path / "x", np.zeros((3, 90, 90)))
+    assert not (tmp_path / "x").exists()
     with pytest.raises(ValueError, match=r"\(N, 3\)"):
         merl.index(np.zeros((4, 2)), np.zeros((4, 2)))
+
+
+def test_write_refuses_values_a_brdf_cannot_have(tmp_path):
+    """A negative BRDF value used to be stored as missing and an infinite
+    one as is; both are refused, naming the first one's index. NaN is the
+    missing marker; raw=True writes stored values as they are."""
+    values = np.ones(merl.SHAPE)
+    values[0, 0, 0, 0] = np.nan
+    for bad in (-0.5, np.inf, -np.inf):
+        values[1, 2, 3, 4] = bad
+        with pytest.raises(ValueError, match=rf"^values\[1, 2, 3, 4\] = {bad}: a BRDF value must be finite and ≥ 0"):
+            merl.write(tmp_path / "bad", values)
+        assert not (tmp_path / "bad").exists()
+    values[1, 2, 3, 4] = 0.0
+    merl.write(tmp_path / "good", values)
+    assert np.isnan(merl.read(tmp_path / "good")[0, 0, 0, 0])
+    values[1, 2, 3, 4] = -1.0
+    merl.write(tmp_path / "raw", values, raw=True)
+    assert np.isnan(merl.read(tmp_path / "raw")[1, 2, 3, 4])
 
 
 def test_bin_centres_lie_in_their_bins():

@@ -181,3 +181,18 @@ def test_material_file(tmp_path):
     with pytest.raises(Exception, match=r"\[material\] p = 9: must be in \[0.2, 5\]"):
         path.write_text("[material]\nbeta = 0.1\np = 9\neta = [[1, 0], [1, 0], [1, 0]]\n", encoding="utf-8")
         mi.load_dict({"type": "twoscale", "filename": str(path)})
+
+
+def test_a_bsdf_prints_its_material_options_included():
+    """``print(bsdf)`` (``to_string``) shows the material's repr: a preset's
+    options and rgb_mode included, and the repr rebuilds the same material."""
+    bsdf = mi.load_dict({"type": "twoscale", "material": "gold-rough", "colour": "white",
+                         "multiple_scattering": "kulla-conty", "rgb_mode": "paper-wavelengths"})
+    want = ('twoscale.Material.preset("gold-rough", colour="white", '
+            'multiple_scattering="kulla-conty", rgb_mode="paper-wavelengths")')
+    assert str(bsdf) == f"TwoScaleBSDF[{want}]"
+    rebuilt = eval(want, {"twoscale": twoscale})
+    direct = twoscale.Material.preset("gold-rough", colour="white",
+                                      multiple_scattering="kulla-conty", rgb_mode="paper-wavelengths")
+    wi, wo = np.array([0.5, 0.0, 0.866]), np.array([-0.45, 0.05, 0.89])
+    np.testing.assert_array_equal(rebuilt.eval(wi, wo), direct.eval(wi, wo))

@@ -167,6 +167,54 @@ def test_bad_arrays_raise_value_error():
         lookup.g1([1.0, 1.0], [1.0, 2.0, 3.0])
 
 
+def test_non_finite_directions_and_bad_uniforms_raise_naming_the_entry():
+    """As strict as the C API: a NaN or infinite direction component, and a
+    uniform outside [0, 1), raise ValueError naming the argument and the
+    entry (they used to give zeros and a normal-looking sample)."""
+    m = twoscale.Material.preset("gold-rough")
+    wi = np.array([[0.5, 0.0, 0.866]] * 4)
+    wo = np.array([[-0.45, 0.05, 0.89]] * 4)
+    u = np.full((4, 3), 0.5)
+    bad = wi.copy()
+    bad[2, 0] = np.nan
+    for method in (m.eval, m.pdf):
+        with pytest.raises(ValueError, match=r"^wi \(entry 2\) has a non-finite component: \[NaN, 0\.0, 0\.866\]$"):
+            method(bad, wo)
+        with pytest.raises(ValueError, match=r"^wo \(entry 0\) has a non-finite component: \[inf"):
+            method(wi[0], np.array([np.inf, 0.0, 1.0]))
+    with pytest.raises(ValueError, match=r"^wi \(entry 2\) has a non-finite component"):
+        m.sample(bad, u)
+    with pytest.raises(ValueError, match=r"^wi \(entry 2\) has a non-finite component"):
+        m.eval_spectral(bad, wo, 0.5)
+    for value in (np.nan, np.inf):
+        worse = u.copy()
+        worse[1, 2] = value
+        with pytest.raises(ValueError, match=r"^u \(entry 1\) has a non-finite component"):
+            m.sample(wi, worse)
+        with pytest.raises(ValueError, match=r"^u \(entry 1\) has a non-finite component"):
+            m.sample_spectral(wi, worse, 0.5)
+    for value in (1.0, -0.25, 7.0):
+        worse = u.copy()
+        worse[3, 0] = value
+        with pytest.raises(ValueError, match=r"^u \(entry 3\) has a component outside \[0, 1\)"):
+            m.sample(wi, worse)
+        with pytest.raises(ValueError, match=r"^u \(entry 3\) has a component outside \[0, 1\)"):
+            m.sample_spectral(wi, worse, 0.5)
+    # A batch of higher rank gives the entry's index too.
+    grid = np.broadcast_to(u, (2, 4, 3)).copy()
+    grid[1, 3, 1] = 1.5
+    with pytest.raises(ValueError, match=r"^u \(entry 7, index \[1, 3\]\) has a component outside"):
+        m.sample(wi, grid)
+    # The edges of the domain are accepted: 0 and the largest float below 1.
+    edge = np.array([[0.0, np.nextafter(np.float32(1), np.float32(0)), 0.0]])
+    assert m.sample(wi[:1], edge)[0].shape == (1, 3)
+    # lookup.brdf refuses them unless clamp=True, as its other domains.
+    keywords = dict(beta=0.1, p=1.0, sigma_s=0.0, b=1.0, c=2.0, n=0.2, k=3.0, lam=0.5)
+    with pytest.raises(ValueError, match=r"^wi \(entry 2\) has a non-finite component"):
+        lookup.brdf(bad, wo, **keywords)
+    assert lookup.brdf(bad, wo, clamp=True, **keywords)[2] == 0.0
+
+
 GOLD = [(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)]
 
 

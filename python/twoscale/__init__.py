@@ -1,6 +1,6 @@
 """The Holzschuch–Pacanowski two-scale BRDF from precomputed tables.
 
-``Material`` is the RGB model of one material (at 0.645, 0.526, 0.444 µm)
+``Material`` is the RGB model of one material (linear sRGB; ``rgb_mode`` below)
 evaluated over NumPy arrays of directions; ``lookup`` holds the table
 lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
 registers a Mitsuba 3 BSDF (imported on first use of ``twoscale.mitsuba``:
@@ -15,7 +15,7 @@ values (the default first), ``BASES`` lists the base layers and
 ``RGB_MODES`` the RGB models (``rgb_mode``: the paper's wavelengths, the
 default of (n, k) pairs, or the integral over the spectrum, the default of
 a preset and of a spectrum): the runtime's one list of each
-(``twoscale::validate::Named``).
+(``twoscale::validate::Named``). ``__version__`` is the crates' version.
 """
 
 import importlib
@@ -29,6 +29,11 @@ __all__ = [
     "BASES", "Material", "OPTIONS", "RGB_MODES", "RGB_WAVELENGTHS", "fit", "lookup", "merl",
     "reference",
 ]
+
+# The crates' version (Cargo's), which is also the package's.
+from ._native import __version__  # noqa: E402
+
+__all__.append("__version__")
 
 
 def __getattr__(name: str) -> ModuleType:

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "__version__",
     "Material",
     "RGB_WAVELENGTHS",
     "OPTIONS",
@@ -31,6 +32,7 @@ __all__ = [
     "MERL_FILE_BYTES",
 ]
 
+__version__: str
 RGB_WAVELENGTHS: list[float]
 OPTIONS: dict[str, tuple[str, ...]]
 BASES: tuple[str, ...]
@@ -99,6 +101,7 @@ class Material:
     def with_layer(
         self, *, albedo: float | None = None, lambertian: float | None = None
     ) -> Material: ...
+    def to_toml(self) -> str: ...
     @property
     def beta(self) -> float: ...
     @property

@@ -10,7 +10,8 @@ reciprocity). The BRDF is the stored value times ``SCALE[channel]``
 
 Arrays have shape ``(3, 90, 90, 180)`` (channel, θh bin, θd bin, φd bin),
 float64. ``read`` gives the BRDF in sr⁻¹ with **NaN where a sample is
-missing**; ``write`` stores NaN (or a negative value) as missing (−1).
+missing**; ``write`` stores NaN as missing (−1) and refuses a negative or
+infinite BRDF value (``ValueError`` with its index), and any other shape.
 
 Round trips: ``write(path, read(path))`` rewrites a file byte for byte
 when ``raw=True`` (the stored values as they are). With the default
@@ -64,7 +65,10 @@ def decode(data: bytes, *, raw: bool = False) -> np.ndarray:
 
 def encode(values, *, raw: bool = False) -> bytes:
     """The bytes of a file holding ``values`` (``(3, 90, 90, 180)``): BRDF
-    values (NaN or negative: missing), or stored values with ``raw=True``."""
+    values (NaN: missing; finite and ≥ 0 otherwise), or with ``raw=True``
+    the stored values as they are (negative: missing). Raises
+    ``ValueError`` for another shape, or a negative or infinite BRDF value
+    (naming its index)."""
     a = np.ascontiguousarray(values, dtype=np.float64)
     return _native.merl_encode(a, not raw)
 

@@ -92,7 +92,11 @@ pub trait Bxdf {
     fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32;
 
     /// An outgoing direction for `i` from three uniforms in [0, 1), with its
-    /// density and ρ; `None` when nothing is sampled.
+    /// density and ρ; `None` when nothing is sampled. A component of `u`
+    /// outside [0, 1) is clamped into it (below 0 reads 0, 1 and above the
+    /// largest `f32` below 1, NaN 0): this renderer-facing call has no
+    /// error to return, while the C API (`ts_sample_rgb`) and Python refuse
+    /// such `u` (`tests/uniforms.rs`).
     fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<BxdfSample<Self::Value>>;
 }
 

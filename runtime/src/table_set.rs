@@ -2,10 +2,10 @@
 //! shipped material presets built from them.
 //!
 //! ```
-//! # #[cfg(feature = "embedded")] {
+//! # #[cfg(all(feature = "embedded", feature = "std"))] {
 //! let tables = twoscale::TableSet::embedded();
 //! let gold = tables.material("gold-rough").expect("a shipped preset");
-//! let rgb = gold.eval([0.6, 0.0, 0.8], [-0.6, 0.0, 0.8]);
+//! let rgb = gold.eval([0.6, 0.0, 0.8], [-0.6, 0.0, 0.8]); // linear sRGB, integrated
 //! assert!(rgb.iter().all(|v| *v > 0.0));
 //! # }
 //! ```
@@ -15,7 +15,7 @@
 //! [`TableSet::from_bytes`] (any 64-byte-aligned bytes, `no_std`) and
 //! [`TableSet::open`] (feature `std`: read-only memory maps of a directory).
 
-use crate::brdf::{Rgb, Tables};
+use crate::brdf::{ChannelBake, INTEGRATED_COUNT, IntegratedRgb, Rgb, Tables};
 use crate::material::{Material, Options};
 use crate::materials::PRESETS;
 use crate::tables::albedo::AlbedoTable;
@@ -24,6 +24,7 @@ use crate::tables::diffuse_fresnel::DiffuseFresnelTable;
 use crate::tables::format::{FormatError, TableId};
 use crate::tables::sigma_ratio::SigmaRatioTable;
 use crate::tables::smith_g1::SmithG1Table;
+use core::borrow::BorrowMut;
 use core::fmt;
 
 /// The tables of a set ([`TableDescriptor::in_set`]), in tag order; each
@@ -199,34 +200,50 @@ impl<'a> TableSet<'a> {
         Rgb::new(&self.brdf_tables(), material, options)
     }
 
-    /// The RGB model of a shipped preset ([`crate::materials::PRESETS`]) with
-    /// the paper's options, at the paper's wavelengths (by value and
-    /// `no_std`; [`TableSet::preset`] gives the presets' default RGB, the
-    /// integral over the spectrum); an unknown name is an error that lists
-    /// the presets.
-    pub fn material<'n>(&self, name: &'n str) -> Result<Rgb<'_>, UnknownMaterial<'n>> {
-        let material = crate::materials::preset(name).ok_or(UnknownMaterial { name })?;
-        Ok(self.rgb(&material, Options::default()))
-    }
-
-    /// The RGB model of a shipped preset with the paper's options and the
-    /// presets' default RGB ([`crate::material::RgbMode::default_for`]: the
-    /// integral over the spectrum, [`crate::brdf::IntegratedRgb`]), its
-    /// bakes on the heap (feature `std`); an unknown name is an error that
-    /// lists the presets.
+    /// The RGB model of a shipped preset ([`crate::materials::PRESETS`])
+    /// with the paper's options: linear sRGB by integration over the
+    /// spectrum ([`IntegratedRgb`], docs/model.md §2.12), what Python's
+    /// `Material.preset`, C's `ts_material_preset` and the Mitsuba plugin
+    /// give for the same name. Its eight bakes (1 MB) are allocated zeroed
+    /// on the heap and filled in place (feature `std`; without it,
+    /// [`TableSet::material_in`] takes the storage). An unknown name is an
+    /// error that lists the presets.
     #[cfg(feature = "std")]
-    pub fn preset<'n>(
+    pub fn material<'n>(
         &self,
         name: &'n str,
-    ) -> Result<
-        crate::brdf::RgbModel<'_, std::boxed::Box<crate::brdf::ChannelBake>>,
-        UnknownMaterial<'n>,
-    > {
+    ) -> Result<IntegratedRgb<'_, std::boxed::Box<ChannelBake>>, UnknownMaterial<'n>> {
+        self.material_in(name, core::array::from_fn(|_| ChannelBake::boxed()))
+    }
+
+    /// [`TableSet::material`] baked into the storage `bakes` (`no_std`: a
+    /// `&mut ChannelBake` each, e.g. from a `static`; see
+    /// [`IntegratedRgb::new_in`]).
+    pub fn material_in<'n, B: BorrowMut<ChannelBake>>(
+        &self,
+        name: &'n str,
+        bakes: [B; INTEGRATED_COUNT],
+    ) -> Result<IntegratedRgb<'_, B>, UnknownMaterial<'n>> {
         let spectral = crate::materials::spectral(name).ok_or(UnknownMaterial { name })?;
-        // Every preset validates (`every_preset_is_found_and_an_unknown_name_lists_them`).
-        let desc = crate::io::desc::MaterialDesc::spectral(spectral, Options::default(), None)
-            .map_err(|_| UnknownMaterial { name })?;
-        Ok(crate::brdf::RgbModel::boxed(&self.brdf_tables(), &desc))
+        Ok(IntegratedRgb::new_in(
+            bakes,
+            &self.brdf_tables(),
+            &spectral,
+            Options::default(),
+        ))
+    }
+
+    /// The RGB model of a shipped preset with the paper's options at the
+    /// paper's three wavelengths ([`Rgb`] at [`crate::material::RGB_WAVELENGTHS`],
+    /// `rgb_mode = "paper-wavelengths"`: what reproduces HP15/HP17; 8–14%
+    /// off the integral for gold), by value (366 KB) and `no_std`; an
+    /// unknown name is an error that lists the presets.
+    pub fn material_at_paper_wavelengths<'n>(
+        &self,
+        name: &'n str,
+    ) -> Result<Rgb<'_>, UnknownMaterial<'n>> {
+        let material = crate::materials::preset(name).ok_or(UnknownMaterial { name })?;
+        Ok(self.rgb(&material, Options::default()))
     }
 }
 
@@ -425,7 +442,10 @@ mod tests {
         for _ in 0..50 {
             let owned = TableSet::open(dir).expect("the committed tables");
             assert_eq!(mapped(&stem), before + 1);
-            let rgb = owned.set().material("gold-rough").expect("preset");
+            let rgb = owned
+                .set()
+                .material_at_paper_wavelengths("gold-rough")
+                .expect("preset");
             assert!(rgb.eval([0.3, 0.1, 0.9], [-0.3, 0.0, 0.95])[0] > 0.0);
         }
         assert_eq!(mapped(&stem), before);
@@ -440,30 +460,65 @@ mod tests {
     #[test]
     fn every_preset_is_found_and_an_unknown_name_lists_them() {
         let set = TableSet::embedded();
+        let (i, o) = ([0.3, 0.1, 0.9], [-0.3, 0.0, 0.95]);
         for (name, _) in PRESETS {
-            let model = set.material(name).expect("preset");
-            let v = model.eval([0.3, 0.1, 0.9], [-0.3, 0.0, 0.95]);
+            let model = set.material_at_paper_wavelengths(name).expect("preset");
+            let v = model.eval(i, o);
             assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {v:?}");
         }
-        // `preset` (the integrated RGB, on the heap) needs `std`.
+        // `material` (the integrated RGB, on the heap) needs `std`.
         #[cfg(feature = "std")]
-        {
-            for (name, _) in PRESETS {
-                let model = set.preset(name).expect("preset");
-                assert!(
-                    matches!(model, crate::brdf::RgbModel::Integrated(_)),
-                    "{name}"
-                );
-                let v = crate::bxdf::Bxdf::eval(&model, [0.3, 0.1, 0.9], [-0.3, 0.0, 0.95]);
-                assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {v:?}");
-            }
-            assert!(set.preset("gold").is_err());
+        for (name, _) in PRESETS {
+            let v = set.material(name).expect("preset").eval(i, o);
+            assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {v:?}");
         }
-        let error = set.material("gold").err().expect("unknown");
+        let error = set
+            .material_at_paper_wavelengths("gold")
+            .err()
+            .expect("unknown");
         let message = std::format!("{error}");
         assert!(message.contains("`gold`"), "{message}");
         for (name, _) in PRESETS {
             assert!(message.contains(name), "{message}");
+        }
+        #[cfg(feature = "std")]
+        assert_eq!(set.material("gold").err(), Some(error));
+    }
+
+    /// `material` is the integrated RGB that a material description of the
+    /// preset builds (what the C API and Python build), bit for bit, and
+    /// `material_at_paper_wavelengths` the paper-wavelengths one.
+    #[cfg(feature = "std")]
+    #[test]
+    fn material_is_the_description_s_default_rgb() {
+        use crate::brdf::RgbModel;
+        use crate::bxdf::Bxdf;
+        use crate::material::RgbMode;
+        let set = TableSet::embedded();
+        let pairs = [
+            ([0.5, 0.0, 0.866], [-0.45, 0.05, 0.89]),
+            ([0.1, -0.2, 0.97], [0.3, 0.4, 0.87]),
+            ([0.9, 0.1, 0.42], [-0.8, 0.0, 0.6]),
+        ];
+        for (name, _) in PRESETS {
+            let spectral = crate::materials::spectral(name).expect("preset");
+            for mode in [None, Some(RgbMode::PaperWavelengths)] {
+                let desc =
+                    crate::io::desc::MaterialDesc::spectral(spectral, Options::default(), mode)
+                        .expect("valid");
+                let described = RgbModel::boxed(&set.brdf_tables(), &desc);
+                for (i, o) in pairs {
+                    let want = Bxdf::eval(&described, i, o).map(f32::to_bits);
+                    let got = match mode {
+                        None => set.material(name).expect("preset").eval(i, o),
+                        Some(_) => set
+                            .material_at_paper_wavelengths(name)
+                            .expect("preset")
+                            .eval(i, o),
+                    };
+                    assert_eq!(got.map(f32::to_bits), want, "{name} {mode:?}");
+                }
+            }
         }
     }
 }

@@ -175,7 +175,9 @@ pub fn ggx() -> Ggx {
 
 /// The RGB preset of the RGB rows and its three indices.
 pub fn rgb_preset<'a>(set: &'a TableSet<'a>) -> (Rgb<'a>, [Complex; 3]) {
-    let model = set.material(RGB_PRESET).expect("preset");
+    let model = set
+        .material_at_paper_wavelengths(RGB_PRESET)
+        .expect("preset");
     let eta = PRESETS
         .iter()
         .find(|(n, _)| *n == RGB_PRESET)

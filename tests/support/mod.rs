@@ -6,8 +6,10 @@ use std::path::PathBuf;
 pub mod brdf;
 pub mod cost;
 
-// The README's code examples run as doctests of this crate.
+// The README's code examples run as doctests of this crate; its Rust block
+// is a whole program (a new crate's src/main.rs, python/tests/test_readme.py).
 #[doc = include_str!("../../README.md")]
+#[allow(clippy::needless_doctest_main)]
 mod readme {}
 
 /// The workspace's committed table directory.

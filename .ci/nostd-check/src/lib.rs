@@ -58,10 +58,11 @@ pub extern "C" fn twoscale_q_bar(n: f32, k: f32, cos_i: f32, ox: f32, oy: f32, o
 }
 
 /// ρ of the `gold-rough` preset from the embedded table set (feature
-/// `embedded`, no std) at the green wavelength, or −1 for an unknown preset.
+/// `embedded`, no std) at the paper's green wavelength, or −1 for an
+/// unknown preset.
 #[unsafe(no_mangle)]
 pub extern "C" fn twoscale_gold_rough_green(ix: f32, iy: f32, iz: f32, ox: f32, oy: f32, oz: f32) -> f32 {
-    match twoscale::TableSet::embedded().material("gold-rough") {
+    match twoscale::TableSet::embedded().material_at_paper_wavelengths("gold-rough") {
         Ok(model) => model.eval([ix, iy, iz], [ox, oy, oz])[1],
         Err(_) => -1.0,
     }

@@ -212,6 +212,19 @@ int main(int argc, char **argv) {
     EXPECT_ERROR(ts_eval_rgb(m, nan_dir, WO, out), TS_ERR_INVALID, "wi");
     EXPECT_ERROR(ts_pdf(m, WI, inf_dir, out), TS_ERR_INVALID, "wo");
     EXPECT_ERROR(ts_sample_rgb(m, WI, nan_dir, (ts_sample *)storage), TS_ERR_INVALID, "u");
+    /* Uniforms outside [0, 1), 1 included, are refused; its edges are not. */
+    {
+        const float ones[3] = {0.5f, 1.0f, 0.5f}, negative[3] = {-0.25f, 0.5f, 0.5f};
+        const float edge[3] = {0.0f, 0.99999994f, 0.0f};
+        ts_sample s;
+        EXPECT_ERROR(ts_sample_rgb(m, WI, ones, &s), TS_ERR_INVALID, "outside [0, 1)");
+        EXPECT_ERROR(ts_sample_rgb(m, WI, negative, &s), TS_ERR_INVALID, "u (entry 0)");
+        CHECK(ts_sample_rgb(m, WI, edge, &s) == TS_OK);
+        float wi2[6] = {WI[0], WI[1], WI[2], WI[0], WI[1], WI[2]};
+        float u2[6] = {0.3f, 0.6f, 0.2f, 0.3f, 1.5f, 0.2f};
+        ts_sample s2[2];
+        EXPECT_ERROR(ts_sample_rgb_batch(m, 2, wi2, u2, s2), TS_ERR_INVALID, "u (entry 1)");
+    }
     {
         float wi2[6] = {WI[0], WI[1], WI[2], NAN, 0.0f, 1.0f}, wo2[6], out2[6];
         memcpy(wo2, WO, sizeof WO);

@@ -2,7 +2,9 @@
 # Builds the C library, checks the committed header is what cbindgen
 # generates, compiles the C tests with the system `cc` against the shared and
 # the static library, and runs them under valgrind memcheck (any error or leak
-# fails). Needs cbindgen 0.29 and valgrind on PATH (.ci/run installs them).
+# fails). Needs cbindgen 0.29 and valgrind on PATH (.ci/run installs them):
+#   cargo install cbindgen --version 0.29.2 --locked
+#   apt-get install valgrind        (Debian/Ubuntu; brew install valgrind elsewhere)
 # Usage: capi/tests/c/run.sh [MATERIALS [PAIRS]]   (3 rows per pair: R, G, B)
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
@@ -11,6 +13,21 @@ pairs=${2:-10}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
+for tool in cbindgen valgrind; do
+  command -v "$tool" >/dev/null || {
+    echo "capi/tests/c/run.sh needs $tool on PATH:" >&2
+    case $tool in
+      cbindgen) echo "  cargo install cbindgen --version 0.29.2 --locked" >&2 ;;
+      valgrind) echo "  apt-get install valgrind (Debian/Ubuntu), or your system's package" >&2 ;;
+    esac
+    exit 1
+  }
+done
+cbindgen --version | grep -q ' 0\.29\.' || {
+  echo "capi/tests/c/run.sh needs cbindgen 0.29 (found $(cbindgen --version)):" >&2
+  echo "  cargo install cbindgen --version 0.29.2 --locked" >&2
+  exit 1
+}
 cbindgen --config capi/cbindgen.toml --crate twoscale-capi --output "$out/twoscale.h"
 if ! diff -u capi/include/twoscale.h "$out/twoscale.h"; then
   echo "capi/include/twoscale.h is stale: regenerate it with" >&2

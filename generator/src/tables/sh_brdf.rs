@@ -125,7 +125,7 @@ impl ModelInputs {
                 .map(|bytes| aligned_copy(&bytes))
                 .map_err(|e| BuildError::Input {
                     path: path.display().to_string(),
-                    message: format!("{e} (T4 projects the two-scale model, which reads it)"),
+                    message: format!("{e} (the two-scale model reads it: T4 projects it, verify's spectral row evaluates it)"),
                 })
         };
         Ok(ModelInputs {

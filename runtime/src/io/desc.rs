@@ -330,6 +330,123 @@ impl OwnedMaterialDesc {
     }
 }
 
+/// A key's value as [`MaterialDesc::keys`] gives it.
+#[cfg(feature = "std")]
+#[derive(Clone, Debug, PartialEq)]
+pub enum KeyValue<'a> {
+    /// A number.
+    Number(f32),
+    /// An option's or the base's name.
+    Name(&'static str),
+    /// `eta` as `(n, k)` per channel.
+    Pairs([[f32; 2]; 3]),
+    /// `eta` as `(λ, n, k)` rows of a spectrum.
+    Spectrum(&'a [[f32; 3]]),
+}
+
+/// The shortest decimal of `x` that reads back to `x` the way the readers
+/// read numbers (as `f64`, rounded to `f32`): Rust's shortest `f32` form,
+/// else the exact `f64` one.
+#[cfg(feature = "std")]
+pub fn number(x: f32) -> std::string::String {
+    let short = std::format!("{x:?}");
+    let reads_back = short.parse::<f64>().map(|v| (v as f32).to_bits()) == Ok(x.to_bits());
+    if reads_back {
+        short
+    } else {
+        std::format!("{:?}", f64::from(x))
+    }
+}
+
+#[cfg(feature = "std")]
+impl<'a> MaterialDesc<'a> {
+    /// Every key of the description with its value, in the order of the
+    /// module documentation's file (`albedo` only for a base that has
+    /// one): the keywords that rebuild the same model bit for bit
+    /// ([`Keywords::material`]). `eta` is the spectrum's rows when the
+    /// material was given over the spectrum, else the three `(n, k)` pairs.
+    pub fn keys(&self) -> std::vec::Vec<(&'static str, KeyValue<'a>)> {
+        use crate::validate::Named;
+        let layer = self.material.layer;
+        let eta = match self.spectral.map(|s| s.eta) {
+            Some(Ior::Tabulated(t)) => KeyValue::Spectrum(t.rows()),
+            _ => KeyValue::Pairs(self.material.eta_rgb.map(|e| [e.re, e.im])),
+        };
+        let s = layer.surface;
+        let mut keys = std::vec![
+            ("beta", KeyValue::Number(s.beta)),
+            ("p", KeyValue::Number(s.p)),
+            ("eta", eta),
+            ("sigma_s", KeyValue::Number(s.sigma_s)),
+            ("b", KeyValue::Number(s.b)),
+            ("c", KeyValue::Number(s.c)),
+            ("base", KeyValue::Name(layer.base.kind().name())),
+        ];
+        if let crate::material::BaseLayer::Plastic { albedo }
+        | crate::material::BaseLayer::Subsurface { albedo } = layer.base
+        {
+            keys.push(("albedo", KeyValue::Number(albedo)));
+        }
+        let o = self.options;
+        keys.extend([
+            ("lambertian", KeyValue::Number(layer.lambertian)),
+            (
+                crate::material::Masking::OPTION,
+                KeyValue::Name(o.masking.name()),
+            ),
+            (
+                crate::material::SigmaRelMode::OPTION,
+                KeyValue::Name(o.sigma_rel.name()),
+            ),
+            (
+                crate::material::ColourTerms::OPTION,
+                KeyValue::Name(o.colour.name()),
+            ),
+            (
+                crate::material::HaloWeight::OPTION,
+                KeyValue::Name(o.halo_weight.name()),
+            ),
+            (
+                crate::material::MultipleScattering::OPTION,
+                KeyValue::Name(o.multiple_scattering.name()),
+            ),
+            (RgbMode::OPTION, KeyValue::Name(self.rgb_mode.name())),
+        ]);
+        keys
+    }
+
+    /// The material file of the description: a `[material]` table of
+    /// every key ([`MaterialDesc::keys`], numbers by [`number`]), which
+    /// [`MaterialDesc::from_toml_str`] reads back to the same description.
+    pub fn to_toml(&self) -> std::string::String {
+        use core::fmt::Write;
+        let list = |values: &mut dyn Iterator<Item = f32>| {
+            let items: std::vec::Vec<_> = values.map(number).collect();
+            std::format!("[{}]", items.join(", "))
+        };
+        let mut out = std::string::String::from("[material]\n");
+        for (key, value) in self.keys() {
+            let text = match value {
+                KeyValue::Number(x) => number(x),
+                KeyValue::Name(name) => std::format!("\"{name}\""),
+                KeyValue::Pairs(pairs) => {
+                    let items: std::vec::Vec<_> =
+                        pairs.iter().map(|p| list(&mut p.iter().copied())).collect();
+                    std::format!("[{}]", items.join(", "))
+                }
+                KeyValue::Spectrum(rows) => std::format!(
+                    "{{ lambda = {}, n = {}, k = {} }}",
+                    list(&mut rows.iter().map(|r| r[0])),
+                    list(&mut rows.iter().map(|r| r[1])),
+                    list(&mut rows.iter().map(|r| r[2])),
+                ),
+            };
+            let _ = writeln!(out, "{key} = {text}");
+        }
+        out
+    }
+}
+
 #[cfg(feature = "toml")]
 pub use self::file::{DescError, DescErrorKind, EtaTable, KeywordTable};
 
