@@ -16,9 +16,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use suite::brdf::NarrowNdfConvolution;
 use suite::cost::{BATCH, Inputs, LAMBDA, NICKEL_LIKE, RGB_PRESET, ggx, nickel, rgb_preset};
-use twoscale::brdf::{
-    BaseLayer, IntegratedRgb, Layer, MultipleScattering, Options, Rgb, Spectral, TwoScale,
-};
+use twoscale::brdf::{IntegratedRgb, Rgb, Spectral, TwoScale};
+use twoscale::material::{BaseLayer, Layer, MultipleScattering, Options};
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 use twoscale::{Convolution, TableSet};
 
@@ -233,7 +232,7 @@ fn brdf(c: &mut Criterion) {
 }
 
 /// A conductor layer of `surface`.
-fn conductor(surface: twoscale::brdf::Surface) -> Layer {
+fn conductor(surface: twoscale::material::Surface) -> Layer {
     Layer {
         surface,
         base: BaseLayer::Conductor,

@@ -164,7 +164,7 @@ fn fresnel(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = 0.0f32;
             for &(eta, cos, _) in &points {
-                sum += twoscale::fresnel::fresnel(black_box(eta), black_box(cos));
+                sum += twoscale::model::fresnel::fresnel(black_box(eta), black_box(cos));
             }
             sum
         })
@@ -186,7 +186,7 @@ fn fresnel(c: &mut Criterion) {
             let mut sum = 0.0f32;
             for &(eta, _, o) in &points {
                 let i = [0.6, 0.0, 0.8];
-                sum += twoscale::fresnel::q_bar(black_box(eta), black_box(i), black_box(o));
+                sum += twoscale::model::fresnel::q_bar(black_box(eta), black_box(i), black_box(o));
             }
             sum
         })
@@ -320,7 +320,7 @@ fn convolution(c: &mut Criterion) {
 /// direct evaluation of the BRDF it projects (the runtime two-scale model
 /// with T3b, one channel, f64 directions rounded to f32 per call).
 fn sh_brdf(c: &mut Criterion) {
-    let pairs = generator::tables::t4::verification_pairs(1024, 7);
+    let pairs = generator::tables::sh_brdf::verification_pairs(1024, 7);
     let narrow: Vec<([f32; 3], [f32; 3])> = pairs
         .iter()
         .map(|(i, o)| (i.map(|v| v as f32), o.map(|v| v as f32)))
@@ -332,7 +332,7 @@ fn sh_brdf(c: &mut Criterion) {
     .unwrap();
     let mut group = c.benchmark_group("sh_brdf");
     group.throughput(Throughput::Elements(pairs.len() as u64));
-    let inputs = generator::tables::t4::ModelInputs::load(&suite::tables_dir()).unwrap();
+    let inputs = generator::tables::sh_brdf::ModelInputs::load(&suite::tables_dir()).unwrap();
     let parsed = inputs.parse().unwrap();
     let model_tables = parsed.brdf_tables();
     for material in &materials.materials {
@@ -341,7 +341,7 @@ fn sh_brdf(c: &mut Criterion) {
         };
         let bytes =
             std::fs::read(suite::tables_dir().join(format!("t4-{}.tbl", material.name))).unwrap();
-        let buf = twoscale::format::aligned_copy(&bytes);
+        let buf = twoscale::tables::format::aligned_copy(&bytes);
         let table = twoscale::ShBrdfTable::from_bytes(buf.bytes()).unwrap();
         let name = format!("{} L={l}", material.name);
         group.bench_function(format!("sh eval_rgb {name}"), |b| {
@@ -351,7 +351,7 @@ fn sh_brdf(c: &mut Criterion) {
                 }
             })
         });
-        let brdf = generator::tables::t4::two_scale_brdf(material, 0, 0.645, &model_tables);
+        let brdf = generator::tables::sh_brdf::two_scale_brdf(material, 0, 0.645, &model_tables);
         group.bench_function(format!("direct two-scale {}", material.name), |b| {
             b.iter(|| {
                 for &(i, o) in &pairs {

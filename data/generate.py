@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Turns the data files of this folder into the Rust tables the runtime embeds.
 
-    python3 data/generate.py              # writes runtime/src/optical_data.rs and colour_data.rs
+    python3 data/generate.py              # writes runtime/src/spectrum/optical_data.rs and colour_data.rs
     python3 data/generate.py --export-cie # rewrites data/cie/ from colour-science (PyPI)
 
 The runtime never parses these files (it is no_std); it embeds the generated
@@ -73,7 +73,7 @@ def write_optical():
             out.append(f"    [{f32(lam)}, {f32(n)}, {f32(k)}],")
         out.append("];")
         out.append("")
-    (ROOT / "runtime" / "src" / "optical_data.rs").write_text("\n".join(out))
+    (ROOT / "runtime" / "src" / "spectrum" / "optical_data.rs").write_text("\n".join(out))
 
 
 def export_cie():
@@ -121,7 +121,7 @@ def write_colour():
         out.append("    [" + ", ".join(f32(v) for v in r) + "],")
     out.append("];")
     out.append("")
-    (ROOT / "runtime" / "src" / "colour_data.rs").write_text("\n".join(out))
+    (ROOT / "runtime" / "src" / "spectrum" / "colour_data.rs").write_text("\n".join(out))
 
 
 if __name__ == "__main__":

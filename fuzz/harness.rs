@@ -15,8 +15,8 @@
 //! table's typed reader and the generic `Table::from_bytes`; whatever loads
 //! is looked up at finite inputs, which must give finite values.
 
-use twoscale::brdf::Options;
-use twoscale::format::{HEADER_SIZE, Header, aligned_copy, checksum};
+use twoscale::material::Options;
+use twoscale::tables::format::{HEADER_SIZE, Header, aligned_copy, checksum};
 use twoscale::{
     ConvTable, Convolution, DiffuseFresnelTable, ShBrdfTable, SigmaRatioTable, SmithG1Table, Table,
     TableSet,
@@ -157,7 +157,7 @@ pub fn run(data: &[u8]) -> bool {
 }
 
 /// `material` from the set, evaluated and sampled.
-fn evaluate(tables: &TableSet<'_>, material: &twoscale::brdf::Material) {
+fn evaluate(tables: &TableSet<'_>, material: &twoscale::material::Material) {
     let model = tables.rgb(material, Options::default());
     for (i, o) in [
         ([0.6, 0.1, 0.8], [-0.55, -0.05, 0.83]),

@@ -9,8 +9,9 @@
 
 use generator::rng::SplitMix64;
 use suite::brdf::{percentile, random_direction};
-use twoscale::brdf::{Material, Options, Rgb, Surface};
-use twoscale::conv::{ConvTable, Convolution};
+use twoscale::brdf::Rgb;
+use twoscale::material::{Material, Options, Surface};
+use twoscale::tables::convolution::{ConvTable, Convolution};
 use twoscale::{Complex, TableSet};
 
 /// T3b without its material slice: C straight from the 4-D table.
@@ -65,7 +66,7 @@ fn random_materials(count: u64) -> Vec<Material> {
     };
     (0..count)
         .map(|_| Material {
-            layer: twoscale::brdf::Layer {
+            layer: twoscale::material::Layer {
                 surface: Surface {
                     beta: log_uniform(&mut rng, 0.002, 1.0),
                     p: (0.2 + 4.8 * rng.uniform()) as f32,
@@ -73,7 +74,7 @@ fn random_materials(count: u64) -> Vec<Material> {
                     b: log_uniform(&mut rng, 0.5, 20.0),
                     c: (1.01 + 8.99 * rng.uniform()) as f32,
                 },
-                base: twoscale::brdf::BaseLayer::Conductor,
+                base: twoscale::material::BaseLayer::Conductor,
                 lambertian: 0.0,
             },
             eta_rgb: [

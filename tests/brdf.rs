@@ -1,5 +1,5 @@
 //! The two-scale BRDF of the runtime (`twoscale::brdf`) and the 2015 model
-//! (`twoscale::hp15`), verified physically (docs/model.md §7): the Beckmann limit,
+//! (`twoscale::brdf::hp15`), verified physically (docs/model.md §7): the Beckmann limit,
 //! reciprocity, the white furnace, χ² tests of the samplers against their
 //! pdfs, robustness over a dense sweep, and agreement with the f64 reference.
 //!
@@ -21,11 +21,12 @@ use suite::brdf::{
     random_direction,
 };
 use twoscale::Complex;
-use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, MultipleScattering, Options,
-    SigmaRelMode, Surface, TwoScale,
+use twoscale::brdf::hp15::{Energy, Hp15, Hp15Params};
+use twoscale::brdf::{Lobe, TwoScale};
+use twoscale::material::{
+    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, MultipleScattering, Options, SigmaRelMode,
+    Surface,
 };
-use twoscale::hp15::{Energy, Hp15, Hp15Params};
 
 const NICKEL_LIKE: Complex = Complex::new(1.98, 3.74);
 
@@ -335,7 +336,7 @@ fn preset_albedos() {
     let mut above = Vec::new();
     for (name, material) in twoscale::materials::PRESETS {
         let s = material.layer.surface;
-        let u_max = f64::from(s.b / twoscale::brdf::RGB_WAVELENGTHS[2]) * 1.0001;
+        let u_max = f64::from(s.b / twoscale::material::RGB_WAVELENGTHS[2]) * 1.0001;
         let conv = ProfileConvolution::new(s.c, s.beta, s.p, u_max);
         let tables = set.brdf_tables_with(&conv);
         let rgb = twoscale::Rgb::new(&tables, &material, Options::default());

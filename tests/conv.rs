@@ -5,12 +5,14 @@
 //! issue's acceptance figures).
 
 use generator::reference::conv as reference;
-use generator::tables::t3;
+use generator::tables::convolution;
 use twoscale::TableId;
-use twoscale::conv::{ConvTable, Convolution, normalised_angle, tan_of_normalised_angle};
-use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{AxisHeader, aligned_copy};
-use twoscale::interp::{coordinate_f64, node_value};
+use twoscale::tables::convolution::{
+    ConvTable, Convolution, normalised_angle, tan_of_normalised_angle,
+};
+use twoscale::tables::format::write::{TableSpec, encode};
+use twoscale::tables::format::{AxisHeader, aligned_copy};
+use twoscale::tables::interp::{coordinate_f64, node_value};
 
 fn small_axis(nodes: u32, base: &AxisHeader) -> AxisHeader {
     AxisHeader { nodes, ..*base }
@@ -22,10 +24,10 @@ fn small_axis(nodes: u32, base: &AxisHeader) -> AxisHeader {
 /// along `ξ` reproduce such data exactly.
 fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f64) -> f64) {
     let axes = [
-        small_axis(4, &t3::U_AXIS),
-        small_axis(3, &t3::C_AXIS),
-        small_axis(5, &t3::BETA_AXIS),
-        small_axis(3, &t3::P_AXIS),
+        small_axis(4, &convolution::U_AXIS),
+        small_axis(3, &convolution::C_AXIS),
+        small_axis(5, &convolution::BETA_AXIS),
+        small_axis(3, &convolution::P_AXIS),
     ];
     let coeff = [0.3, -0.7, 1.1, 0.4];
     let f = move |x: [f64; 4], xi: f64| -> f64 {
@@ -61,11 +63,11 @@ fn linear_table(angles: usize) -> (Vec<u8>, [AxisHeader; 4], impl Fn([f64; 4], f
         kernel: TableId::Convolution.descriptor().kernel,
         value_type: TableId::Convolution.descriptor().value_type,
         axes: &axes,
-        params: &t3::header_params(
+        params: &convolution::header_params(
             angles,
-            &twoscale::conv::AngleParams {
+            &twoscale::tables::format::AngleParams {
                 ndf_softening: 1e-6,
-                ..t3::ANGLE
+                ..convolution::ANGLE
             },
         )
         .to_values(),
@@ -121,7 +123,7 @@ fn lookup_reproduces_data_linear_in_parameters_and_angle() {
         f64::from(1.0f32),
     ];
     assert!((f64::from(s).ln() - f(x, 0.0)).abs() < 2e-5);
-    let g2 = f(x, 0.5).exp() - t3::G_OFFSET;
+    let g2 = f(x, 0.5).exp() - convolution::G_OFFSET;
     assert!((f64::from(g) - g2.max(0.0).sqrt()).abs() < 1e-4 * g2.sqrt().max(1.0));
 }
 
@@ -239,7 +241,7 @@ const ANGLE_CASES: [(f64, f64, f64); 6] = [
 /// `atan` of `(τ − τe) / (1 + τ τe)`.)
 #[test]
 fn normalised_angle_matches_its_formula() {
-    let a = t3::ANGLE;
+    let a = convolution::ANGLE;
     let direct = |tau: f64, u: f64, beta: f64, p: f64| -> f64 {
         let ue = (u * u + a.kernel_scale_floor.powi(2)).sqrt();
         let p_eff = p / (1.0 + a.ndf_softening * p / (2.0 * ue * beta));
@@ -277,7 +279,7 @@ fn normalised_angle_matches_its_formula() {
 
 #[test]
 fn normalised_angle_inverts_and_is_monotone() {
-    let a = t3::ANGLE;
+    let a = convolution::ANGLE;
     for &(u, beta, p) in &ANGLE_CASES {
         let mut last = -1.0;
         for k in 0..=200 {
@@ -304,7 +306,7 @@ fn normalised_angle_inverts_and_is_monotone() {
 #[test]
 fn angle_rule_integrates_the_measure() {
     for &(u, beta, p) in &[(0.0, 1.0, 1.0), (30.0, 0.05, 2.0), (3000.0, 0.002, 0.2)] {
-        let (thetas, weights) = t3::angle_rule(u, beta, p);
+        let (thetas, weights) = convolution::angle_rule(u, beta, p);
         let sum: f64 = weights.iter().sum();
         let want = 1.0 - thetas.last().unwrap().cos();
         assert!(
@@ -314,7 +316,7 @@ fn angle_rule_integrates_the_measure() {
     }
 }
 
-fn shipped() -> twoscale::format::AlignedBuf {
+fn shipped() -> twoscale::tables::format::AlignedBuf {
     suite::read_table(TableId::Convolution)
 }
 
@@ -330,8 +332,8 @@ fn shipped_table_reproduces_exact_profiles_at_nodes() {
     let quantised = raw.quantised().unwrap();
     for index in [0usize, 7, 1234, 5555, 9001, 13_337, 20_159, 30_001, 40_319] {
         let bound = 2e-4 + 0.5 * f64::from(quantised.scales[2 * index + 1]);
-        let [u, c, beta, p] = t3::node_params(index);
-        let (thetas, _) = t3::angle_rule(u, beta, p);
+        let [u, c, beta, p] = convolution::node_params(index);
+        let (thetas, _) = convolution::angle_rule(u, beta, p);
         let exact = reference::convolution_profile(u, c, beta, p, &thetas).unwrap();
         let peak = exact.iter().cloned().fold(0.0, f64::max);
         for (&theta, &want) in thetas.iter().zip(&exact) {
@@ -353,8 +355,8 @@ fn pointwise_errors(profiles: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
     let table = ConvTable::from_bytes(buf.bytes()).unwrap();
     let mut errors = Vec::new();
     let mut e_l2 = Vec::new();
-    for point in t3::verification_points(profiles, seed) {
-        let r = t3::verify_point(&table, point).unwrap();
+    for point in convolution::verification_points(profiles, seed) {
+        let r = convolution::verify_point(&table, point).unwrap();
         errors.extend(r.accurate_pointwise);
         e_l2.push(r.accurate_e_l2);
     }

@@ -14,11 +14,11 @@ use generator::rng::SplitMix64;
 use std::f64::consts::PI;
 use suite::brdf::{NarrowNdfConvolution, ProfileConvolution, chi_square_two_scale};
 use twoscale::Complex;
-use twoscale::brdf::{
-    BaseLayer, ColourTerms, HaloWeight, Layer, Lobe, Masking, MultipleScattering, Options, Surface,
-    TwoScale,
+use twoscale::brdf::{Lobe, TwoScale};
+use twoscale::material::{
+    BaseLayer, ColourTerms, HaloWeight, Layer, Masking, MultipleScattering, Options, Surface,
 };
-use twoscale::fresnel::fresnel_average;
+use twoscale::model::fresnel::fresnel_average;
 
 /// The white furnace's target: `|albedo − 1| ≤ 0.005` (issue 27).
 const FURNACE_TOLERANCE: f64 = 0.005;
@@ -316,7 +316,7 @@ fn conductors_match_the_closed_form() {
             let e = f64::from(column.albedo(f64::from(i[2])));
             let (mut off_row, mut on_row) = (String::new(), String::new());
             for (k, eta) in material.eta_rgb.into_iter().enumerate() {
-                let lambda = twoscale::brdf::RGB_WAVELENGTHS[k];
+                let lambda = twoscale::material::RGB_WAVELENGTHS[k];
                 let [off, on] = [false, true].map(|compensate| {
                     let model = TwoScale::new(
                         &tables,

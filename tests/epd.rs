@@ -5,7 +5,7 @@
 use generator::quad::{Tolerance, integrate, integrate_to_infinity};
 use generator::reference::epd as reference;
 use generator::rng::SplitMix64;
-use twoscale::epd::Epd;
+use twoscale::model::epd::Epd;
 use twoscale::{SmithG1Table, TableId};
 
 fn with_t1<R>(f: impl FnOnce(&SmithG1Table<'_>) -> R) -> R {
@@ -61,7 +61,7 @@ fn ndf_is_normalised() {
 #[test]
 fn t1_is_within_target_at_random_points() {
     with_t1(|t1| {
-        let points = generator::tables::t1::verification_points(6000, 12345);
+        let points = generator::tables::smith_g1::verification_points(6000, 12345);
         let mut worst = (0.0f64, 0.0, 0.0);
         for (p, a) in points {
             let reference = reference::g1(p, a).unwrap();

@@ -3,7 +3,7 @@
 //! panics or accepts the damage.
 
 use std::mem::offset_of;
-use twoscale::format::{
+use twoscale::tables::format::{
     AxisHeader, FORMAT_VERSION, FormatError, HEADER_SIZE, Header, TableId, aligned_copy, checksum,
 };
 use twoscale::{SmithG1Table, Table};
@@ -309,8 +309,8 @@ fn t1_rejects_impossible_values() {
 /// panic) by readers that need f32 values, and when its payload is cut.
 #[test]
 fn u16_tables_round_trip_within_half_a_step() {
-    use twoscale::format::write::{TableSpec, encode};
-    use twoscale::format::{Kernel, Mapping, ValueType};
+    use twoscale::tables::format::write::{TableSpec, encode};
+    use twoscale::tables::format::{Kernel, Mapping, ValueType};
     let axis = |nodes| AxisHeader {
         nodes,
         mapping: Mapping::Uniform,

@@ -8,7 +8,7 @@ use generator::reference::fresnel as reference;
 use generator::reference::fresnel::Complex64;
 use generator::rng::SplitMix64;
 use generator::table_source::TableSource;
-use twoscale::fresnel::{fresnel, q_bar};
+use twoscale::model::fresnel::{fresnel, q_bar};
 use twoscale::{Complex, DiffuseFresnelTable, FormatError, TableId};
 
 /// n ∈ [0.05, 10] log-spaced, with values straddling 1 and the f32 neighbours
@@ -217,7 +217,7 @@ fn with_t5<R>(f: impl FnOnce(&DiffuseFresnelTable<'_>) -> R) -> R {
 fn t5_is_within_target_at_random_points() {
     with_t5(|t5| {
         let mut worst = (0.0f64, 0.0f64);
-        for eta in generator::tables::t5::verification_points(4000, 555) {
+        for eta in generator::tables::diffuse_fresnel::verification_points(4000, 555) {
             let want = reference::diffuse_internal(eta).unwrap();
             let error = (f64::from(t5.f_dr_int(eta as f32)) - want).abs();
             if error > worst.0 {

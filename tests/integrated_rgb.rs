@@ -6,10 +6,11 @@ use generator::rng::SplitMix64;
 use generator::spectral_accuracy::{direction, integrated_errors};
 use suite::brdf::chi_square_sampler;
 use twoscale::TableSet;
-use twoscale::brdf::{BaseLayer, ColourTerms, IntegratedRgb, Layer, Options, Surface, TwoScale};
-use twoscale::fresnel::Complex;
+use twoscale::brdf::{IntegratedRgb, TwoScale};
+use twoscale::material::{BaseLayer, ColourTerms, Layer, Options, Surface};
 use twoscale::materials::SPECTRAL_PRESETS;
-use twoscale::optical::{Ior, SpectralMaterial};
+use twoscale::math::Complex;
+use twoscale::spectrum::optical::{Ior, SpectralMaterial};
 
 /// p99 and max of the relative error per channel of `model` against the
 /// 5 nm sum over 600 pairs, half uniform and half drawn from the model's

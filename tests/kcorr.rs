@@ -3,7 +3,7 @@
 //! the table's domain, and the spectrum type.
 
 use generator::reference::kcorr as reference;
-use twoscale::kcorr::normal_incidence_ratio;
+use twoscale::tables::sigma_ratio::normal_incidence_ratio;
 use twoscale::{KCorrelation, SigmaRatioTable, TableId};
 
 fn with_t2<R>(f: impl FnOnce(&SigmaRatioTable<'_>) -> R) -> R {
@@ -21,7 +21,9 @@ fn rel(a: f64, b: f64) -> f64 {
 fn t2_is_within_target_at_random_points() {
     with_t2(|t2| {
         let mut worst = (0.0f64, 0.0, 0.0, 0.0);
-        for (cos_theta_i, big_b, c) in generator::tables::t2::verification_points(4000, 777) {
+        for (cos_theta_i, big_b, c) in
+            generator::tables::sigma_ratio::verification_points(4000, 777)
+        {
             let reference = reference::sigma_ratio(cos_theta_i.acos(), big_b, c).unwrap();
             let got = f64::from(t2.sigma_ratio_cos(cos_theta_i as f32, big_b as f32, c as f32));
             if rel(got, reference) > worst.0 {

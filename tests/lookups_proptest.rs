@@ -5,13 +5,14 @@
 use proptest::prelude::*;
 use std::sync::LazyLock;
 use twoscale::TableSet;
-use twoscale::brdf::{
+use twoscale::material::{
     BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, MultipleScattering, Options,
     SigmaRelMode, Surface,
 };
-use twoscale::conv::Convolution;
-use twoscale::epd::Epd;
-use twoscale::fresnel::{Complex, fresnel, q_bar};
+use twoscale::math::Complex;
+use twoscale::model::epd::Epd;
+use twoscale::model::fresnel::{fresnel, q_bar};
+use twoscale::tables::convolution::Convolution;
 
 /// Any finite f32, or a value in a typical parameter range.
 fn finite() -> impl Strategy<Value = f32> {

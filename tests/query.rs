@@ -35,7 +35,7 @@ fn reference_total(
     params: &generator::reference::brdf::Params,
     i: [f32; 3],
     o: [f32; 3],
-    options: &twoscale::brdf::Options,
+    options: &twoscale::material::Options,
 ) -> f64 {
     generator::reference::brdf::two_scale(params, i.map(f64::from), o.map(f64::from), options)
         .unwrap()
@@ -186,7 +186,7 @@ fn out_of_domain_rows_are_refused_or_clamped_and_marked() {
 /// reference does not cover are refused before any row.
 #[test]
 fn brdf_of_a_material_file_is_the_rgb_model() {
-    use twoscale::desc::MaterialDesc;
+    use twoscale::io::desc::MaterialDesc;
     let text = "[material]\nbeta = 0.2\np = 1.3\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n\
                 sigma_s = 0.03\nb = 2.0\nc = 2.5\nsigma_rel = \"symmetrised\"\n";
     let owned = MaterialDesc::from_toml_str(text).unwrap();
@@ -275,7 +275,7 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
 /// large part of ρ (measured 1.0e-5).
 #[test]
 fn brdf_of_a_compensated_material() {
-    use twoscale::desc::MaterialDesc;
+    use twoscale::io::desc::MaterialDesc;
     let text = "[material]\nbeta = 0.6\np = 0.6\neta = [[0.163, 3.56], [0.584, 2.15], [1.403, 1.925]]\n\
                 multiple_scattering = \"kulla-conty\"\n";
     let desc = MaterialDesc::from_toml_str(text).unwrap();
@@ -338,7 +338,7 @@ fn brdf_of_a_compensated_material() {
 /// `channel` rows, is refused before any row.
 #[test]
 fn brdf_with_a_lambda_column_is_the_spectral_model() {
-    use twoscale::desc::MaterialDesc;
+    use twoscale::io::desc::MaterialDesc;
     let text = "[material]\nbeta = 0.2\np = 1.3\n\
                 eta = { lambda = [0.4, 0.5, 0.7], n = [1.4, 0.8, 0.2], k = [1.9, 2.2, 4.0] }\n\
                 sigma_s = 0.03\nb = 2.0\nc = 2.5\nrgb_mode = \"integrated\"\n";

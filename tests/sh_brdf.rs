@@ -7,14 +7,14 @@
 use generator::analytic::{BeckmannCt, Lambertian};
 use generator::sh::{IsotropicBrdf, Projection, default_quadrature, project};
 use generator::tables::TableKind;
-use generator::tables::t4::{ModelInputs, Projected, ShBrdf};
+use generator::tables::sh_brdf::{ModelInputs, Projected, ShBrdf};
 use twoscale::ShBrdfTable;
-use twoscale::format::aligned_copy;
-use twoscale::sh::{ProjectedModel, coefficient_count, normalized_legendre};
+use twoscale::tables::format::aligned_copy;
+use twoscale::tables::sh_brdf::{ProjectedModel, coefficient_count, normalized_legendre};
 
 /// Builds a one-material T4 file of the Beckmann stand-in in memory from
 /// the materials text.
-fn built(materials: &str) -> twoscale::format::AlignedBuf {
+fn built(materials: &str) -> twoscale::tables::format::AlignedBuf {
     let materials = generator::materials::Materials::parse(materials).unwrap();
     let kind = &ShBrdf::all(&materials, &Projected::BeckmannStandIn)[0];
     let bytes = kind.build(&indicatif::ProgressBar::hidden()).unwrap();
@@ -43,7 +43,7 @@ fn committed_t4_files_read_and_are_reciprocal() {
     // The first preset: its integrated RGB (RgbMode::default_for).
     assert_eq!(table.model(), ProjectedModel::IntegratedRgb);
     assert_eq!(table.channels(), 3);
-    let pairs = generator::tables::t4::verification_pairs(500, 3);
+    let pairs = generator::tables::sh_brdf::verification_pairs(500, 3);
     for (wi, wo) in pairs {
         let (i, o) = (wi.map(|v| v as f32), wo.map(|v| v as f32));
         let (a, b) = (table.eval_rgb(i, o), table.eval_rgb(o, i));
@@ -86,10 +86,10 @@ fn runtime_eval_matches_the_f64_projection() {
     let table = ShBrdfTable::from_bytes(buf.bytes()).unwrap();
     let materials = generator::materials::Materials::parse(ROUGH).unwrap();
     let brdf =
-        generator::tables::t4::material_brdf(&materials.materials[0], 1, 0.526, None).unwrap();
+        generator::tables::sh_brdf::material_brdf(&materials.materials[0], 1, 0.526, None).unwrap();
     let projection = project(brdf.as_ref(), 10, default_quadrature(10), None);
     let mut worst: f64 = 0.0;
-    for (wi, wo) in generator::tables::t4::verification_pairs(2000, 5) {
+    for (wi, wo) in generator::tables::sh_brdf::verification_pairs(2000, 5) {
         let want = projection.eval(wi, wo) * wi[2] * wo[2];
         let got = f64::from(table.eval(1, wi.map(|v| v as f32), wo.map(|v| v as f32)));
         worst = worst.max((got * wi[2] * wo[2] - want).abs());
@@ -165,9 +165,9 @@ fn albedo_of(brdf: &dyn IsotropicBrdf, o: [f64; 3]) -> f64 {
 }
 
 /// A one-channel T4 file of a projection.
-fn table_from(projection: &Projection) -> twoscale::format::AlignedBuf {
-    use twoscale::format::write::{TableSpec, encode};
-    use twoscale::format::{AxisHeader, Kernel, Mapping};
+fn table_from(projection: &Projection) -> twoscale::tables::format::AlignedBuf {
+    use twoscale::tables::format::write::{TableSpec, encode};
+    use twoscale::tables::format::{AxisHeader, Kernel, Mapping};
     let l = projection.band_limit();
     let count = coefficient_count(l);
     let grid: Vec<f32> = projection.packed(None).iter().map(|&v| v as f32).collect();
@@ -179,13 +179,13 @@ fn table_from(projection: &Projection) -> twoscale::format::AlignedBuf {
         param: 0.0,
         param2: 0.0,
     };
-    let mut aux = vec![0.0f32; twoscale::sh::AUX_NAMES.len()];
+    let mut aux = vec![0.0f32; twoscale::tables::sh_brdf::AUX_NAMES.len()];
     aux[0] = ProjectedModel::Lambertian.code() as f32;
     let bytes = encode(&TableSpec {
         table_id: twoscale::TableId::ShBrdf,
         channels: 1,
         kernel: Kernel::Multilinear,
-        value_type: twoscale::format::ValueType::F32,
+        value_type: twoscale::tables::format::ValueType::F32,
         axes: &[axis],
         params: &[l as f64, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 40.0],
         grid: &grid,
@@ -199,7 +199,7 @@ fn table_from(projection: &Projection) -> twoscale::format::AlignedBuf {
 /// The workspace's T1, T2, T5 and T3 (T4's inputs).
 fn model_inputs() -> ModelInputs {
     ModelInputs::load(std::path::Path::new(
-        generator::tables::t4::WORKSPACE_TABLES,
+        generator::tables::sh_brdf::WORKSPACE_TABLES,
     ))
     .unwrap()
 }
@@ -247,10 +247,11 @@ fn committed_rough_file_matches_the_integrated_two_scale_model() {
     let inputs = model_inputs();
     let parsed = inputs.parse().unwrap();
     let tables = parsed.brdf_tables();
-    let pairs = generator::tables::t4::verification_pairs(4000, 21);
+    let pairs = generator::tables::sh_brdf::verification_pairs(4000, 21);
     for (c, &lambda) in materials.wavelengths.iter().enumerate() {
         // The preset's default RGB: channel c of the integral over the spectrum.
-        let brdf = generator::tables::t4::material_brdf(gold, c, lambda, Some(&tables)).unwrap();
+        let brdf =
+            generator::tables::sh_brdf::material_brdf(gold, c, lambda, Some(&tables)).unwrap();
         let (rms, p99, max) = f_errors(
             &pairs,
             |i, o| brdf.eval(i, o),
@@ -280,7 +281,7 @@ fn two_scale_projection_is_asymmetric_only_with_nano_roughness() {
         let text = text.replace("sigma_s = 0.0", &format!("sigma_s = {sigma_s}"));
         let materials = generator::materials::Materials::parse(&text).unwrap();
         let brdf =
-            generator::tables::t4::two_scale_brdf(&materials.materials[0], 1, 0.526, &tables);
+            generator::tables::sh_brdf::two_scale_brdf(&materials.materials[0], 1, 0.526, &tables);
         let (diff, norm) = project(&brdf, l, default_quadrature(l), None).asymmetry();
         eprintln!("σs = {sigma_s}: ‖M − Mᵀ‖/‖M‖ = {:.3e}", diff / norm);
         asymmetry.push(diff / norm);

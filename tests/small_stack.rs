@@ -5,7 +5,8 @@
 //! the previous one.
 
 use twoscale::TableSet;
-use twoscale::brdf::{ChannelBake, Options, RGB_WAVELENGTHS, Rgb, TwoScale};
+use twoscale::brdf::{ChannelBake, Rgb, TwoScale};
+use twoscale::material::{Options, RGB_WAVELENGTHS};
 use twoscale::materials::PRESETS;
 
 /// The stack of the construction thread.

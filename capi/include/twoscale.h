@@ -234,8 +234,8 @@ typedef struct {
 } ts_table_bytes;
 
 /**
- * Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
- * `twoscale::brdf::Options`). Set `size` to `sizeof(ts_material_desc)`
+ * Every parameter of a material (`twoscale::material::Layer`, the RGB index and
+ * `twoscale::material::Options`). Set `size` to `sizeof(ts_material_desc)`
  * (`ts_material_desc_preset` does); other sizes are rejected. All-zero
  * enumeration fields are the defaults (conductor, the paper's options).
  * Lengths are in µm. Values outside the model's domain (`Material::validate`

@@ -19,18 +19,20 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
-use twoscale::brdf::{
-    BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking, Material,
-    MultipleScattering, Options, RGB_WAVELENGTHS, RgbMode, RgbModel, SigmaRelMode, Surface,
-};
+use twoscale::brdf::{ChannelBake, RgbModel};
+
 use twoscale::brdf::{BoxedSpectral, SPECTRAL_WAVELENGTHS, Spectral};
-use twoscale::desc::{DescError, DescErrorKind, MaterialDesc};
-use twoscale::format::{FormatError, TableId, aligned_copy};
+use twoscale::domain::{self, Domain, Invalid};
+use twoscale::io::desc::{DescError, DescErrorKind, MaterialDesc};
+use twoscale::material::{
+    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, Material, MultipleScattering,
+    Options, RGB_WAVELENGTHS, RgbMode, SigmaRelMode, Surface,
+};
 use twoscale::materials::PRESETS;
-use twoscale::optical::{Ior, OwnedSpectralMaterial, Tabulated};
+use twoscale::spectrum::optical::{Ior, OwnedSpectralMaterial, Tabulated};
 use twoscale::table_set::TABLES;
+use twoscale::tables::format::{FormatError, TableId, aligned_copy};
 use twoscale::validate::Refused;
-use twoscale::validate::{self, Domain, Invalid};
 use twoscale::{Bxdf, Complex, OwnedTableSet, TableSet, TableSetError, TableStorage};
 
 /// Success.
@@ -104,7 +106,7 @@ pub struct ts_tables {
 /// lambda, n, k }`), from `ts_material_file_from_toml`; read it with
 /// `ts_material_file_desc`, free it with `ts_material_file_free`. Opaque.
 pub struct ts_material_file {
-    desc: twoscale::desc::OwnedMaterialDesc,
+    desc: twoscale::io::desc::OwnedMaterialDesc,
 }
 
 /// An RGB material built from a `ts_tables`. Opaque; about 136 KB (360 KB
@@ -148,8 +150,8 @@ pub struct ts_table_bytes {
     pub albedo_len: usize,
 }
 
-/// Every parameter of a material (`twoscale::brdf::Layer`, the RGB index and
-/// `twoscale::brdf::Options`). Set `size` to `sizeof(ts_material_desc)`
+/// Every parameter of a material (`twoscale::material::Layer`, the RGB index and
+/// `twoscale::material::Options`). Set `size` to `sizeof(ts_material_desc)`
 /// (`ts_material_desc_preset` does); other sizes are rejected. All-zero
 /// enumeration fields are the defaults (conductor, the paper's options).
 /// Lengths are in µm. Values outside the model's domain (`Material::validate`
@@ -579,9 +581,9 @@ impl ts_material_desc {
         };
         if material.layer.base == BaseLayer::Conductor {
             // A conductor has no base layer: its albedo field must stay 0.
-            validate::check(
+            domain::check(
                 "albedo",
-                validate::widen(albedo),
+                domain::widen(albedo),
                 Domain::Closed(0.0, 0.0),
                 "a conductor has no base layer",
             )
@@ -637,7 +639,7 @@ impl ts_material_desc {
             std::slice::from_raw_parts(self.eta_rows.cast::<[f32; 3]>(), self.eta_row_count)
         };
         let eta = Ior::Tabulated(Tabulated::new(rows).map_err(invalid)?);
-        let spectral = twoscale::optical::SpectralMaterial {
+        let spectral = twoscale::spectrum::optical::SpectralMaterial {
             layer: material.layer,
             eta,
         };
@@ -918,7 +920,7 @@ fn preset_desc(name: &str) -> Result<MaterialDesc<'static>, Fail> {
 
 /// The description of a material file: refused when it gives a tabulated
 /// spectrum, whose rows a `ts_material_desc` cannot own.
-fn file_desc(desc: &twoscale::desc::OwnedMaterialDesc) -> Result<MaterialDesc<'static>, Fail> {
+fn file_desc(desc: &twoscale::io::desc::OwnedMaterialDesc) -> Result<MaterialDesc<'static>, Fail> {
     let desc = desc.get();
     match desc.spectral.map(|s| s.eta) {
         Some(Ior::Tabulated(_)) => Err(Fail::new(

@@ -6,8 +6,8 @@
 //! the material's complex Fresnel factor and, for a plastic, the base layer of
 //! docs/model.md §2.6; it has no diffraction lobe, no EPD shape (`p` is ignored: the NDF
 //! is Beckmann with `α = β`), and no σs, b, c. The committed T4 files project
-//! the two-scale model instead (`tables::t4`); the stand-in is
-//! `tables::t4::Projected::BeckmannStandIn` (header `brdf_model = 2`).
+//! the two-scale model instead (`tables::sh_brdf`); the stand-in is
+//! `tables::sh_brdf::Projected::BeckmannStandIn` (header `brdf_model = 2`).
 
 use std::f64::consts::PI;
 

@@ -7,8 +7,8 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use twoscale::format::TableId;
-use twoscale::format::write::write_atomic;
+use twoscale::tables::format::TableId;
+use twoscale::tables::format::write::write_atomic;
 
 use crate::error::{Error, FileAction};
 use crate::table_source::TableSource;
@@ -24,7 +24,8 @@ pub fn build(kinds: &[&dyn TableKind], out: &Path) -> Result<ExitCode, Error> {
     for kind in kinds {
         if kind.id() == TableId::ShBrdf && !announced {
             announced = true;
-            let inputs = tables::t4::input_dir(out).map_or(TableSource::Embedded, TableSource::Dir);
+            let inputs =
+                tables::sh_brdf::input_dir(out).map_or(TableSource::Embedded, TableSource::Dir);
             eprintln!("T4 projects the two-scale model reading T1, T2, T5, T3 from {inputs}");
         }
         let stem = kind.file_stem();
@@ -75,14 +76,17 @@ fn with_progress<T>(name: &str, len: u64, unit: &str, work: impl FnOnce(&Progres
 
 /// `build t3 --shard K/N`: the shard file of T3's nodes, in `out`.
 pub fn build_shard(out: &Path, shard: &str) -> Result<ExitCode, Error> {
-    let shard = tables::t3::Shard::parse(shard)?;
+    let shard = tables::convolution::Shard::parse(shard)?;
     std::fs::create_dir_all(out).map_err(Error::file(FileAction::Create, out))?;
     let name = shard.file_name();
     let start = Instant::now();
-    let work = tables::t3::work(Some(shard));
-    let bytes = with_progress(&name, work, tables::t3::Conv.work_unit(), |progress| {
-        tables::t3::build_shard(shard, progress)
-    })
+    let work = tables::convolution::work(Some(shard));
+    let bytes = with_progress(
+        &name,
+        work,
+        tables::convolution::Conv.work_unit(),
+        |progress| tables::convolution::build_shard(shard, progress),
+    )
     .map_err(Error::table(&name))?;
     let path = out.join(&name);
     write_atomic(&path, &bytes).map_err(Error::file(FileAction::Write, &path))?;
@@ -105,7 +109,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<ExitCode, Error> {
                 .map_err(Error::file(FileAction::Read, p))
         })
         .collect::<Result<Vec<_>, Error>>()?;
-    let bytes = tables::t3::merge(&files).map_err(|e| match e {
+    let bytes = tables::convolution::merge(&files).map_err(|e| match e {
         tables::BuildError::Shard(e) => Error::Shard(e),
         e => Error::table(TableId::Convolution.name())(e),
     })?;

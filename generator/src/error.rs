@@ -6,14 +6,14 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use twoscale::desc::DescError;
+use twoscale::io::desc::DescError;
 
 use crate::materials::MaterialsError;
 use crate::plot::PlotError;
 use crate::query::QueryError;
 use crate::table_source::TableFileError;
 use crate::tables::BuildError;
-use crate::tables::t3::ShardError;
+use crate::tables::convolution::ShardError;
 
 /// What was being done to a file when it failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,9 +5,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use twoscale::Table;
-use twoscale::format::{HEADER_SIZE, Header, MAGIC, TableId, checksum};
-use twoscale::interp::node_value;
-use twoscale::validate::{Shortest, Shortest32};
+use twoscale::domain::{Shortest, Shortest32};
+use twoscale::tables::format::{HEADER_SIZE, Header, MAGIC, TableId, checksum};
+use twoscale::tables::interp::node_value;
 use zerocopy::TryFromBytes;
 
 use crate::error::{Error, FileAction};
@@ -51,7 +51,7 @@ pub fn inspect(paths: &[PathBuf], out: &mut impl Write) -> Result<ExitCode, Erro
     for path in paths {
         for file in files_of(path)? {
             let bytes = std::fs::read(&file).map_err(Error::file(FileAction::Read, &file))?;
-            let bytes = twoscale::format::aligned_copy(&bytes);
+            let bytes = twoscale::tables::format::aligned_copy(&bytes);
             failed |=
                 !describe(&file.display().to_string(), bytes.bytes(), out).map_err(write_error)?;
         }
@@ -144,9 +144,9 @@ fn describe(name: &str, bytes: &[u8], out: &mut impl Write) -> std::io::Result<b
             out,
             "  projected BRDF     {:?}, {} packed coefficients per channel",
             table.model(),
-            twoscale::sh::coefficient_count(table.band_limit())
+            twoscale::tables::sh_brdf::coefficient_count(table.band_limit())
         )?;
-        for (aux, value) in twoscale::sh::AUX_NAMES.iter().zip(table.aux()) {
+        for (aux, value) in twoscale::tables::sh_brdf::AUX_NAMES.iter().zip(table.aux()) {
             writeln!(out, "  aux {aux:<20} {}", Shortest32(*value))?;
         }
     }

@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use generator::error::Error;
 use generator::materials::Materials;
 use generator::table_source::TableSource;
-use generator::tables::t4::{Projected, ShBrdf};
+use generator::tables::sh_brdf::{Projected, ShBrdf};
 use generator::tables::{self, TableKind};
 
 /// Where `build` and `merge` write unless given `--out` (relative to the
@@ -362,7 +362,7 @@ fn set_threads(threads: Option<usize>) -> Result<(), Error> {
 
 /// The T4 builders of the materials file (default: the shipped one),
 /// projecting the two-scale model with the tables of `dir` (or the
-/// embedded ones: `t4::input_dir`).
+/// embedded ones: `sh_brdf::input_dir`).
 fn material_tables(materials: Option<&Path>, dir: &Path) -> Result<Vec<ShBrdf>, Error> {
     let materials = Materials::load_or_shipped(materials)?;
     Ok(ShBrdf::all(
@@ -424,7 +424,7 @@ fn query(
     material: Option<&Path>,
 ) -> Result<ExitCode, Error> {
     let material = material
-        .map(twoscale::desc::MaterialDesc::from_toml_file)
+        .map(twoscale::io::desc::MaterialDesc::from_toml_file)
         .transpose()
         .map_err(Error::Material)?;
     let stdin = std::io::stdin();

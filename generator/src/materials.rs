@@ -8,7 +8,7 @@
 //! [[material]]
 //! name = "nickel"          # file t4-nickel.tbl; [a-z0-9-], unique
 //! beta = 0.0598            # the material's keys, as a material file's [material]
-//! p = 1.0                  # (twoscale::desc): beta, p, eta, sigma_s, b, c, base,
+//! p = 1.0                  # (twoscale::io::desc): beta, p, eta, sigma_s, b, c, base,
 //! sigma_s = 0.0273         # albedo, lambertian, with their defaults
 //! b = 4.8418
 //! eta = [[2.0, 3.8], [1.8, 3.3], [1.7, 2.8]]   # n + ik, one pair per wavelength
@@ -21,7 +21,7 @@
 //! ```
 //!
 //! A material's keys are the one schema of a material description
-//! ([`twoscale::desc`]: Python's `twoscale.Material` keywords, the fit's
+//! ([`twoscale::io::desc`]: Python's `twoscale.Material` keywords, the fit's
 //! output), read and validated by the runtime, so a value is refused here
 //! as everywhere else. `name`, `preset`, `band_limit` and `filter` are this
 //! file's own. T4 projects the model with the default options, so the
@@ -33,9 +33,9 @@ use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
 use twoscale::Complex;
-use twoscale::brdf::{Layer, Options, RgbMode};
-use twoscale::desc::{EtaTable, KeywordTable};
-use twoscale::optical::SpectralMaterial;
+use twoscale::io::desc::{EtaTable, KeywordTable};
+use twoscale::material::{Layer, Options, RgbMode};
+use twoscale::spectrum::optical::SpectralMaterial;
 
 use crate::sh::BandFilter;
 
@@ -141,10 +141,10 @@ impl Materials {
     pub fn parse(text: &str) -> Result<Materials, MaterialsError> {
         let raw: RawFile = toml::from_str(text).map_err(|e| MaterialsError(e.to_string()))?;
         let channels = raw.wavelengths.len();
-        if !(1..=twoscale::sh::MAX_CHANNELS).contains(&channels) {
+        if !(1..=twoscale::tables::sh_brdf::MAX_CHANNELS).contains(&channels) {
             return Err(MaterialsError(format!(
                 "wavelengths: {channels} given, 1 to {} allowed",
-                twoscale::sh::MAX_CHANNELS
+                twoscale::tables::sh_brdf::MAX_CHANNELS
             )));
         }
         for &lambda in &raw.wavelengths {
@@ -182,7 +182,7 @@ impl Material {
 
     /// The material of `[[material]]` number `index` (from 0): the file's
     /// keys taken out, the rest read as a material description
-    /// ([`twoscale::desc`]) with one index per wavelength.
+    /// ([`twoscale::io::desc`]) with one index per wavelength.
     fn from_table(
         mut table: toml::Table,
         index: usize,
@@ -220,9 +220,9 @@ impl Material {
                 "material name '{name}' must be non-empty and use only a-z, 0-9 and '-'"
             )));
         }
-        let max = twoscale::sh::MAX_BAND_LIMIT;
+        let max = twoscale::tables::sh_brdf::MAX_BAND_LIMIT;
         if let Some(l) = own.band_limit
-            && !(twoscale::sh::MIN_BAND_LIMIT..=max).contains(&l)
+            && !(twoscale::tables::sh_brdf::MIN_BAND_LIMIT..=max).contains(&l)
         {
             return err(format!("band_limit = {l} is outside [2, {max}]"));
         }
@@ -253,7 +253,7 @@ impl Material {
 }
 
 /// The layer and indices of the material keys in `table` (`name` for the
-/// messages), validated by the runtime ([`twoscale::desc::Keywords::layer`]);
+/// messages), validated by the runtime ([`twoscale::io::desc::Keywords::layer`]);
 /// options other than the default are refused (T4 projects the default).
 fn keywords(
     name: &str,
@@ -302,7 +302,7 @@ fn from_preset(
             .collect();
         return err(format!("not a shipped preset ({})", names.join(", ")));
     };
-    let rgb = twoscale::brdf::RGB_WAVELENGTHS.map(f64::from);
+    let rgb = twoscale::material::RGB_WAVELENGTHS.map(f64::from);
     if wavelengths.len() != 3
         || wavelengths
             .iter()
@@ -327,7 +327,7 @@ fn from_preset(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use twoscale::brdf::BaseLayer;
+    use twoscale::material::BaseLayer;
 
     const GOOD: &str = r#"
 wavelengths = [0.645, 0.526, 0.444]
@@ -373,7 +373,7 @@ albedo = 0.6
 lambertian = 0.1
 "#;
         let file = format!("[material]\n{table}\n[metrics]\nrmse = [0.1, 0.1, 0.1]\n");
-        let desc = twoscale::desc::MaterialDesc::from_toml_str(&file).unwrap();
+        let desc = twoscale::io::desc::MaterialDesc::from_toml_str(&file).unwrap();
         let desc = desc.get();
         let entry =
             format!("wavelengths = [0.645, 0.526, 0.444]\n[[material]]\nname = \"fit\"\n{table}");
@@ -394,7 +394,7 @@ lambertian = 0.1
     /// (`twoscale::materials::PRESETS`): same names and parameters.
     #[test]
     fn preset_entries_take_the_runtime_presets() {
-        use twoscale::brdf::RGB_WAVELENGTHS;
+        use twoscale::material::RGB_WAVELENGTHS;
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../materials.toml");
         let file = Materials::load(Path::new(path)).unwrap();
         assert_eq!(
@@ -412,13 +412,17 @@ lambertian = 0.1
             assert_eq!(m.eta, preset.eta_rgb.to_vec(), "{name}");
             // T4 projects a preset's integrated RGB, the runtime's default.
             assert_eq!(m.spectral, twoscale::materials::spectral(name), "{name}");
-            assert_eq!(m.rgb_mode(), twoscale::brdf::RgbMode::Integrated, "{name}");
+            assert_eq!(
+                m.rgb_mode(),
+                twoscale::material::RgbMode::Integrated,
+                "{name}"
+            );
         }
         let own = Materials::parse(GOOD).unwrap();
         assert_eq!(own.materials[0].spectral, None);
         assert_eq!(
             own.materials[0].rgb_mode(),
-            twoscale::brdf::RgbMode::PaperWavelengths
+            twoscale::material::RgbMode::PaperWavelengths
         );
     }
 

@@ -5,8 +5,8 @@
 //!   its three terms apart (`TwoScale::eval_lobes`: specular `A_spec ρ_CT`,
 //!   diffraction `ρ_CTD`, base `ρ_base + k_d/π`).
 //! * **Error maps** of T1, T2 and T3: the errors `verify` measures, at
-//!   `verify`'s random points (the same functions: `t1::error_at`,
-//!   `t2::error_at`, `t3::verify_point`), binned over two axes of the
+//!   `verify`'s random points (the same functions: `smith_g1::error_at`,
+//!   `sigma_ratio::error_at`, `convolution::verify_point`), binned over two axes of the
 //!   table's domain (the largest error per bin; T3's profiles, being few,
 //!   are drawn one marker each).
 //!
@@ -17,16 +17,17 @@
 use crate::error::{Error, FileAction};
 use crate::materials::{Material, Materials};
 use crate::table_source::{TableFileError, TableSource};
-use crate::tables::t4::two_scale_brdf;
-use crate::tables::{BuildError, t1, t2, t3};
+use crate::tables::sh_brdf::two_scale_brdf;
+use crate::tables::{BuildError, convolution, sigma_ratio, smith_g1};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use rayon::prelude::*;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::brdf::{IntegratedRgb, Options, Spectral, Tables};
-use twoscale::optical::SpectralMaterial;
+use twoscale::brdf::{IntegratedRgb, Spectral, Tables};
+use twoscale::material::Options;
+use twoscale::spectrum::optical::SpectralMaterial;
 use twoscale::{ConvTable, FormatError, Rgb, SigmaRatioTable, SmithG1Table, TableId};
 
 /// DejaVu Sans as Debian's `fonts-dejavu-core` installs it.
@@ -498,9 +499,9 @@ pub fn t1_errors(source: &TableSource, points: usize, seed: u64) -> Result<Sampl
     let file = source.open(TableId::SmithG1)?;
     let table =
         SmithG1Table::from_bytes(file.bytes()).map_err(malformed(source, TableId::SmithG1))?;
-    t1::verification_points(points, seed)
+    smith_g1::verification_points(points, seed)
         .par_iter()
-        .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), t1::error_at(&table, p, a)?)))
+        .map(|&(p, a)| Ok((p, a.max(1e-300).log10(), smith_g1::error_at(&table, p, a)?)))
         .collect::<Result<_, BuildError>>()
         .map_err(PlotError::Table)
 }
@@ -510,20 +511,20 @@ pub fn t2_errors(source: &TableSource, points: usize, seed: u64) -> Result<Sampl
     let file = source.open(TableId::SigmaRatio)?;
     let table = SigmaRatioTable::from_bytes(file.bytes())
         .map_err(malformed(source, TableId::SigmaRatio))?;
-    t2::verification_points(points, seed)
+    sigma_ratio::verification_points(points, seed)
         .par_iter()
         .map(|&(cos_i, big_b, c)| {
             Ok((
                 cos_i.acos().to_degrees(),
                 big_b.log10(),
-                t2::error_at(&table, cos_i, big_b, c)?,
+                sigma_ratio::error_at(&table, cos_i, big_b, c)?,
             ))
         })
         .collect::<Result<_, BuildError>>()
         .map_err(PlotError::Table)
 }
 
-/// T3b's e_L2 at `verify`'s profiles (`t3::profiles_for(points)` of them):
+/// T3b's e_L2 at `verify`'s profiles (`convolution::profiles_for(points)` of them):
 /// `([u, c, β, p], e_L2)`.
 pub fn t3_errors(
     source: &TableSource,
@@ -533,9 +534,9 @@ pub fn t3_errors(
     let file = source.open(TableId::Convolution)?;
     let table =
         ConvTable::from_bytes(file.bytes()).map_err(malformed(source, TableId::Convolution))?;
-    t3::verification_points(t3::profiles_for(points), seed)
+    convolution::verification_points(convolution::profiles_for(points), seed)
         .par_iter()
-        .map(|&pt| Ok((pt, t3::verify_point(&table, pt)?.accurate_e_l2)))
+        .map(|&pt| Ok((pt, convolution::verify_point(&table, pt)?.accurate_e_l2)))
         .collect::<Result<_, BuildError>>()
         .map_err(PlotError::Table)
 }

@@ -11,17 +11,18 @@
 use rayon::prelude::*;
 use std::fmt;
 use std::io::{BufRead, Write};
-use twoscale::brdf::{
-    BoxedSpectral, ChannelBake, MultipleScattering, RgbMode, SPECTRAL_WAVELENGTHS, Spectral,
-};
-use twoscale::desc::OwnedMaterialDesc;
-use twoscale::optical::SpectralMaterial;
+use twoscale::brdf::{BoxedSpectral, ChannelBake, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::io::desc::OwnedMaterialDesc;
+use twoscale::material::{MultipleScattering, RgbMode};
+use twoscale::spectrum::optical::SpectralMaterial;
 use twoscale::{
     AlbedoTable, ConvTable, Convolution, DiffuseFresnelTable, Rgb, SigmaRatioTable, SmithG1Table,
     TableId, TableSet,
 };
 
-use twoscale::validate::{self, Invalid, Shortest, Shortest32};
+use twoscale::domain::{self, Invalid, Shortest, Shortest32};
+
+use twoscale::validate;
 
 use crate::table_source::{TableFile, TableFileError, TableSource};
 
@@ -167,7 +168,7 @@ impl Quantity {
                 validate::eta(("n", "k"), eta).map_err(RowError::Invalid)?;
                 let reference = fresnel::fresnel(fresnel::Complex64::new(n, k), cos_theta)
                     .map_err(|e| reference(&e))?;
-                let value = twoscale::fresnel::fresnel(eta, f(cos_theta));
+                let value = twoscale::model::fresnel::fresnel(eta, f(cos_theta));
                 (vec![short32(value), short(reference)], true)
             }
             Quantity::Conv => {
@@ -210,22 +211,22 @@ impl Quantity {
                     lambda: x[7],
                 };
                 let (i, o) = ([x[8], x[9], x[10]], [x[11], x[12], x[13]]);
-                let layer = twoscale::brdf::Layer {
-                    surface: twoscale::brdf::Surface {
+                let layer = twoscale::material::Layer {
+                    surface: twoscale::material::Surface {
                         beta: f(params.beta),
                         p: f(params.p),
                         sigma_s: f(params.sigma_s),
                         b: f(params.b),
                         c: f(params.c),
                     },
-                    base: twoscale::brdf::BaseLayer::Conductor,
+                    base: twoscale::material::BaseLayer::Conductor,
                     lambertian: 0.0,
                 };
                 let eta = twoscale::Complex::new(f(params.n), f(params.k));
                 layer.validate().map_err(RowError::Invalid)?;
                 validate::eta(("n", "k"), eta).map_err(RowError::Invalid)?;
                 validate::wavelength(f(params.lambda)).map_err(RowError::Invalid)?;
-                let options = twoscale::brdf::Options::default();
+                let options = twoscale::material::Options::default();
                 let reference =
                     brdf::two_scale(&params, i, o, &options).map_err(|e| reference(&e))?;
                 let set = tables.set()?;
@@ -526,7 +527,7 @@ enum MaterialModel<'a> {
     Channels {
         model: Box<Rgb<'a, Box<ChannelBake>>>,
         params: [brdf::Params; 3],
-        options: twoscale::brdf::Options,
+        options: twoscale::material::Options,
         /// The reference's energy-compensation lobe per channel, when the
         /// material's options ask for it.
         compensation: Option<Box<[brdf::Compensation; 3]>>,
@@ -537,7 +538,7 @@ enum MaterialModel<'a> {
         model: Box<BoxedSpectral<'a>>,
         spectral: SpectralMaterial<'a>,
         params: brdf::Params,
-        options: twoscale::brdf::Options,
+        options: twoscale::material::Options,
     },
 }
 
@@ -583,10 +584,10 @@ impl MaterialModel<'_> {
                     SPECTRAL_WAVELENGTHS[0],
                     SPECTRAL_WAVELENGTHS[SPECTRAL_WAVELENGTHS.len() - 1],
                 );
-                validate::check(
+                domain::check(
                     "lambda",
-                    validate::widen(lambda),
-                    validate::Domain::Closed(validate::widen(lo), validate::widen(hi)),
+                    domain::widen(lambda),
+                    domain::Domain::Closed(domain::widen(lo), domain::widen(hi)),
                     "µm, the spectral model's range",
                 )
                 .map_err(RowError::Invalid)?;

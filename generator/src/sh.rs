@@ -2,7 +2,7 @@
 //! (\[WAT92\] §2, docs/model.md §2.9), generic over the BRDF.
 //!
 //! The layout, the odd completion and the real-SH convention are documented
-//! in `twoscale::sh`. Block `m` of the matrix is
+//! in `twoscale::tables::sh_brdf`. Block `m` of the matrix is
 //!
 //! ```text
 //! B^m_{l l'} = 4 ∫₀¹ ∫₀¹ P̄_l^m(xi) P̄_l'^m(xo) g_m(xi, xo) dxi dxo,
@@ -38,7 +38,7 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use twoscale::Bxdf;
-use twoscale::sh::{MAX_BAND_LIMIT, block_size, normalized_legendre};
+use twoscale::tables::sh_brdf::{MAX_BAND_LIMIT, block_size, normalized_legendre};
 
 use crate::quad::gauss_legendre;
 
@@ -381,10 +381,12 @@ impl Projection {
     }
 
     /// The symmetrised matrix `(M + Mᵀ)/2` (WAT92 §3), filtered, in the packed
-    /// layout of `twoscale::sh` (upper triangles of the blocks, `m` ascending).
+    /// layout of `twoscale::tables::sh_brdf` (upper triangles of the blocks, `m` ascending).
     pub fn packed(&self, filter: Option<BandFilter>) -> Vec<f64> {
         let h = |l: usize| filter.map_or(1.0, |f| f.attenuation(l));
-        let mut out = Vec::with_capacity(twoscale::sh::coefficient_count(self.band_limit));
+        let mut out = Vec::with_capacity(twoscale::tables::sh_brdf::coefficient_count(
+            self.band_limit,
+        ));
         for (m, block) in self.blocks.iter().enumerate() {
             let n = block_size(self.band_limit, m);
             for a in 0..n {

@@ -17,10 +17,11 @@
 use crate::rng::SplitMix64;
 use crate::tables::Accuracy;
 use std::f64::consts::PI;
-use twoscale::brdf::{ChannelBake, IntegratedRgb, Options, Spectral, Tables, TwoScale};
-use twoscale::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
+use twoscale::brdf::{ChannelBake, IntegratedRgb, Spectral, Tables, TwoScale};
+use twoscale::material::Options;
 use twoscale::materials::SPECTRAL_PRESETS;
-use twoscale::optical::SpectralMaterial;
+use twoscale::spectrum::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
+use twoscale::spectrum::optical::SpectralMaterial;
 
 /// The section's name in the report.
 pub const STEM: &str = "spectral";

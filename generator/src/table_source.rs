@@ -5,11 +5,11 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoscale::mmap::MappedFile;
+use twoscale::tables::mmap::MappedFile;
 use twoscale::{FormatError, TableId};
 
 use crate::tables::BuildError;
-use crate::tables::t4::ModelInputs;
+use crate::tables::sh_brdf::ModelInputs;
 
 /// The tables a subcommand reads.
 #[derive(Clone, Debug, PartialEq, Eq)]

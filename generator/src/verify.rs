@@ -7,14 +7,14 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 use twoscale::Table;
-use twoscale::format::write::write_atomic;
+use twoscale::tables::format::write::write_atomic;
 
 use crate::error::{Error, FileAction};
 use crate::report::{self, TableReport};
 use crate::spectral_accuracy;
 use crate::table_source::TableSource;
 use crate::tables::TableKind;
-use crate::tables::t4::ModelInputs;
+use crate::tables::sh_brdf::ModelInputs;
 
 /// What `verify` measures.
 pub struct VerifyArgs<'a> {

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use generator::export::{self, Precision, Source, c, npy};
-use twoscale::format::{AxisHeader, TableId};
-use twoscale::interp::{Axis, node_value};
-use twoscale::mmap::MappedFile;
+use twoscale::tables::format::{AxisHeader, TableId};
+use twoscale::tables::interp::{Axis, node_value};
+use twoscale::tables::mmap::MappedFile;
 
 const TABLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tables");
 
@@ -178,7 +178,7 @@ fn c_headers_compile_and_hold_the_runtime_values() {
         body.push_str(&format!(
             "    printf(\"%a\\n\", ts_t3_convolution_normalised_angle({tau:e}, {u:e}, {beta:e}, {p:e}));\n"
         ));
-        let xi = twoscale::conv::normalised_angle(tau, u, beta, p, &angle);
+        let xi = twoscale::tables::convolution::normalised_angle(tau, u, beta, p, &angle);
         expected.push((
             format!("xi(tau = {tau:e}, u = {u:e}, β = {beta:e}, p = {p})"),
             xi,
@@ -197,7 +197,7 @@ fn c_headers_compile_and_hold_the_runtime_values() {
     for _ in 0..200 {
         let p = rng.uniform_in(0.2, 5.0) as f32;
         let a = rng.log_uniform_in(1e-4, 1e4) as f32;
-        let k_p = twoscale::smith::asymptotic_slope(f64::from(p)) as f32;
+        let k_p = twoscale::tables::smith_g1::asymptotic_slope(f64::from(p)) as f32;
         body.push_str(&format!(
             "    printf(\"%a\\n\", (double)ts_t1_smith_g1_g1({p:e}f, {a:e}f, {k_p:e}f));\n"
         ));
@@ -235,8 +235,8 @@ fn c_headers_compile_and_hold_the_runtime_values() {
             "    printf(\"%a\\n\", (double)ts_t6_albedo_albedo({cos:e}f, {beta:e}f, {p:e}f, {masking}));\n"
         ));
         let m = [
-            twoscale::brdf::Masking::Separable,
-            twoscale::brdf::Masking::HeightCorrelated,
+            twoscale::material::Masking::Separable,
+            twoscale::material::Masking::HeightCorrelated,
         ][masking];
         let e = f64::from(albedo.albedo(cos, beta, p, m));
         // f32 summation order (2.4e-7 at worst when written).

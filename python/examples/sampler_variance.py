@@ -20,10 +20,19 @@ presets, the variance (green) beside that of `roughconductor` (Beckmann,
 (docs/design/halo-sampling.md).
 
     python python/examples/sampler_variance.py [--samples N] [--quick] [--halo | --spectral | --equal-noise]
+        [--markdown FILE]
+
+`--markdown FILE` also writes the tables to FILE under a line naming the
+command (docs/figures/visible-normals.md, docs/figures/halo-sampling.md,
+docs/figures/equal-noise.md); the samples are drawn from fixed seeds, so
+the same code writes the same file.
 """
 
 import argparse
+import contextlib
+import io
 import os
+import sys
 
 import numpy as np
 from scipy.special import expit, gammainccinv, gammaincinv
@@ -285,7 +294,54 @@ def main():
                         help="the spectral sampler between its sampler models")
     parser.add_argument("--equal-noise", action="store_true",
                         help="a few presets beside roughconductor")
+    parser.add_argument("--markdown", metavar="FILE",
+                        help="also write the tables to FILE (docs/figures/)")
     args = parser.parse_args()
+    if args.markdown is not None and not os.path.isdir(os.path.dirname(args.markdown) or "."):
+        sys.exit(f"error: {args.markdown}: no directory {os.path.dirname(args.markdown)}")
+    if args.markdown is None:
+        run(args)
+        return
+    # The tables go to stdout as they are computed and, at the end, to FILE.
+    captured = io.StringIO()
+    with contextlib.redirect_stdout(_Tee(sys.stdout, captured)):
+        run(args)
+    command = " ".join(["python python/examples/sampler_variance.py"] + sys.argv[1:])
+    try:
+        with open(args.markdown, "w", encoding="utf-8") as f:
+            f.write(f"# Relative variance of the sampling weight: {_subject(args)}\n\n"
+                    f"Written by `{command}` "
+                    "(do not edit: rerun the command). E[w²]/E[w]² − 1 per channel of "
+                    "w = ρ cos θo / pdf, failed samples counting as w = 0.\n\n")
+            f.write(captured.getvalue())
+    except OSError as e:
+        sys.exit(f"error: {args.markdown}: {e.strerror}")
+
+
+def _subject(args):
+    """What the tables of `args` measure (the title of `--markdown`'s file)."""
+    if args.halo:
+        return "the presets and strong halos (docs/design/halo-sampling.md)"
+    if args.spectral:
+        return "the spectral sampler between its sampler models (docs/design/rgb-integration.md)"
+    if args.equal_noise:
+        return "presets beside roughconductor (docs/design/halo-sampling.md)"
+    return "visible normals at σs = 0 (docs/design/visible-normals.md)"
+
+
+class _Tee(io.TextIOBase):
+    """Writes to every stream it holds."""
+
+    def __init__(self, *streams):
+        self.streams = streams
+
+    def write(self, text):
+        for stream in self.streams:
+            stream.write(text)
+        return len(text)
+
+
+def run(args):
     if args.halo:
         halo_rows([0, 45, 70, 85], args.samples)
         return

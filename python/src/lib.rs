@@ -24,14 +24,17 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
-use twoscale::brdf::{
-    BakeVisitor, BaseKind, BaseLayer, ChannelBake, ColourTerms, HaloWeight, Layer, Masking,
-    MultipleScattering, Options, SigmaRelMode, Surface,
+use twoscale::brdf::{BakeVisitor, ChannelBake};
+use twoscale::brdf::{BoxedSpectral, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
+use twoscale::domain::{self, Invalid};
+use twoscale::io::desc::{self, DescError, DescErrorKind, Eta, Keywords, MaterialDesc};
+use twoscale::material::RgbMode;
+use twoscale::material::{
+    BaseKind, BaseLayer, ColourTerms, HaloWeight, Layer, Masking, MultipleScattering, Options,
+    SigmaRelMode, Surface,
 };
-use twoscale::brdf::{BoxedSpectral, RgbMode, RgbModel, SPECTRAL_WAVELENGTHS, Spectral};
-use twoscale::desc::{self, DescError, DescErrorKind, Eta, Keywords, MaterialDesc};
-use twoscale::optical::{OwnedSpectralMaterial, SpectralMaterial};
-use twoscale::validate::{self, Invalid, Named};
+use twoscale::spectrum::optical::{OwnedSpectralMaterial, SpectralMaterial};
+use twoscale::validate::{self, Named};
 use twoscale::{Bxdf, Complex, Convolution, TableSet, TwoScale};
 use twoscale_reference::reference::{brdf as ref_brdf, conv as ref_conv, epd as ref_epd};
 use twoscale_reference::reference::{fresnel as ref_fresnel, kcorr as ref_kcorr};
@@ -273,7 +276,7 @@ type SpectralSampleArrays<'py> = (Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyArra
 #[pyclass(frozen, module = "twoscale")]
 struct Material {
     model: Box<RgbModel<'static, Box<ChannelBake>>>,
-    material: twoscale::brdf::Material,
+    material: twoscale::material::Material,
     options: Options,
     rgb_mode: RgbMode,
     /// The index over the spectrum (`MaterialDesc::spectral`): given, a
@@ -430,7 +433,7 @@ impl Material {
         multiple_scattering: Option<&str>,
         rgb_mode: Option<&str>,
     ) -> PyResult<Self> {
-        // The keywords are a material description's keys (`twoscale::desc`):
+        // The keywords are a material description's keys (`twoscale::io::desc`):
         // one reading, with its defaults and messages, for Python and TOML.
         let eta = EtaArgument::read(eta)?;
         let keywords = Keywords {
@@ -459,7 +462,7 @@ impl Material {
     /// from_toml(path): the material of a material file (TOML: a
     /// `[material]` table whose keys are this class's keywords, and an
     /// optional `[metrics]` table, not read), as `python -m twoscale.fit`
-    /// writes it. Read by the runtime (`twoscale::desc`), as the C API and
+    /// writes it. Read by the runtime (`twoscale::io::desc`), as the C API and
     /// the generator read it: a refused file raises `ValueError` (`OSError`
     /// if it cannot be read) with their message, which starts with the path.
     #[staticmethod]
@@ -691,7 +694,7 @@ impl Material {
     /// built them, for ports of `eval` and `pdf` (`twoscale.drjit_bsdf`):
     /// a list of three dicts (red, green, blue) mapping names to float
     /// scalars and float32 or float64 arrays (the names and layouts of
-    /// `TwoScale::visit_bakes` and `runtime/src/bake.rs`; not a stable
+    /// `TwoScale::visit_bakes` and `runtime/src/bake/`; not a stable
     /// interface). For `rgb_mode="paper-wavelengths"` only.
     fn bakes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let RgbModel::PaperWavelengths(model) = &*self.model else {
@@ -783,7 +786,7 @@ impl Material {
                 Some(self.rgb_mode),
             ),
             None => MaterialDesc::rgb(
-                twoscale::brdf::Material {
+                twoscale::material::Material {
                     layer,
                     ..self.material
                 },
@@ -1138,7 +1141,7 @@ fn sigma_ratio<'py>(
         let (cos_given, bb, c) = (th.cos() as f32, bb as f32, c as f32);
         if !clamp {
             t.check(cos_given, bb, c).map_err(|e| match e.name {
-                "cos_theta_i" => format!("theta_i = {}: {e}", validate::Shortest(th)),
+                "cos_theta_i" => format!("theta_i = {}: {e}", domain::Shortest(th)),
                 _ => e.to_string(),
             })?;
         }
@@ -1215,7 +1218,7 @@ fn fresnel<'py>(
         } else {
             let eta = Complex::new(n as f32, k as f32);
             in_domain(clamp, || validate::eta(("n", "k"), eta))?;
-            Ok(twoscale::fresnel::fresnel(eta, cos as f32).into())
+            Ok(twoscale::model::fresnel::fresnel(eta, cos as f32).into())
         }
     })
 }
@@ -1303,7 +1306,10 @@ fn brdf<'py>(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Material>()?;
-    m.add("RGB_WAVELENGTHS", twoscale::brdf::RGB_WAVELENGTHS.to_vec())?;
+    m.add(
+        "RGB_WAVELENGTHS",
+        twoscale::material::RGB_WAVELENGTHS.to_vec(),
+    )?;
     let options = BTreeMap::from([
         (Masking::OPTION, names::<Masking>()),
         (SigmaRelMode::OPTION, names::<SigmaRelMode>()),

@@ -1,4 +1,4 @@
-//! Bindings of `twoscale::merl`, the MERL BRDF file format, for
+//! Bindings of `twoscale::io::merl`, the MERL BRDF file format, for
 //! `twoscale.merl` (python/twoscale/merl.py): decoding and encoding whole
 //! files between bytes and `(3, 90, 90, 180)` float64 arrays (channel, θh
 //! bin, θd bin, φd bin), the bin of direction pairs and the bin centres.
@@ -10,7 +10,7 @@ use numpy::{
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use twoscale::merl;
+use twoscale::io::merl;
 
 /// The `(3, 90, 90, 180)` shape of a file's values.
 const SHAPE: (usize, usize, usize, usize) =

@@ -388,7 +388,7 @@ def test_a_spectral_eta_is_the_preset_it_copies():
 
 def test_integrated_rgb_differs_from_the_paper_wavelengths_for_gold():
     """Gold's blue at the paper's 0.444 µm is well above the integral's
-    (docs/design/rgb-integration.md: 8-14% at p99 over pairs)."""
+    (docs/design/rgb-integration.md: 8-12% per channel at p99 over pairs)."""
     wi = np.array([0.5, 0.0, 0.866])
     wo = np.array([-0.5, 0.0, 0.866])
     paper = twoscale.Material.preset("gold-hp17-geometry", rgb_mode="paper-wavelengths").eval(wi, wo)

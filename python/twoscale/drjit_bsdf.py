@@ -5,7 +5,7 @@ there).
 The per-material bakes come from the Rust runtime (:meth:`twoscale.Material.bakes`,
 the only place where the tables are interpreted); they are uploaded once per
 material as Dr.Jit arrays, and ``eval`` mirrors ``TwoScale::lobes`` of
-runtime/src/brdf.rs with Dr.Jit operations only (gathers and arithmetic: no
+runtime/src/brdf/ with Dr.Jit operations only (gathers and arithmetic: no
 NumPy, no host callback), so it runs with Mitsuba's symbolic loops and calls
 on (the default) and no Dr.Jit flag is switched. The lookups are the runtime's
 own interpolations (linear in the 1-D bakes, Catmull–Rom over the padded
@@ -67,7 +67,7 @@ import numpy as np
 import twoscale
 from twoscale.mitsuba import _material
 
-# The constants of `math::log2_axis` (runtime/src/math.rs), in f32.
+# The constants of `math::log2_axis` (runtime/src/math/mod.rs), in f32.
 _LOG2_E = np.float32(math.log2(math.e))
 _AXIS_D0 = float(_LOG2_E)
 _AXIS_C2 = float(np.float32(3.0) - np.float32(2.5) * _LOG2_E)

@@ -32,7 +32,7 @@
 //! study can tell where the fitted parameters might jump between branches.
 //!
 //! The shipped table fits the paper's form at every node with
-//! [`fit_k_lobe`] (`tables::t3`); the error of the form itself is what
+//! [`fit_k_lobe`] (`tables::convolution`); the error of the form itself is what
 //! `generator verify` reports for T3a.
 
 /// The result of [`best_scale`].

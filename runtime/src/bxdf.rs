@@ -1,9 +1,10 @@
 //! One interface for every BRDF of the runtime, as pbrt-v4's `BxDF` and
 //! Mitsuba 3's `BSDF` have: [`Bxdf`] with `eval`, `sample`, `pdf` and the
 //! [`BxdfFlags`] of what the BRDF holds. Implemented by the two-scale model
-//! at one wavelength ([`TwoScale`], `f32` values) and in RGB ([`Rgb`],
-//! `[f32; 3]`), the 2015 model ([`Hp15`], `f32`) and the SH matrices
-//! ([`ShBrdfTable`], `[f32; 3]`).
+//! at one wavelength ([`TwoScale`], `f32` values), in RGB at the paper's
+//! wavelengths ([`Rgb`], `[f32; 3]`), integrated over the spectrum
+//! ([`IntegratedRgb`]) or either ([`RgbModel`]), the 2015 model ([`Hp15`],
+//! `f32`) and the SH matrices ([`ShBrdfTable`], `[f32; 3]`).
 //!
 //! Conventions (those of [`crate::brdf`]): reflection only, directions in the
 //! local frame (normal `+z`), `i` towards the light, `o` towards the viewer,
@@ -15,10 +16,10 @@
 //! is expected. Each implementation forwards to the type's own methods
 //! (static dispatch: no cost over calling them directly).
 
+use crate::brdf::hp15::Hp15;
 use crate::brdf::{ChannelBake, IntegratedRgb, Rgb, RgbModel, TwoScale};
-use crate::hp15::Hp15;
 use crate::math::{BELOW_ONE, upper_unit};
-use crate::sh::ShBrdfTable;
+use crate::tables::sh_brdf::ShBrdfTable;
 use core::borrow::Borrow;
 use core::f64::consts::PI;
 use core::ops::BitOr;
@@ -299,8 +300,8 @@ impl Bxdf for ShBrdfTable<'_> {
 mod tests {
     use super::*;
     use crate::TableSet;
-    use crate::brdf::Options;
-    use crate::hp15::{Energy, Hp15Params};
+    use crate::brdf::hp15::{Energy, Hp15Params};
+    use crate::material::Options;
     use crate::materials::PRESETS;
     use crate::test_rng::Lcg;
 
@@ -387,7 +388,7 @@ mod tests {
                 s.sigma_s > 0.0 && s.b > 0.0 && s.c > 1.0,
                 "{name}"
             );
-            let diffuse = material.layer.base != crate::brdf::BaseLayer::Conductor
+            let diffuse = material.layer.base != crate::material::BaseLayer::Conductor
                 || material.layer.lambertian > 0.0;
             assert_eq!(flags.contains(BxdfFlags::DIFFUSE), diffuse, "{name}");
         }

@@ -14,45 +14,38 @@
 // `x.max(lo).min(hi)` maps NaN to `lo`; `clamp` would propagate NaN.
 #![allow(clippy::manual_clamp)]
 
-pub mod albedo;
+// The layers, bottom up (each imports only from the ones above it in this
+// list; tests/layers.rs checks it): ground, tables, model, bakes, BRDFs,
+// front doors.
 mod bake;
 pub mod brdf;
 pub mod bxdf;
-pub mod colour;
-pub mod conv;
-pub mod desc;
-pub mod epd;
-pub mod format;
-pub mod fresnel;
-pub mod gamma;
-mod halo;
-pub mod hp15;
-pub mod interp;
-pub mod kcorr;
+pub mod domain;
+pub mod io;
+pub mod material;
 pub mod materials;
 pub mod math;
-pub mod merl;
-#[cfg(feature = "std")]
-pub mod mmap;
-pub mod optical;
-pub mod sh;
-pub mod smith;
+pub mod model;
+pub mod spectrum;
 pub mod table_set;
+pub mod tables;
 #[cfg(test)]
 mod test_rng;
 pub mod validate;
-mod visible;
 
-pub use albedo::AlbedoTable;
 pub use brdf::{Rgb, TwoScale};
 pub use bxdf::{Bxdf, BxdfFlags, BxdfSample};
-pub use conv::{ConvFitTable, ConvTable, Convolution};
-pub use format::{AlignedBytes, FormatError, Table, TableId};
-pub use fresnel::{Complex, DiffuseFresnelTable};
-pub use kcorr::{KCorrelation, SigmaRatioTable};
-pub use sh::ShBrdfTable;
-pub use smith::{SmithG1Table, SmithShape};
+pub use domain::{Domain, Invalid, Shortest, Shortest32};
+pub use math::Complex;
+pub use model::kcorr::KCorrelation;
 #[cfg(feature = "std")]
 pub use table_set::{OwnedTableSet, TableStorage};
 pub use table_set::{TableBytes, TableSet, TableSetError, UnknownMaterial};
-pub use validate::{Domain, Invalid, Named, Shortest, Shortest32};
+pub use tables::albedo::AlbedoTable;
+pub use tables::convolution::{ConvFitTable, ConvTable, Convolution};
+pub use tables::diffuse_fresnel::DiffuseFresnelTable;
+pub use tables::format::{AlignedBytes, FormatError, Table, TableId};
+pub use tables::sh_brdf::ShBrdfTable;
+pub use tables::sigma_ratio::SigmaRatioTable;
+pub use tables::smith_g1::{SmithG1Table, SmithShape};
+pub use validate::Named;

@@ -1,8 +1,8 @@
 //! Named material presets for [`crate::brdf`], as plain `const` data: each
 //! preset is a [`SpectralMaterial`] (its index over the spectrum, from the
-//! measured tables of [`crate::optical`]), and [`PRESETS`] holds them at the
+//! measured tables of [`crate::spectrum::optical`]), and [`PRESETS`] holds them at the
 //! paper's three RGB wavelengths 0.645, 0.526, 0.444 µm
-//! ([`crate::brdf::RGB_WAVELENGTHS`]; [`SpectralMaterial::paper_rgb`]).
+//! ([`crate::material::RGB_WAVELENGTHS`]; [`SpectralMaterial::paper_rgb`]).
 //!
 //! Geometry parameters are in the ranges HP17 fits to measured materials;
 //! HP17's nickel fit is β = 0.0598, σs = 0.0273 µm, b = 4.8418 µm
@@ -10,7 +10,7 @@
 //! choices, one per metal, spread over glossy to rough and weak to strong
 //! halos; none is a fit to a measurement.
 //!
-//! Optical constants: [`crate::optical`] (Johnson & Christy 1972 for gold,
+//! Optical constants: [`crate::spectrum::optical`] (Johnson & Christy 1972 for gold,
 //! silver, copper; 1974 for nickel, chromium, titanium, iron; Rakić 1995
 //! for aluminium), interpolated linearly in photon energy between rows.
 //!
@@ -18,14 +18,14 @@
 //! usual round value for acrylic/PMMA-like varnishes in the visible (PMMA's
 //! index is 1.48–1.50 over 0.44–0.65 µm); the dispersion is neglected.
 
-use crate::brdf::{BaseLayer, Layer, Material, Surface};
-use crate::fresnel::Complex;
-use crate::optical::{
+use crate::material::{BaseLayer, Layer, Material, Surface};
+use crate::math::Complex;
+use crate::spectrum::optical::{
     AG_JOHNSON, AL_RAKIC, AU_JOHNSON, CR_JOHNSON, CU_JOHNSON, FE_JOHNSON, Ior, NI_JOHNSON,
     SpectralMaterial, TI_JOHNSON, Tabulated,
 };
 
-/// A measured metal index ([`crate::optical`]).
+/// A measured metal index ([`crate::spectrum::optical`]).
 const fn measured(rows: &'static [[f32; 3]]) -> Ior<'static> {
     Ior::Tabulated(Tabulated::shipped(rows))
 }

@@ -15,20 +15,21 @@
 //! [`TableSet::from_bytes`] (any 64-byte-aligned bytes, `no_std`) and
 //! [`TableSet::open`] (feature `std`: read-only memory maps of a directory).
 
-use crate::albedo::AlbedoTable;
-use crate::brdf::{Material, Options, Rgb, Tables};
-use crate::conv::ConvTable;
-use crate::format::{FormatError, TableId};
-use crate::fresnel::DiffuseFresnelTable;
-use crate::kcorr::SigmaRatioTable;
+use crate::brdf::{Rgb, Tables};
+use crate::material::{Material, Options};
 use crate::materials::PRESETS;
-use crate::smith::SmithG1Table;
+use crate::tables::albedo::AlbedoTable;
+use crate::tables::convolution::ConvTable;
+use crate::tables::diffuse_fresnel::DiffuseFresnelTable;
+use crate::tables::format::{FormatError, TableId};
+use crate::tables::sigma_ratio::SigmaRatioTable;
+use crate::tables::smith_g1::SmithG1Table;
 use core::fmt;
 
 /// The tables of a set ([`TableDescriptor::in_set`]), in tag order; each
 /// is the file `<TableId::name()>.tbl`.
 ///
-/// [`TableDescriptor::in_set`]: crate::format::TableDescriptor::in_set
+/// [`TableDescriptor::in_set`]: crate::tables::format::TableDescriptor::in_set
 pub const TABLES: [TableId; 5] = set_tables();
 
 const fn set_tables<const N: usize>() -> [TableId; N] {
@@ -183,7 +184,7 @@ impl<'a> TableSet<'a> {
     /// `&set.convolution.fit()`; tests pass adapters).
     pub fn brdf_tables_with<'s>(
         &'s self,
-        convolution: &'s (dyn crate::conv::Convolution + Sync),
+        convolution: &'s (dyn crate::tables::convolution::Convolution + Sync),
     ) -> Tables<'s> {
         Tables {
             convolution,
@@ -191,7 +192,7 @@ impl<'a> TableSet<'a> {
         }
     }
 
-    /// The RGB model of `material` (at [`crate::brdf::RGB_WAVELENGTHS`]).
+    /// The RGB model of `material` (at [`crate::material::RGB_WAVELENGTHS`]).
     /// Construction bakes what depends only on the material (see
     /// [`crate::brdf::TwoScale::new`]); build it once per material.
     pub fn rgb(&self, material: &Material, options: Options) -> Rgb<'_> {
@@ -209,7 +210,7 @@ impl<'a> TableSet<'a> {
     }
 
     /// The RGB model of a shipped preset with the paper's options and the
-    /// presets' default RGB ([`crate::brdf::RgbMode::default_for`]: the
+    /// presets' default RGB ([`crate::material::RgbMode::default_for`]: the
     /// integral over the spectrum, [`crate::brdf::IntegratedRgb`]), its
     /// bakes on the heap (feature `std`); an unknown name is an error that
     /// lists the presets.
@@ -223,7 +224,7 @@ impl<'a> TableSet<'a> {
     > {
         let spectral = crate::materials::spectral(name).ok_or(UnknownMaterial { name })?;
         // Every preset validates (`every_preset_is_found_and_an_unknown_name_lists_them`).
-        let desc = crate::desc::MaterialDesc::spectral(spectral, Options::default(), None)
+        let desc = crate::io::desc::MaterialDesc::spectral(spectral, Options::default(), None)
             .map_err(|_| UnknownMaterial { name })?;
         Ok(crate::brdf::RgbModel::boxed(&self.brdf_tables(), &desc))
     }
@@ -234,7 +235,8 @@ impl TableSet<'static> {
     /// The bytes of the tables compiled into the crate (feature `embedded`).
     pub fn embedded_bytes() -> TableBytes<'static> {
         // Every table of the set is compiled in (`format::embedded_bytes`).
-        let bytes = TableBytes::try_from_fn(|id| crate::format::embedded_bytes(id).ok_or(()));
+        let bytes =
+            TableBytes::try_from_fn(|id| crate::tables::format::embedded_bytes(id).ok_or(()));
         bytes.unwrap_or(TableBytes {
             smith: &[],
             sigma_ratio: &[],
@@ -268,7 +270,7 @@ impl TableSet<'static> {
     pub fn open(dir: impl AsRef<std::path::Path>) -> Result<OwnedTableSet, TableSetError> {
         OwnedTableSet::from_storage(|id| {
             let path = dir.as_ref().join(id.file_name());
-            match crate::mmap::MappedFile::open(&path) {
+            match crate::tables::mmap::MappedFile::open(&path) {
                 Ok(file) => Ok(TableStorage::Mapped(file)),
                 Err(error) => Err(TableSetError::Io { path, error }),
             }
@@ -280,9 +282,9 @@ impl TableSet<'static> {
 #[cfg(feature = "std")]
 pub enum TableStorage {
     /// A read-only memory map of the file.
-    Mapped(crate::mmap::MappedFile),
+    Mapped(crate::tables::mmap::MappedFile),
     /// A 64-byte-aligned heap copy.
-    Copied(crate::format::AlignedBuf),
+    Copied(crate::tables::format::AlignedBuf),
 }
 
 #[cfg(feature = "std")]

@@ -10,14 +10,15 @@
 //! `studies brdf-instructions` runs itself under `valgrind --tool=callgrind`
 //! twice per operation (N and 3N calls) and prints the difference per call.
 
+use crate::common;
+use std::fmt::Write as _;
 use std::hint::black_box;
+use std::path::Path;
 use std::process::Command;
 use suite::cost::{self, Inputs};
 use twoscale::TableSet;
-use twoscale::brdf::{
-    BaseLayer, BoxedSpectral, ChannelBake, IntegratedRgb, Layer, MultipleScattering, Options, Rgb,
-    Spectral, TwoScale,
-};
+use twoscale::brdf::{BoxedSpectral, ChannelBake, IntegratedRgb, Rgb, Spectral, TwoScale};
+use twoscale::material::{BaseLayer, Layer, MultipleScattering, Options};
 use twoscale::materials::{self, HP17_NICKEL_SURFACE, PRESETS};
 
 /// The operations, their baselines first.
@@ -109,7 +110,10 @@ pub struct Workload<'a> {
 
 impl<'a> Workload<'a> {
     /// The models of `suite::cost` on `set` (and T3a's fit, kept in `fit`).
-    pub fn new(set: &'a TableSet<'static>, fit: &'a twoscale::conv::ConvFitTable<'static>) -> Self {
+    pub fn new(
+        set: &'a TableSet<'static>,
+        fit: &'a twoscale::tables::convolution::ConvFitTable<'static>,
+    ) -> Self {
         let (rgb, rgb_eta) = cost::rgb_preset(set);
         Workload {
             set,
@@ -309,8 +313,10 @@ fn instructions(operation: &str, calls: usize) -> Result<u64, String> {
 
 /// Prints instructions per call of every operation and their ratios to the
 /// baselines (eval-rgb to the RGB GGX eval, sample to GGX's visible-normal
-/// sample + eval, the rest to the GGX eval).
-pub fn report(calls: usize) -> Result<(), String> {
+/// sample + eval, the rest to the GGX eval), and writes the table to
+/// `markdown` when given.
+pub fn report(calls: usize, markdown: Option<&Path>) -> Result<(), String> {
+    common::check_markdown(markdown)?;
     let mut per_call = Vec::new();
     for op in OPERATIONS {
         let n = calls_of(op, calls);
@@ -325,18 +331,37 @@ pub fn report(calls: usize) -> Result<(), String> {
             .find(|(n, _)| *n == name)
             .map_or(f64::NAN, |x| x.1)
     };
-    println!("| operation | instructions per call | ratio | against |");
-    println!("|---|---|---|---|");
+    let mut out = String::from(
+        "| operation | instructions per call | ratio | against |\n|---|---|---|---|\n",
+    );
     for &(op, count) in &per_call {
         let baseline = baseline(op);
         if baseline.is_empty() {
-            println!("| {op} | {count:.0} | | |");
+            let _ = writeln!(out, "| {op} | {count:.0} | | |");
         } else {
-            println!(
+            let _ = writeln!(
+                out,
                 "| {op} | {count:.0} | {:.2}× | {baseline} |",
                 count / of(baseline)
             );
         }
     }
-    Ok(())
+    print!("{out}");
+    match markdown {
+        Some(path) => common::write_markdown(
+            path,
+            "Instructions per call of the BRDF's operations",
+            &format!("brdf-instructions --calls {calls}"),
+            &format!(
+                "Counted by callgrind on the release build: each operation run N and 3N \
+                 times (N = {calls}; construction N/1000, at least 3), the difference \
+                 over 2N. The workload is `benches/brdf.rs`'s (`suite::cost`): HP17's \
+                 nickel geometry at 0.526 µm, the `gold-hp17-geometry` preset for RGB, \
+                 the `nickel` preset for the spectral model. Instruction counts do not \
+                 depend on the machine's load but do on the compiler; they do not see \
+                 latency (times: `studies brdf-timing`, docs/design/speed.md).\n\n{out}"
+            ),
+        ),
+        None => Ok(()),
+    }
 }

@@ -1,16 +1,21 @@
 //! What the T3 studies share: exact profiles, the committed table, the two
 //! parameter distributions, and error summaries.
 
-use generator::tables::t3;
-use generator::tables::t4::WORKSPACE_TABLES;
+use generator::tables::convolution;
+use generator::tables::sh_brdf::WORKSPACE_TABLES;
 use std::path::Path;
-use twoscale::format::{AlignedBuf, AxisHeader, TableId};
-use twoscale::interp::Axis;
+use twoscale::tables::format::{AlignedBuf, AxisHeader, TableId};
+use twoscale::tables::interp::Axis;
 use twoscale_reference::reference::conv::{Params, ProfileRule, convolution_profile, e_l2_on};
 use twoscale_reference::rng::SplitMix64;
 
 /// T3's parameter axes `(u, c, β, p)`, as the generator builds them.
-pub const AXES: [AxisHeader; 4] = [t3::U_AXIS, t3::C_AXIS, t3::BETA_AXIS, t3::P_AXIS];
+pub const AXES: [AxisHeader; 4] = [
+    convolution::U_AXIS,
+    convolution::C_AXIS,
+    convolution::BETA_AXIS,
+    convolution::P_AXIS,
+];
 
 /// Gauss nodes per interval of the studies' profile rule (half the metric's
 /// 16: the metric does not change, and the reference costs half).
@@ -20,7 +25,7 @@ pub const ORDER: usize = 8;
 pub fn committed_t3() -> AlignedBuf {
     let path = Path::new(WORKSPACE_TABLES).join(generator::tables::file_name(TableId::Convolution));
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    twoscale::format::aligned_copy(&bytes)
+    twoscale::tables::format::aligned_copy(&bytes)
 }
 
 /// The runtime's cell of `x` on axis `d` of [`AXES`] (clamped to the axis).
@@ -160,7 +165,7 @@ pub fn floored_ln(values: &[f64]) -> Vec<f64> {
     let peak = values.iter().copied().fold(0.0f64, f64::max);
     values
         .iter()
-        .map(|&x| x.max(t3::VALUE_FLOOR * peak).ln())
+        .map(|&x| x.max(convolution::VALUE_FLOOR * peak).ln())
         .collect()
 }
 
@@ -168,7 +173,7 @@ pub fn floored_ln(values: &[f64]) -> Vec<f64> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Distribution {
     /// `generator verify`'s: uniform in the mapped coordinates of the whole
-    /// T3 domain (`t3::verification_points`).
+    /// T3 domain (`convolution::verification_points`).
     Verify,
     /// The BRDF check's (`tests/independent/brdf_scipy.py`): u log-uniform in
     /// [0.5, 50], c uniform in [1.2, 6], β log-uniform in [0.05, 1], p
@@ -180,7 +185,7 @@ impl Distribution {
     /// `count` points of the distribution from `seed`.
     pub fn points(self, count: usize, seed: u64) -> Vec<[f64; 4]> {
         match self {
-            Distribution::Verify => t3::verification_points(count, seed),
+            Distribution::Verify => convolution::verification_points(count, seed),
             Distribution::Brdf => {
                 let mut rng = SplitMix64::new(seed);
                 (0..count)
@@ -214,4 +219,37 @@ pub fn percentiles(v: &mut [f64], qs: &[f64]) -> String {
         .map(|&q| format!("{:.2}%", 100.0 * quantile(v, q)))
         .collect();
     cells.join(" ")
+}
+
+/// Fails early, before a study's work, when `path` (its `--markdown` file)
+/// could not be written: its directory does not exist.
+pub fn check_markdown(path: Option<&Path>) -> Result<(), String> {
+    let Some(path) = path else { return Ok(()) };
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{}: no directory {}",
+            path.display(),
+            dir.display()
+        ))
+    }
+}
+
+/// Writes a study's tables `body` (markdown) to `path` under `title` and the
+/// command that regenerates the file, `studies COMMAND --markdown PATH`, as
+/// `generator verify --markdown` writes docs/accuracy.md: the figures of a
+/// record live in a generated file under docs/figures/ instead of the
+/// record's text.
+pub fn write_markdown(path: &Path, title: &str, command: &str, body: &str) -> Result<(), String> {
+    let text = format!(
+        "# {title}\n\nWritten by `cargo run --release -p studies -- {command} --markdown {}` \
+         (do not edit: rerun the command).\n\n{body}",
+        path.display()
+    );
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }

@@ -71,7 +71,7 @@ struct Layout {
 
 impl Layout {
     /// The parameter axes (and sets [`t3_angle::XI_COUNT`]).
-    fn grid(&self) -> Result<[twoscale::format::AxisHeader; 4], String> {
+    fn grid(&self) -> Result<[twoscale::tables::format::AxisHeader; 4], String> {
         if let Some(n) = self.xi {
             if n < 4 {
                 return Err(format!("--xi {n}: at least 4"));
@@ -252,6 +252,10 @@ enum Study {
         /// under callgrind).
         #[arg(long)]
         operation: Option<String>,
+        /// Also write the table as markdown to this file
+        /// (docs/figures/brdf-instructions.md).
+        #[arg(long, conflicts_with = "operation")]
+        markdown: Option<PathBuf>,
     },
     /// RGB by integration over the spectrum against the paper's three
     /// wavelengths, and few-wavelength candidates
@@ -263,6 +267,10 @@ enum Study {
         /// Seed of the pairs.
         #[arg(long, default_value_t = 26)]
         seed: u64,
+        /// Also write the tables as markdown to this file
+        /// (docs/figures/rgb-integration.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
     },
     /// Wall time per call of the BRDF's operations and the GGX baselines,
     /// interleaved batches, minimum over rounds (docs/design/speed.md).
@@ -274,8 +282,8 @@ enum Study {
         #[arg(long, default_value_t = 4096)]
         batch: usize,
     },
-    /// T6's node counts and p mapping against its interpolated error, size
-    /// and build time (docs/design/t6-albedo-axes.md).
+    /// T6's node counts and p mapping against its interpolated error and
+    /// size, build times on stderr (docs/design/t6-albedo-axes.md).
     T6Axes {
         /// Random points (each measured for both maskings).
         #[arg(long, default_value_t = 20000)]
@@ -284,16 +292,24 @@ enum Study {
         #[arg(long = "layout", value_parser = t6_axes::parse_layout,
               default_values = ["40,56,10,-0.5", "40,48,13,-0.5", "36,48,14,-0.35", "32,44,14,-0.35", "36,40,16,-0.35"])]
         layouts: Vec<[f64; 4]>,
+        /// Also write the table as markdown to this file
+        /// (docs/figures/t6-axes.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
     },
     /// T4's error against the band limit L
     /// (docs/design/t4-band-limits.md).
     T4BandLimits {
-        /// Which BRDFs.
-        #[arg(value_enum, default_value_t = t4_band_limits::Subject::TwoScale)]
-        subject: t4_band_limits::Subject,
+        /// Which BRDFs (one table, in this order).
+        #[arg(value_enum, default_values = ["two-scale"])]
+        subjects: Vec<t4_band_limits::Subject>,
         /// Materials file (for the two-scale presets).
         #[arg(long, default_value = DEFAULT_MATERIALS)]
         materials: PathBuf,
+        /// Also write the table as markdown to this file
+        /// (docs/figures/t4-band-limits.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
     },
 }
 
@@ -384,13 +400,29 @@ fn main() -> ExitCode {
             t3_thresholds::run();
             Ok(())
         }
-        Study::T6Axes { points, layouts } => t6_axes::run(&layouts, points),
-        Study::T4BandLimits { subject, materials } => t4_band_limits::run(subject, &materials),
-        Study::RgbIntegration { pairs, seed } => rgb_integration::run(pairs, seed),
+        Study::T6Axes {
+            points,
+            layouts,
+            markdown,
+        } => t6_axes::run(&layouts, points, markdown.as_deref()),
+        Study::T4BandLimits {
+            subjects,
+            materials,
+            markdown,
+        } => t4_band_limits::run(&subjects, &materials, markdown.as_deref()),
+        Study::RgbIntegration {
+            pairs,
+            seed,
+            markdown,
+        } => rgb_integration::run(pairs, seed, markdown.as_deref()),
         Study::BrdfTiming { rounds, batch } => brdf_instructions::timing(rounds, batch),
-        Study::BrdfInstructions { calls, operation } => match operation {
+        Study::BrdfInstructions {
+            calls,
+            operation,
+            markdown,
+        } => match operation {
             Some(op) => brdf_instructions::run_calls(&op, calls),
-            None => brdf_instructions::report(calls),
+            None => brdf_instructions::report(calls, markdown.as_deref()),
         },
     };
     match result {

@@ -2,7 +2,7 @@
 //! what the paper's three wavelengths miss, and how few wavelengths an
 //! integrating RGB model needs.
 //!
-//! The reference is the CIE 5 nm sum of `twoscale::colour` over 85
+//! The reference is the CIE 5 nm sum of `twoscale::spectrum::colour` over 85
 //! one-wavelength models, each built at its λ with the preset's measured
 //! η(λ). The candidates, evaluated at the same pairs, interpolate a spectrum
 //! from K wavelengths λ_k with a basis `L_k(λ)` and integrate the
@@ -22,11 +22,15 @@
 //! Errors are relative per channel, over pairs where the reference channel
 //! exceeds 1e-3 of the preset's largest value at the pairs.
 
+use crate::common;
+use std::fmt::Write as _;
+use std::path::Path;
 use twoscale::TableSet;
-use twoscale::brdf::{ChannelBake, Options, TwoScale};
-use twoscale::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
-use twoscale::fresnel::{fresnel, q_bar};
+use twoscale::brdf::{ChannelBake, TwoScale};
+use twoscale::material::Options;
 use twoscale::materials::SPECTRAL_PRESETS;
+use twoscale::model::fresnel::{fresnel, q_bar};
+use twoscale::spectrum::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
 use twoscale_reference::rng::SplitMix64;
 
 /// The candidate wavelength counts.
@@ -154,7 +158,9 @@ fn p99_max(errors: &mut [f64]) -> (f64, f64) {
     (p99, errors[errors.len() - 1])
 }
 
-pub fn run(pairs: usize, seed: u64) -> Result<(), String> {
+/// Prints the two tables (and writes them to `markdown` when given).
+pub fn run(pairs: usize, seed: u64, markdown: Option<&Path>) -> Result<(), String> {
+    common::check_markdown(markdown)?;
     let set = TableSet::embedded();
     let tables = set.brdf_tables();
     let options = Options::default();
@@ -181,10 +187,6 @@ pub fn run(pairs: usize, seed: u64) -> Result<(), String> {
             bases.push((format!("{name} {k}"), weighted, basis));
         }
     }
-    println!(
-        "# RGB by integration: errors per channel against the 5 nm sum ({pairs} pairs, seed {seed})"
-    );
-    println!();
     let mut geometry_rows = Vec::new();
     let mut table = Vec::new();
     for preset in SPECTRAL_PRESETS {
@@ -333,39 +335,63 @@ pub fn run(pairs: usize, seed: u64) -> Result<(), String> {
             geometry_rows.push((preset.name, offset, reference, candidates[0]));
         }
     }
-    print!("| preset | paper |");
-    for (name, _, _) in &bases {
-        print!(" {name} |");
-    }
-    println!();
-    println!("|---|---|{}", "---|".repeat(bases.len()));
-    for (name, stats) in &table {
-        print!("| {name} |");
-        for (p99, max) in stats {
-            print!(" {:.2} / {:.2} |", 100.0 * p99, 100.0 * max);
-        }
-        println!();
-    }
-    println!();
-    println!("(p99 / max of the relative error per channel, %)");
-    println!();
-    println!(
-        "# θi = 45°, in the plane of incidence: integrated vs three wavelengths (channels / their max)"
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "## Errors per channel against the 5 nm sum\n\n\
+         {pairs} direction pairs per preset (seed {seed}): p99 / max of the relative error \
+         per channel, %, where the 5 nm sum exceeds 1e-3 of the preset's peak. `paper` is \
+         `Rgb` (0.645, 0.526, 0.444 µm); the others interpolate K wavelengths (`hat K`: \
+         hats over [0.40, 0.70] µm, `cheb K`: Chebyshev nodes over [0.38, 0.72] µm) and \
+         integrate exactly: ρ itself, `F-`: every lobe divided by F(θd), `F/W-`: the \
+         specular lobe by F(θd) and the halo by W (`R0`: F at normal incidence, `Fio`: \
+         √(F(θi) F(θo)), `Q`: its exact Q̄, `QNhat`: Q̄ from N hats).\n"
     );
-    println!();
-    println!("| preset | offset | integrated (R, G, B) | three wavelengths | luminance ratio |");
-    println!("|---|---|---|---|---|");
+    out.push_str("| preset | paper |");
+    for (name, _, _) in &bases {
+        let _ = write!(out, " {name} |");
+    }
+    let _ = writeln!(out, "\n|---|---|{}", "---|".repeat(bases.len()));
+    for (name, stats) in &table {
+        let _ = write!(out, "| {name} |");
+        for (p99, max) in stats {
+            let _ = write!(out, " {:.2} / {:.2} |", 100.0 * p99, 100.0 * max);
+        }
+        out.push('\n');
+    }
+    let _ = writeln!(
+        out,
+        "\n## Integrated against three wavelengths at θi = 45°\n\n\
+         In the plane of incidence, o at the mirror direction and 10° beyond it; each \
+         model's channels divided by their largest; the luminance ratio is the \
+         three-wavelength model's Y over the 5 nm sum's.\n"
+    );
+    let _ = writeln!(
+        out,
+        "| preset | offset | integrated (R, G, B) | three wavelengths | luminance ratio |\n\
+         |---|---|---|---|---|"
+    );
     for (name, offset, r, p) in geometry_rows {
         let norm = |v: [f64; 3]| {
             let m = v.iter().copied().fold(f64::MIN, f64::max);
             format!("{:.3}, {:.3}, {:.3}", v[0] / m, v[1] / m, v[2] / m)
         };
         let ratio = colour::luminance(p) / colour::luminance(r);
-        println!(
+        let _ = writeln!(
+            out,
             "| {name} | {offset}° | {} | {} | {ratio:.3} |",
             norm(r),
             norm(p)
         );
     }
-    Ok(())
+    print!("{out}");
+    match markdown {
+        Some(path) => common::write_markdown(
+            path,
+            "RGB by integration over the spectrum: the study's figures",
+            &format!("rgb-integration --pairs {pairs} --seed {seed}"),
+            &out,
+        ),
+        None => Ok(()),
+    }
 }

@@ -3,17 +3,18 @@
 //!
 //! Every measurement builds what one table node would hold — `ln C` at the
 //! 32 node angles of the angle under test, from exact profiles — and
-//! interpolates it as the lookup does (`twoscale::conv::along_xi`; across β
-//! and p with `twoscale::conv::axis_weights`), against exact `C`.
+//! interpolates it as the lookup does (`twoscale::tables::convolution::along_xi`; across β
+//! and p with `twoscale::tables::convolution::axis_weights`), against exact `C`.
 
 use crate::common::{Distribution, Exact, cell_on, exact_c, floored_ln, percentiles, quantile};
-use generator::tables::t3;
+use generator::tables::convolution;
 use rayon::prelude::*;
-use twoscale::conv::{
-    AngleParams, along_xi, axis_weights, normalised_angle, tan_of_normalised_angle,
+use twoscale::tables::convolution::{
+    along_xi, axis_weights, normalised_angle, tan_of_normalised_angle,
 };
-use twoscale::format::AxisHeader;
-use twoscale::interp::node_value;
+use twoscale::tables::format::AngleParams;
+use twoscale::tables::format::AxisHeader;
+use twoscale::tables::interp::node_value;
 use twoscale_reference::reference::conv::{kernel_integral, ndf_integral};
 use twoscale_reference::reference::epd::{ndf_peak, ndf_sin_cos};
 
@@ -35,7 +36,7 @@ impl Angle {
     /// fade `(p′/p)^m` where the kernel is wider than the NDF, default 0).
     pub fn parse(s: &str) -> Result<Angle, String> {
         if s == "format1" {
-            return Ok(Angle::Format1(t3::ANGLE));
+            return Ok(Angle::Format1(convolution::ANGLE));
         }
         let v: Vec<f64> = s
             .split(',')
@@ -52,7 +53,7 @@ impl Angle {
             edge_smoothing: smoothing,
             edge_fade_tan: if fade > 0.0 { fade } else { f64::INFINITY },
             edge_softening_fade: sharp,
-            ..t3::ANGLE
+            ..convolution::ANGLE
         }))
     }
 
@@ -147,12 +148,12 @@ pub const DEFAULT_ANGLES: [&str; 6] = [
 ];
 
 /// Normalised angles per node in the studies' tables (default
-/// `t3::ANGLES`; `--xi` of t3-angle-patch and t3-angle-at-points).
+/// `convolution::ANGLES`; `--xi` of t3-angle-patch and t3-angle-at-points).
 pub static XI_COUNT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
 
-/// [`XI_COUNT`], or `t3::ANGLES` when unset.
+/// [`XI_COUNT`], or `convolution::ANGLES` when unset.
 fn xi_count() -> usize {
-    *XI_COUNT.get_or_init(|| t3::ANGLES)
+    *XI_COUNT.get_or_init(|| convolution::ANGLES)
 }
 
 /// The node angles `θ_k` of `angle` at `point` (one node of a table built
@@ -214,7 +215,7 @@ pub enum Blend {
     /// Equal θh: each corner's cubic along ξ at its own ξ of the query's θh,
     /// then the values blended.
     Theta,
-    /// A residual table: `ln C − ln C̃` (`twoscale::conv::ln_approximation`
+    /// A residual table: `ln C − ln C̃` (`twoscale::tables::convolution::ln_approximation`
     /// with each node's own parameters) blended at equal ξ, the cubic at the
     /// query's ξ, plus `ln C̃` with the query's parameters.
     Residual,
@@ -298,7 +299,11 @@ fn ln_approx([u, c, beta, p]: [f64; 4], theta: f64) -> f64 {
         let (sin, cos) = theta.sin_cos();
         let narrow = wk + ndf_sin_cos(beta, p, peak, sin, cos).ln();
         let wide = wd
-            + f64::from(twoscale::conv::kernel((2.0 * u * sin) as f32, c as f32)).ln()
+            + f64::from(twoscale::tables::convolution::kernel(
+                (2.0 * u * sin) as f32,
+                c as f32,
+            ))
+            .ln()
             + 2.0 * cos.ln();
         ln_sum(ln_harmonic(narrow, wd), ln_harmonic(wide, narrow_peak))
     };
@@ -591,8 +596,11 @@ mod tests {
     #[test]
     fn the_last_default_angle_is_the_shipped_one() {
         let shipped = Angle::parse(DEFAULT_ANGLES[DEFAULT_ANGLES.len() - 1]).unwrap();
-        assert_eq!(shipped, Angle::Runtime(t3::ANGLE));
-        assert_eq!(Angle::parse("format1").unwrap(), Angle::Format1(t3::ANGLE));
+        assert_eq!(shipped, Angle::Runtime(convolution::ANGLE));
+        assert_eq!(
+            Angle::parse("format1").unwrap(),
+            Angle::Format1(convolution::ANGLE)
+        );
         assert!(Angle::parse("0.5,0.5").is_err());
         assert!(Angle::parse("a,b,c,d").is_err());
     }

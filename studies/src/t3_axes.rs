@@ -8,11 +8,11 @@
 //! values of the axis, against exact `ln C` there.
 
 use crate::common::{Distribution, exact_c, floored_ln, percentiles};
-use generator::tables::t3;
+use generator::tables::convolution;
 use rayon::prelude::*;
-use twoscale::conv::axis_weights;
-use twoscale::format::{AxisHeader, Mapping};
-use twoscale::interp::{Axis, node_value};
+use twoscale::tables::convolution::axis_weights;
+use twoscale::tables::format::{AxisHeader, Mapping};
+use twoscale::tables::interp::{Axis, node_value};
 
 /// A parameter axis of T3.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -54,17 +54,17 @@ impl Param {
                 (28, 0.1),
                 (28, 1.0),
             ]
-            .map(|(n, offset)| with(t3::U_AXIS, n, Mapping::LogOffset, offset, 0.0))
+            .map(|(n, offset)| with(convolution::U_AXIS, n, Mapping::LogOffset, offset, 0.0))
             .to_vec(),
             Param::C => [(10, 0.0), (10, 0.25), (10, 0.5), (10, 1.0), (12, 0.5)]
-                .map(|(n, linear)| with(t3::C_AXIS, n, Mapping::LogOffset, -1.0, linear))
+                .map(|(n, linear)| with(convolution::C_AXIS, n, Mapping::LogOffset, -1.0, linear))
                 .to_vec(),
             Param::P => vec![
-                with(t3::P_AXIS, 12, Mapping::Power, -0.5, 0.0),
-                with(t3::P_AXIS, 12, Mapping::Log, 0.0, 0.0),
-                with(t3::P_AXIS, 12, Mapping::Power, -0.25, 0.0),
-                with(t3::P_AXIS, 12, Mapping::LogOffset, 0.0, 0.3),
-                with(t3::P_AXIS, 14, Mapping::Log, 0.0, 0.0),
+                with(convolution::P_AXIS, 12, Mapping::Power, -0.5, 0.0),
+                with(convolution::P_AXIS, 12, Mapping::Log, 0.0, 0.0),
+                with(convolution::P_AXIS, 12, Mapping::Power, -0.25, 0.0),
+                with(convolution::P_AXIS, 12, Mapping::LogOffset, 0.0, 0.3),
+                with(convolution::P_AXIS, 14, Mapping::Log, 0.0, 0.0),
             ],
         }
     }
@@ -87,7 +87,7 @@ pub fn run(param: Param, triples: usize) {
             q[axis] = x;
             // The node angles depend on u, β, p (not on c).
             let angles_of = if axis == 1 { base } else { q };
-            let (thetas, _) = t3::angle_rule(angles_of[0], angles_of[2], angles_of[3]);
+            let (thetas, _) = convolution::angle_rule(angles_of[0], angles_of[2], angles_of[3]);
             floored_ln(&exact_c(q, &thetas))
         };
         type Row = (Vec<Vec<Vec<f64>>>, Vec<(f64, Vec<f64>)>);

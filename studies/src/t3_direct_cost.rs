@@ -7,7 +7,9 @@
 //! (same stride): the agreement of a changed quadrature with the old one on
 //! real T3 nodes, every angle.
 
-use generator::tables::t3::{angle_rule, node_count, node_params, node_tries_zonal_harmonics};
+use generator::tables::convolution::{
+    angle_rule, node_count, node_params, node_tries_zonal_harmonics,
+};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;

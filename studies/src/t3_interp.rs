@@ -9,10 +9,12 @@
 //!   storage), along the parameters, along ξ, or both.
 
 use crate::common::{AXES, Distribution, Exact, cell, committed_t3, percentiles};
-use generator::tables::t3;
+use generator::tables::convolution;
 use rayon::prelude::*;
-use twoscale::conv::{ConvTable, FIT_CHANNELS, along_xi, axis_weights, normalised_angle};
-use twoscale::interp::{bspline_weights, node_value};
+use twoscale::tables::convolution::{
+    ConvTable, FIT_CHANNELS, along_xi, axis_weights, normalised_angle,
+};
+use twoscale::tables::interp::{bspline_weights, node_value};
 use twoscale_reference::bspline::prefilter;
 
 /// The committed T3 as the runtime reads it, with `cubic` parameter axes,
@@ -75,7 +77,7 @@ impl Variant {
     }
 
     fn angles(&self) -> usize {
-        t3::ANGLES + if self.xi_bspline { 2 } else { 0 }
+        convolution::ANGLES + if self.xi_bspline { 2 } else { 0 }
     }
 
     /// `C` at `τ = tan θh` and the point, in f64 from the variant's data.
@@ -118,14 +120,14 @@ impl Variant {
             sum
         };
         let [u, _, beta, p] = point;
-        let xi = normalised_angle(tau, u, beta, p, &t3::ANGLE);
+        let xi = normalised_angle(tau, u, beta, p, &convolution::ANGLE);
         let ln_c = if self.xi_bspline {
-            let position = xi.clamp(0.0, 1.0) * (t3::ANGLES - 1) as f64;
-            let i = (position.floor() as usize).min(t3::ANGLES - 2);
+            let position = xi.clamp(0.0, 1.0) * (convolution::ANGLES - 1) as f64;
+            let i = (position.floor() as usize).min(convolution::ANGLES - 2);
             let w = bspline_weights((position - i as f64) as f32);
             (0..4).map(|k| f64::from(w[k]) * blend(i + k)).sum()
         } else {
-            f64::from(along_xi(t3::ANGLES, xi, |first| {
+            f64::from(along_xi(convolution::ANGLES, xi, |first| {
                 std::array::from_fn(|k| blend(first + k) as f32)
             }))
         };
@@ -139,7 +141,9 @@ fn node_values() -> Vec<f64> {
     let raw = twoscale::Table::from_bytes(buf.bytes()).expect("valid T3");
     let grid = raw.quantised().expect("T3 is stored quantised");
     (0..grid.nodes())
-        .flat_map(|i| (FIT_CHANNELS..t3::CHANNELS).map(move |k| f64::from(grid.value(i, k))))
+        .flat_map(|i| {
+            (FIT_CHANNELS..convolution::CHANNELS).map(move |k| f64::from(grid.value(i, k)))
+        })
         .collect()
 }
 
@@ -174,7 +178,7 @@ fn prefilter_xi(data: &[f64], angles: usize) -> Vec<f64> {
 /// (core and tail) per variant.
 pub fn spline(profiles: usize, seed: u64, distribution: Distribution, snap: &str) {
     let values = node_values();
-    let angles = t3::ANGLES;
+    let angles = convolution::ANGLES;
     let params = prefilter_params(&values, angles);
     let variants = [
         Variant {

@@ -5,9 +5,9 @@
 //! totals by method and by u node, extrapolated to the whole grid (×stride).
 //! One thread (the per-node CPU time is what the figures are about). With
 //! `zh_only`, only the nodes that the build tries by zonal harmonics
-//! (`t3::node_tries_zonal_harmonics`).
+//! (`convolution::node_tries_zonal_harmonics`).
 
-use generator::tables::t3::{
+use generator::tables::convolution::{
     angle_rule, fit_paper_form, node_count, node_params, node_tries_zonal_harmonics,
 };
 use std::collections::BTreeMap;

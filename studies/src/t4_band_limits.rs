@@ -1,13 +1,17 @@
 //! T4's band limits (`docs/design/t4-band-limits.md`): the error of the
 //! projected BRDF against band limit `L` — relative RMS of
 //! `f = ρ cos θi cos θo` and p99 / max of `|f_SH − f| / max f` over 20 000
-//! random pairs (`t4::verification_pairs`, seed 11) — and the asymmetry
+//! random pairs (`sh_brdf::verification_pairs`, seed 11) — and the asymmetry
 //! `‖M − Mᵀ‖/‖M‖` before symmetrising (WAT92 26–27).
 
+use crate::common;
 use generator::analytic::BeckmannCt;
 use generator::materials::Materials;
 use generator::sh::{IsotropicBrdf, default_quadrature, project};
-use generator::tables::t4::{ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verification_pairs};
+use generator::tables::sh_brdf::{
+    ModelInputs, WORKSPACE_TABLES, two_scale_brdf, verification_pairs,
+};
+use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -24,7 +28,15 @@ pub enum Subject {
     Polished,
 }
 
-fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize], theta_factor: usize) {
+/// One markdown row per band limit of `brdf` appended to `out`; the
+/// projection's time goes to stderr (the machine's, not the projection's).
+fn study(
+    out: &mut String,
+    name: &str,
+    brdf: &dyn IsotropicBrdf,
+    bands: &[usize],
+    theta_factor: usize,
+) {
     let pairs = verification_pairs(20_000, 11);
     let exact: Vec<f64> = pairs
         .iter()
@@ -47,9 +59,10 @@ fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize], theta_factor: us
             errors.push(e.abs() / peak);
         }
         errors.sort_by(f64::total_cmp);
-        println!(
-            "{name}, L = {l:3}: rel RMS of f {:.2e}, p99 |Δf|/max f {:.2e}, max {:.2e}, \
-             asymmetry {:.2e}, projection {seconds:.1} s",
+        eprintln!("{name}, L = {l}: projected in {seconds:.1} s");
+        let _ = writeln!(
+            out,
+            "| {name} | {l} | {:.2e} | {:.2e} | {:.2e} | {:.2e} |",
             (sum2 / norm).sqrt(),
             errors[errors.len() * 99 / 100],
             errors[errors.len() - 1],
@@ -58,8 +71,48 @@ fn study(name: &str, brdf: &dyn IsotropicBrdf, bands: &[usize], theta_factor: us
     }
 }
 
-/// Runs the study on `subject`.
-pub fn run(subject: Subject, materials: &Path) -> Result<(), String> {
+/// Runs the study on each of `subjects`; prints one table (and writes it to
+/// `markdown` when given).
+pub fn run(subjects: &[Subject], materials: &Path, markdown: Option<&Path>) -> Result<(), String> {
+    common::check_markdown(markdown)?;
+    let mut out = String::from(
+        "| BRDF | L | rel RMS of f | p99 \\|Δf\\|/max f | max \\|Δf\\|/max f | asymmetry |\n\
+         |---|---:|---:|---:|---:|---:|\n",
+    );
+    for &subject in subjects {
+        run_one(&mut out, subject, materials)?;
+    }
+    print!("{out}");
+    let Some(path) = markdown else {
+        return Ok(());
+    };
+    let names: Vec<&str> = subjects
+        .iter()
+        .map(|s| match s {
+            Subject::TwoScale => "two-scale",
+            Subject::Beckmann => "beckmann",
+            Subject::Polished => "polished",
+        })
+        .collect();
+    common::write_markdown(
+        path,
+        "T4's error against the band limit L",
+        &format!("t4-band-limits {}", names.join(" ")),
+        &format!(
+            "Each BRDF projected to real SH at band limit L with T4's quadrature (the \
+             polished lobe with 4× its θ nodes), at 20 000 random pairs \
+             (`sh_brdf::verification_pairs`, seed 11): the relative RMS of \
+             `f = ρ cos θi cos θo`, p99 and max of `|f_SH − f| / max f`, and the \
+             projected matrix's asymmetry `‖M − Mᵀ‖/‖M‖` before symmetrising. The \
+             two-scale presets are projected at one wavelength (the green channel of \
+             `materials.toml`), as T4 projected them before it took the integrated \
+             RGB.\n\n{out}"
+        ),
+    )
+}
+
+/// Appends the rows of `subject` to `out`.
+fn run_one(out: &mut String, subject: Subject, materials: &Path) -> Result<(), String> {
     match subject {
         Subject::Beckmann => {
             for (name, alpha, bands) in [
@@ -74,7 +127,7 @@ pub fn run(subject: Subject, materials: &Path) -> Result<(), String> {
                     &[8, 16, 32, 48, 64, 96][..],
                 ),
             ] {
-                study(name, &BeckmannCt { alpha, eta: None }, bands, 1);
+                study(out, name, &BeckmannCt { alpha, eta: None }, bands, 1);
             }
         }
         Subject::Polished => {
@@ -82,7 +135,7 @@ pub fn run(subject: Subject, materials: &Path) -> Result<(), String> {
                 alpha: 0.005,
                 eta: None,
             };
-            study("Beckmann polished α = 0.005", &brdf, &[64, 127], 4);
+            study(out, "Beckmann polished α = 0.005", &brdf, &[64, 127], 4);
         }
         Subject::TwoScale => {
             let materials = Materials::load(materials).map_err(|e| e.to_string())?;
@@ -102,7 +155,13 @@ pub fn run(subject: Subject, materials: &Path) -> Result<(), String> {
                     .find(|m| m.name == name)
                     .ok_or_else(|| format!("no preset {name} in the materials file"))?;
                 let brdf = two_scale_brdf(material, channel, lambda, &tables);
-                study(&format!("two-scale {name} at {lambda} µm"), &brdf, bands, 1);
+                study(
+                    out,
+                    &format!("two-scale {name} at {lambda} µm"),
+                    &brdf,
+                    bands,
+                    1,
+                );
             }
         }
     }

@@ -7,7 +7,7 @@ use generator::reference::conv;
 use generator::rng::SplitMix64;
 use std::f64::consts::PI;
 use twoscale::brdf::{Lobe, TwoScale};
-use twoscale::conv::{Convolution, kernel};
+use twoscale::tables::convolution::{Convolution, kernel};
 
 /// A cheap stand-in for C where its accuracy does not matter (sampling
 /// tests, robustness sweeps, benchmarks until T3 exists): the narrow-NDF

@@ -58,7 +58,7 @@ impl Ggx {
     #[inline]
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
         match self.cos_d_and_dg(i, o) {
-            Some((cos_d, dg)) => twoscale::fresnel::fresnel(self.eta, cos_d) * dg,
+            Some((cos_d, dg)) => twoscale::model::fresnel::fresnel(self.eta, cos_d) * dg,
             None => 0.0,
         }
     }
@@ -67,7 +67,7 @@ impl Ggx {
     #[inline]
     pub fn eval_rgb(&self, etas: &[Complex; 3], i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         match self.cos_d_and_dg(i, o) {
-            Some((cos_d, dg)) => etas.map(|eta| twoscale::fresnel::fresnel(eta, cos_d) * dg),
+            Some((cos_d, dg)) => etas.map(|eta| twoscale::model::fresnel::fresnel(eta, cos_d) * dg),
             None => [0.0; 3],
         }
     }

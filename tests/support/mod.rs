@@ -17,7 +17,7 @@ pub fn tables_dir() -> PathBuf {
 
 /// Reads a committed table file into a 64-byte-aligned buffer (for T4, which
 /// has one file per material, the rough gold's).
-pub fn read_table(id: twoscale::TableId) -> twoscale::format::AlignedBuf {
+pub fn read_table(id: twoscale::TableId) -> twoscale::tables::format::AlignedBuf {
     let name = match id {
         twoscale::TableId::ShBrdf => "t4-gold-rough.tbl".to_string(),
         _ => generator::tables::file_name(id),
@@ -29,7 +29,7 @@ pub fn read_table(id: twoscale::TableId) -> twoscale::format::AlignedBuf {
             path.display()
         )
     });
-    twoscale::format::aligned_copy(&bytes)
+    twoscale::tables::format::aligned_copy(&bytes)
 }
 
 /// Outcome of a χ² goodness-of-fit test.
@@ -80,7 +80,7 @@ pub fn chi_square(observed: &[f64], expected: &[f64], min_expected: f64) -> ChiS
     let p_value = if impossible > 0.0 {
         0.0
     } else {
-        twoscale::gamma::gamma_q(dof as f64 / 2.0, statistic / 2.0)
+        twoscale::math::gamma::gamma_q(dof as f64 / 2.0, statistic / 2.0)
     };
     ChiSquare {
         statistic,

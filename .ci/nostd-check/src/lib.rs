@@ -3,7 +3,7 @@
 //! library linked.
 #![no_std]
 
-use twoscale::epd::Epd;
+use twoscale::model::epd::Epd;
 use twoscale::{Complex, DiffuseFresnelTable, SmithG1Table};
 
 #[panic_handler]
@@ -47,14 +47,14 @@ pub extern "C" fn twoscale_f_dr_int(eta: f32) -> f32 {
 /// Unpolarised Fresnel reflectance of n + ik at incidence cos θ.
 #[unsafe(no_mangle)]
 pub extern "C" fn twoscale_fresnel(n: f32, k: f32, cos_theta: f32) -> f32 {
-    twoscale::fresnel::fresnel(Complex::new(n, k), cos_theta)
+    twoscale::model::fresnel::fresnel(Complex::new(n, k), cos_theta)
 }
 
 /// Q̄ of n + ik for incidence i = (sin θi, 0, cos θi) and o = (ox, oy, oz).
 #[unsafe(no_mangle)]
 pub extern "C" fn twoscale_q_bar(n: f32, k: f32, cos_i: f32, ox: f32, oy: f32, oz: f32) -> f32 {
     let sin_i = twoscale::math::sqrtf((1.0 - cos_i * cos_i).max(0.0));
-    twoscale::fresnel::q_bar(Complex::new(n, k), [sin_i, 0.0, cos_i], [ox, oy, oz])
+    twoscale::model::fresnel::q_bar(Complex::new(n, k), [sin_i, 0.0, cos_i], [ox, oy, oz])
 }
 
 /// ρ of the `gold-rough` preset from the embedded table set (feature

@@ -7,8 +7,8 @@
 
 use std::fmt::Write as _;
 
-use twoscale::format::Mapping;
-use twoscale::interp::coordinate_f64;
+use twoscale::tables::format::Mapping;
+use twoscale::tables::interp::coordinate_f64;
 
 use super::{Encoded, NamedArray, Source, aux_array, npy};
 
@@ -109,13 +109,13 @@ fn coordinate_expression(mapping: Mapping, param: f64, param2: f64) -> String {
 }
 
 /// T3's normalised angle in C (double, as the runtime's
-/// `twoscale::conv::normalised_angle`; `P` is the macro prefix of the
+/// `twoscale::tables::convolution::normalised_angle`; `P` is the macro prefix of the
 /// header's parameters, `p` the function prefix).
 pub fn normalised_angle(p: &str, u: &str) -> String {
     format!(
         r#"/* The normalised angle xi in [0, 1] of tau = tan(theta_h) for the (clamped) parameters
  * (u, beta, p): xi = F(min(tau, tau_max)) / F(tau_max), F as in docs/export.md (T3, step 3);
- * in double, as the runtime's twoscale::conv::normalised_angle. tau < 0 is 0. */
+ * in double, as the runtime's twoscale::tables::convolution::normalised_angle. tau < 0 is 0. */
 static inline double {p}_asinh_pos(double x) {{
     return log1p(x + x * x / (1.0 + sqrt(1.0 + x * x)));
 }}
@@ -226,7 +226,7 @@ pub fn sigma_ratio(p: &str, u: &str, value: &str) -> String {
     format!(
         r#"/* sigma_rel / sigma_s inside the table's domain (B in [0.05, 3000], c in (1, 100]):
  * q = tricubic B-spline at (cos theta_i, B, c), times r0 = sqrt(1 - (1 + B^2)^(-(c-1)/2)).
- * Outside it the runtime applies the rules of runtime/src/kcorr.rs. */
+ * Outside it the runtime applies the rules of runtime/src/tables/sigma_ratio.rs. */
 static inline float {p}_sigma_ratio(float cos_theta_i, float big_b, float c) {{
 float t0, t1, t2, w0[4], w1[4], w2[4];
 int i0 = ts_cell({p}_cos_theta_i_position(cos_theta_i), {u}_COS_THETA_I_NODES, &t0);
@@ -254,7 +254,7 @@ return (float)(q * r0);
 }
 
 /// T6's lookup in C: the tricubic B-spline at the incidence and width
-/// coordinates of `twoscale::albedo` (computed in double, as the runtime
+/// coordinates of `twoscale::tables::albedo` (computed in double, as the runtime
 /// does), channel `masking`. The C lookups read the header's first exported
 /// precision (`value`, the C expression of stored value `k`) as the runtime
 /// does (docs/export.md); `p` is the identifier prefix, `u` its upper case.
@@ -296,8 +296,8 @@ return fminf(fmaxf(e, 0.0f), 1.0f);
 
 "#,
         v("k"),
-        centre = twoscale::albedo::WIDTH_CENTRE,
-        exponent = twoscale::albedo::WIDTH_EXPONENT,
+        centre = twoscale::tables::albedo::WIDTH_CENTRE,
+        exponent = twoscale::tables::albedo::WIDTH_EXPONENT,
     )
 }
 
@@ -440,10 +440,12 @@ pub fn header(source: &Source<'_>, encoded: &[Encoded]) -> String {
             axis.mapping.describe(axis.param, axis.param2),
             header.kernel.stored_per_axis(axis.nodes),
             match header.kernel {
-                twoscale::format::Kernel::Multilinear | twoscale::format::Kernel::CatmullRom => {
+                twoscale::tables::format::Kernel::Multilinear
+                | twoscale::tables::format::Kernel::CatmullRom => {
                     "node values"
                 }
-                twoscale::format::Kernel::CubicBSpline => "B-spline coefficients, nodes + 2",
+                twoscale::tables::format::Kernel::CubicBSpline =>
+                    "B-spline coefficients, nodes + 2",
             },
             axis.nodes,
             c_float(axis.lo as f32),

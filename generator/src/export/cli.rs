@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use twoscale::format::write::write_atomic;
+use twoscale::tables::format::write::write_atomic;
 
 use super::{
     EXPORTABLE, Encoded, Format, Precision, Source, allowed_precisions, aux_array, c,

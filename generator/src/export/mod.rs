@@ -23,9 +23,9 @@ pub mod npy;
 
 use std::fmt::Write as _;
 
-use twoscale::format::write::{TableSpec, encode};
-use twoscale::format::{Kernel, Table, TableId, ValueType, quantise_node};
-use twoscale::interp::{coordinate_f64, node_value};
+use twoscale::tables::format::write::{TableSpec, encode};
+use twoscale::tables::format::{Kernel, Table, TableId, ValueType, quantise_node};
+use twoscale::tables::interp::{coordinate_f64, node_value};
 
 use crate::tables::{self, Accuracy, Budget, Export, TableKind};
 
@@ -378,7 +378,7 @@ pub fn measure(
             encoded.precision.name()
         ));
     }
-    let aligned = twoscale::format::aligned_copy(&file);
+    let aligned = twoscale::tables::format::aligned_copy(&file);
     kind.verify(aligned.bytes(), points, seed)
         .map_err(|e| e.to_string())
 }

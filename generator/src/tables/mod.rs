@@ -7,15 +7,15 @@ use twoscale::{FormatError, TableId};
 
 use crate::quad::QuadError;
 
-pub mod t1;
-pub mod t2;
-pub mod t3;
-pub mod t4;
-pub mod t5;
-pub mod t6;
+pub mod albedo;
+pub mod convolution;
+pub mod diffuse_fresnel;
+pub mod sh_brdf;
+pub mod sigma_ratio;
+pub mod smith_g1;
 
 /// A table the generator knows how to build and verify: the generator's
-/// side of the table's [`TableDescriptor`](twoscale::format::TableDescriptor)
+/// side of the table's [`TableDescriptor`](twoscale::tables::format::TableDescriptor)
 /// (its id says which; [`all`] is the registry).
 pub trait TableKind: Sync {
     /// Which table.
@@ -67,7 +67,7 @@ pub struct SpotCheck {
 }
 
 /// What `generator export` needs of a table beyond its file and its
-/// [`TableDescriptor`](twoscale::format::TableDescriptor).
+/// [`TableDescriptor`](twoscale::tables::format::TableDescriptor).
 #[derive(Clone, Copy, Debug)]
 pub struct Export {
     /// One-line summary of the interpolation a consumer must do
@@ -98,14 +98,14 @@ pub enum Budget {
 }
 
 /// Every table the generator builds from no input but its own code, in
-/// build order (T4 is built per material: [`t4::ShBrdf`]).
+/// build order (T4 is built per material: [`sh_brdf::ShBrdf`]).
 pub fn all() -> Vec<&'static dyn TableKind> {
     vec![
-        &t1::SmithG1,
-        &t2::SigmaRatio,
-        &t5::DiffuseFresnel,
-        &t6::Albedo,
-        &t3::Conv,
+        &smith_g1::SmithG1,
+        &sigma_ratio::SigmaRatio,
+        &diffuse_fresnel::DiffuseFresnel,
+        &albedo::Albedo,
+        &convolution::Conv,
     ]
 }
 
@@ -287,7 +287,7 @@ pub enum BuildError {
         message: String,
     },
     /// T3's shard files could not be written or merged.
-    Shard(t3::ShardError),
+    Shard(convolution::ShardError),
     /// An input of the build (a table T4's BRDF reads, a material it cannot
     /// model) is missing or unusable.
     Input {
@@ -314,8 +314,8 @@ impl fmt::Display for BuildError {
 
 impl std::error::Error for BuildError {}
 
-impl From<t3::ShardError> for BuildError {
-    fn from(e: t3::ShardError) -> Self {
+impl From<convolution::ShardError> for BuildError {
+    fn from(e: convolution::ShardError) -> Self {
         BuildError::Shard(e)
     }
 }

@@ -51,7 +51,7 @@ use std::cell::Cell;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
-use twoscale::brdf::Masking;
+use twoscale::material::Masking;
 
 use crate::quad::{self, QuadError, Tolerance};
 use crate::reference::epd::LambdaCurve;

@@ -14,7 +14,7 @@
 use std::f64::consts::PI;
 use std::fmt;
 
-use twoscale::brdf::{
+use twoscale::material::{
     BaseLayer, ColourTerms, HaloWeight, Masking, Material, MultipleScattering, Options,
     RGB_WAVELENGTHS, SigmaRelMode,
 };

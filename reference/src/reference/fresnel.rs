@@ -2,7 +2,7 @@
 //! the diffraction colour term Q of (HP17 10), and the diffuse Fresnel
 //! reflectances of a dielectric (docs/model.md §2.3, §2.6).
 //!
-//! It is written independently of the runtime's `twoscale::fresnel`, so that
+//! It is written independently of the runtime's `twoscale::model::fresnel`, so that
 //! comparing the two means something: its own complex type (square root from
 //! the polar form, where the runtime uses the half-angle formulas), and the
 //! angles of (HP17 10) taken literally from `atan2` (where the runtime never

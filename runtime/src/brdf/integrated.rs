@@ -2,7 +2,7 @@
 //! (docs/design/rgb-integration.md, docs/model.md §2.12):
 //!
 //! ```text
-//! ρ_c(i,o) = ∫ ρ(i,o,λ) w_c(λ) dλ                       (w_c: crate::colour)
+//! ρ_c(i,o) = ∫ ρ(i,o,λ) w_c(λ) dλ                       (w_c: crate::spectrum::colour)
 //!          ≈ Σ_k [ρ_s + ρ_CTD](λ_k) R_kc(cos θd) + [ρ_base + ρ_ms](λ_k) P_kc
 //! R_kc(μ)  = Σ_j hat_k(λ_j) W_c,j F(η(λ_j), μ) / F(η(λ_k), μ)
 //! P_kc     = Σ_j hat_k(λ_j) W_c,j
@@ -10,7 +10,7 @@
 //!
 //! `λ_k` are [`INTEGRATED_WAVELENGTHS`] (8, 0.38 to 0.72 µm),
 //! `hat_k` their hat functions (held beyond the ends), `W_c,j` the CIE 5 nm
-//! weights of [`crate::colour`]. The surface lobes are divided by F(θd) at
+//! weights of [`crate::spectrum::colour`]. The surface lobes are divided by F(θd) at
 //! their wavelength and integrated against F: a metal's colour, which
 //! changes fast with λ (gold's edge at 0.47–0.55 µm), is integrated at the
 //! 85 CIE wavelengths; what is left is smooth in λ and interpolated from
@@ -20,15 +20,15 @@
 //! through those in `u = b cos θd/λ` ([`CONV_WEIGHTS`]). A channel that
 //! comes out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
-use super::{
-    BakeVisitor, ChannelBake, ColourTerms, Geometry, NodeBakes, Options, RgbSample, SurfaceBakes,
-    Tables, TwoScale, finite_or_zero,
-};
+use super::construct::{NodeBakes, SurfaceBakes};
+use super::eval::Geometry;
+use super::{BakeVisitor, ChannelBake, RgbSample, Tables, TwoScale, finite_or_zero};
 use crate::bake::c_of_ln;
-use crate::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
-use crate::fresnel::fresnel;
+use crate::material::{ColourTerms, Options};
 use crate::math::{self, BELOW_ONE};
-use crate::optical::SpectralMaterial;
+use crate::model::fresnel::fresnel;
+use crate::spectrum::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
+use crate::spectrum::optical::SpectralMaterial;
 use core::borrow::{Borrow, BorrowMut};
 
 /// Number of wavelengths the integrated model evaluates.
@@ -100,14 +100,14 @@ fn hat_cell(lambda: f32) -> (usize, f64) {
 
 /// `R_kc` over `√cos θd` and `P_kc` (module documentation): 6 KB.
 #[derive(Clone)]
-struct ColourBake {
+pub(super) struct ColourBake {
     surface: [[[f32; 3]; INTEGRATED_COUNT]; COLOUR_NODES],
     plain: [[f32; 3]; INTEGRATED_COUNT],
 }
 
 impl ColourBake {
     /// The weights of `material`'s index; `white`: F ≡ 1.
-    fn new(material: &SpectralMaterial<'_>, white: bool) -> ColourBake {
+    pub(super) fn new(material: &SpectralMaterial<'_>, white: bool) -> ColourBake {
         let mut plain = [[0.0f64; 3]; INTEGRATED_COUNT];
         let cells: [(usize, f64); WAVELENGTH_COUNT] =
             core::array::from_fn(|j| hat_cell(colour::wavelength(j)));
@@ -224,7 +224,7 @@ pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
 /// [`INTEGRATED_WAVELENGTHS`] sharing the surface's bakes, and the colour
 /// weights. The bakes are held as `B` as [`super::Rgb`]'s: boxed
 /// (`IntegratedRgb::boxed`, feature `std`) or in caller-provided storage
-/// ([`IntegratedRgb::new_in`]); 8 × 45 KB.
+/// ([`IntegratedRgb::new_in`]); 984 KB by value (8 models of 122 KB, the colour weights 6 KB).
 #[derive(Clone)]
 pub struct IntegratedRgb<'a, B = ChannelBake> {
     nodes: [TwoScale<'a, B>; INTEGRATED_COUNT],
@@ -386,7 +386,7 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
         }
     }
 
-    fn pdf_at(&self, geometry: &Geometry) -> f64 {
+    pub(super) fn pdf_at(&self, geometry: &Geometry) -> f64 {
         // The nodes share the surface, hence the specular density.
         let specular = self.nodes[0].specular_pdf(geometry);
         let sum: f64 = SAMPLER_NODES
@@ -422,59 +422,12 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     }
 }
 
-/// Which RGB a material's model gives: the paper's three wavelengths
-/// ([`super::Rgb`], HP15 §5.5; what reproduces HP15/HP17) or the integral
-/// over the spectrum ([`IntegratedRgb`], docs/model.md §2.12). Named
-/// `rgb_mode` in material files and Python, `ts_material_desc.rgb_mode` in
-/// C. When none is given, [`RgbMode::default_for`] decides.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RgbMode {
-    /// ρ at 0.645, 0.526, 0.444 µm as red, green, blue.
-    PaperWavelengths,
-    /// `ρ_c = ∫ ρ(λ) w_c(λ) dλ` (needs the index over the spectrum).
-    Integrated,
-}
-
-impl RgbMode {
-    /// The mode of a material that names none: [`RgbMode::Integrated`] for
-    /// a material given over the spectrum (every preset; `eta = (lambda,
-    /// n, k)`), [`RgbMode::PaperWavelengths`] for one given by its index at
-    /// the paper's three wavelengths (or one constant index), which
-    /// integration would only interpolate. The one place that decides it
-    /// ([`crate::desc::MaterialDesc::rgb`] and
-    /// [`crate::desc::MaterialDesc::spectral`] call it).
-    pub const fn default_for(over_spectrum: bool) -> RgbMode {
-        if over_spectrum {
-            RgbMode::Integrated
-        } else {
-            RgbMode::PaperWavelengths
-        }
-    }
-}
-
-/// The RGB model of [`RgbMode`]: [`super::Rgb`] or [`IntegratedRgb`].
+/// The RGB model of [`RgbMode`](crate::material::RgbMode): [`super::Rgb`] or [`IntegratedRgb`].
 #[derive(Clone)]
 #[allow(clippy::large_enum_variant)] // one per material, boxed by the front ends
 pub enum RgbModel<'a, B = ChannelBake> {
-    /// [`RgbMode::PaperWavelengths`].
+    /// [`RgbMode::PaperWavelengths`](crate::material::RgbMode::PaperWavelengths).
     PaperWavelengths(super::Rgb<'a, B>),
-    /// [`RgbMode::Integrated`].
+    /// [`RgbMode::Integrated`](crate::material::RgbMode::Integrated).
     Integrated(IntegratedRgb<'a, B>),
-}
-
-#[cfg(feature = "std")]
-impl<'a> RgbModel<'a, std::boxed::Box<ChannelBake>> {
-    /// The model `desc.rgb_mode` names, its bakes on the heap
-    /// ([`crate::desc::MaterialDesc`] holds the spectrum that
-    /// [`RgbMode::Integrated`] needs).
-    pub fn boxed(tables: &Tables<'a>, desc: &crate::desc::MaterialDesc<'_>) -> Self {
-        match (desc.rgb_mode, &desc.spectral) {
-            (RgbMode::Integrated, Some(spectral)) => {
-                RgbModel::Integrated(IntegratedRgb::boxed(tables, spectral, desc.options))
-            }
-            _ => {
-                RgbModel::PaperWavelengths(super::Rgb::boxed(tables, &desc.material, desc.options))
-            }
-        }
-    }
 }

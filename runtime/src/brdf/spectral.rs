@@ -21,14 +21,15 @@
 //! Only these bake C and the halo sampler; each model between them takes C
 //! from the one before it (a bake at a shorter λ covers a longer λ's u).
 
+use super::eval::{Pair, halo_attenuation, q_bar};
 use super::integrated::models_at;
 use super::{
-    BakeVisitor, ChannelBake, ColourTerms, Options, Pair, Sample, Tables, TwoScale,
-    exp_and_one_minus_over, finite_or_zero, halo_attenuation, q_bar,
+    BakeVisitor, ChannelBake, Sample, Tables, TwoScale, exp_and_one_minus_over, finite_or_zero,
 };
 use crate::bake::DirectionCell;
-use crate::fresnel::fresnel;
-use crate::optical::SpectralMaterial;
+use crate::material::{ColourTerms, Options};
+use crate::model::fresnel::fresnel;
+use crate::spectrum::optical::SpectralMaterial;
 use core::borrow::{Borrow, BorrowMut};
 use zerocopy::FromZeros;
 
@@ -187,7 +188,7 @@ struct NodeTerms {
 impl NodeTerms {
     /// The terms of `node` at `pair`; `plain` 0 unless `diffuse` (the
     /// models have a base lobe, `k_d` or the compensation lobe).
-    fn new<B: Borrow<ChannelBake>>(
+    pub(super) fn new<B: Borrow<ChannelBake>>(
         node: &TwoScale<'_, B>,
         pair: &Pair,
         white: bool,
@@ -383,7 +384,7 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// F(η(λ), θd) at `lambda` (clamped) and the cell of `cos θd`
     /// ([`FresnelBake`]), or 1 for white colour terms.
     #[inline]
-    fn fresnel_at(&self, lambda: f32, cos_d: DirectionCell) -> f64 {
+    pub(super) fn fresnel_at(&self, lambda: f32, cos_d: DirectionCell) -> f64 {
         if self.white {
             1.0
         } else {
@@ -496,8 +497,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fresnel::Complex;
     use crate::materials::SPECTRAL_PRESETS;
+    use crate::math::Complex;
     use crate::test_rng::Lcg;
 
     /// [`FresnelBake`] against the closed form, at 20 000 random (λ, cos θ)
