@@ -210,3 +210,63 @@ def test_fit_refuses_bad_arguments_by_name(model_file, keywords, error, words):
 def test_fit_refuses_an_array_of_another_shape():
     with pytest.raises(ValueError, match=r"a MERL array has shape \(3, 90, 90, 180\), got \(3, 90, 90\)"):
         fit(np.zeros((3, 90, 90)), verbose=False)
+
+
+# --- The package, and the readers of a fit's file -------------------------
+
+
+def test_scipy_is_a_declared_dependency():
+    """``pip install ./python`` brings SciPy, which ``twoscale.fit`` needs."""
+    import importlib.metadata
+
+    requires = importlib.metadata.requires("twoscale") or []
+    assert any(r.split(";")[0].strip().startswith("scipy") and "extra" not in r for r in requires), requires
+
+
+def test_the_spectral_index_gives_the_same_rgb_model_and_a_spectral_one(model_file):
+    """``Fit.toml(spectral_index=True)`` (``--spectral-index``): the index as
+    ``eta = { lambda, n, k }`` at the paper's wavelengths, which rebuilds the
+    fitted RGB model bit for bit and also has a model at any wavelength;
+    the plain file has none."""
+    r = fit(model_file, samples=600, starts=1, max_nfev=3, refine_samples=0, verbose=False, **TRUTH)
+    plain = twoscale.Material.from_toml_string(r.toml())
+    spectral = twoscale.Material.from_toml_string(r.toml(spectral_index=True))
+    assert spectral.rgb_mode == "paper-wavelengths"
+    wi, wo = stratified_directions(4000, np.random.default_rng(3))
+    want = r.material.eval(wi, wo)
+    for m in (plain, spectral):
+        np.testing.assert_array_equal(m.eval(wi, wo).view(np.uint32), want.view(np.uint32))
+    at = spectral.eval_spectral(wi, wo, np.linspace(0.36, 0.83, len(wi)))
+    assert np.all(np.isfinite(at)) and np.all((at > 0) == (want[:, 0] > 0))
+    with pytest.raises(ValueError, match="needs an index over the spectrum"):
+        plain.eval_spectral(wi, wo, np.full(len(wi), 0.5))
+
+
+def test_mitsuba_spectral_reads_the_spectral_index_and_refuses_the_per_channel_one(tmp_path, model_file):
+    pytest.importorskip("mitsuba")
+    r = fit(model_file, samples=600, starts=1, max_nfev=3, refine_samples=0, verbose=False, **TRUTH)
+    (tmp_path / "plain.toml").write_text(r.toml())
+    (tmp_path / "spectral.toml").write_text(r.toml(spectral_index=True))
+    code = (
+        "import os, sys\n"
+        "llvm = '/usr/lib/x86_64-linux-gnu/libLLVM-19.so'\n"
+        "os.path.exists(llvm) and os.environ.setdefault('DRJIT_LIBLLVM_PATH', llvm)\n"
+        "import mitsuba as mi\n"
+        "mi.set_variant('llvm_ad_spectral')\n"
+        "import twoscale.mitsuba\n"
+        "twoscale.mitsuba.register()\n"
+        "bsdf = mi.load_dict({'type': 'twoscale', 'filename': 'spectral.toml'})\n"
+        "si = mi.SurfaceInteraction3f()\n"
+        "si.wi = mi.Vector3f(0.3, 0.0, 0.954); si.wavelengths = mi.Spectrum([450.0, 520.0, 600.0, 700.0])\n"
+        "value = bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(-0.2, 0.1, 0.975))\n"
+        "import numpy as np\n"
+        "print('spectral', bool(np.all(np.array(value) > 0)))\n"
+        "try:\n"
+        "    mi.load_dict({'type': 'twoscale', 'filename': 'plain.toml'})\n"
+        "except Exception as e:\n"
+        "    print('plain refused:', 'needs an index over the spectrum' in str(e))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    if "llvm_ad_spectral" in done.stderr and "variant" in done.stderr and done.returncode != 0:
+        pytest.skip("no llvm_ad_spectral variant")
+    assert done.stdout.splitlines() == ["spectral True", "plain refused: True"], done.stdout + done.stderr

@@ -80,7 +80,7 @@ except ImportError as e:  # a declared dependency; installed without it (--no-de
     raise ImportError("twoscale.fit needs SciPy (a dependency of twoscale): pip install scipy") from e
 
 from . import merl
-from ._native import Material
+from ._native import RGB_WAVELENGTHS, Material
 
 #: The compressive weight's exponent (HP17 57).
 WC_EXPONENT = 1.4
@@ -97,6 +97,15 @@ FD_STEP = 3e-4
 EPD_STARTS = ({"beta": 0.1, "p": 1.0}, {"index": (1.5, 3.0)})
 #: Starts of the two-scale stage: (σs µm, b µm, c), from the EPD fit.
 HALO_STARTS = ((0.02, 3.0, 2.5), (0.05, 15.0, 3.5), (0.01, 8.0, 2.0), (0.005, 1.0, 1.5))
+#: xtol of each start (least_squares' relative step tolerance; the final
+#: refinement runs to 1e-8).
+START_XTOL = 1e-5
+#: At most this many evaluations of each start (converged starts took
+#: 16–90; one from far away crawled 559 to a worse minimum).
+START_NFEV = 100
+#: Two starts reached one minimum when β, p, σs, b and c agree within this
+#: in the solver's coordinates (logarithms: a relative difference).
+AGREE = 1e-3
 #: A parameter with a larger standard error is undetermined.
 UNDETERMINED_SE = 0.35
 #: Singular values of the column-scaled Jacobian below this share of the
@@ -390,11 +399,21 @@ class _Objective:
                 jac[:, i] = column.ravel()
         return jac
 
-    def solve(self, flat, max_nfev=None):
+    def solve(self, flat, max_nfev=None, xtol=1e-8):
         """The local minimum from ``flat``: (its parameters, least_squares' result)."""
         r = least_squares(self.residuals, self.x_of(flat), jac=self.jacobian, bounds=(self.lo, self.hi),
-                          max_nfev=max_nfev)
+                          max_nfev=max_nfev, xtol=xtol)
         return self.flat(r.x), r
+
+
+def same_minimum(a, b, names, base):
+    """Whether two solutions (flat parameters) are one minimum: each of
+    ``names`` within ``AGREE`` in the solver's coordinates (b and c left
+    out when σs is at its lower bound in both: no diffraction)."""
+    floor = _BOUNDS["sigma_s"][0] * (1 + AGREE)
+    if "sigma_s" in names and a["sigma_s"] <= floor and b["sigma_s"] <= floor:
+        names = [n for n in names if n not in ("b", "c")]
+    return all(abs(_to_x(n, a[n], base) - _to_x(n, b[n], base)) <= AGREE for n in names)
 
 
 def _at_bounds(objective, result):
@@ -462,11 +481,24 @@ class Fit:
     standard_error: dict = dataclasses.field(default_factory=dict)
     undetermined: tuple = ()
 
-    def toml(self) -> str:
+    def toml(self, spectral_index: bool = False) -> str:
         """``[material]`` (Material's keywords) and ``[metrics]`` (with
-        ``standard_error`` and ``undetermined``)."""
+        ``standard_error`` and ``undetermined``). With ``spectral_index``
+        the index is written over the spectrum, ``eta = { lambda, n, k }``
+        at the paper's three wavelengths, with ``rgb_mode =
+        "paper-wavelengths"``: the same RGB model bit for bit, readable by
+        spectral renderers (Mitsuba's ``*_spectral``), which interpolate it
+        linearly in 1/λ between them and hold the end values beyond: a
+        choice, not a measurement (docs/fitting.md)."""
+        material = dict(self.keywords)
+        if spectral_index:
+            # Rows in increasing λ (blue first); the f32 wavelengths' shortest form.
+            rows = sorted(zip((float(str(np.float32(x))) for x in RGB_WAVELENGTHS), material["eta"]))
+            material["eta"] = {"lambda": [r[0] for r in rows], "n": [r[1][0] for r in rows],
+                               "k": [r[1][1] for r in rows]}
+            material["rgb_mode"] = "paper-wavelengths"
         extra = {"standard_error": self.standard_error, "undetermined": list(self.undetermined)}
-        return _toml({"material": self.keywords, "metrics": {**self.metrics, **extra}})
+        return _toml({"material": material, "metrics": {**self.metrics, **extra}})
 
 
 def _toml_value(v):
@@ -618,13 +650,27 @@ def fit(
         names = [n for n in _names(base, not with_halo, lambertian) if n not in fixed and n not in hold]
         return _Objective(data, base, not with_halo, names, values)
 
-    def run(label, obj, flat):
-        flat, r = obj.solve(flat, max_nfev)
+    def run(label, obj, flat, xtol=1e-8, nfev=max_nfev):
+        flat, r = obj.solve(flat, nfev, xtol)
         log(f"  {label}: cost {r.cost:.4g} after {r.nfev} iterations ({time.perf_counter() - t0:.1f} s)")
         return flat, r, obj
 
     def free(variant):
         return {k: v for k, v in variant.items() if k not in fixed}
+
+    def stage(label, obj, origin, variants, compare):
+        """Runs from ``origin`` updated by each of ``variants`` in turn, until
+        the lowest minimum so far has been reached from two of them: the
+        (flat, result, objective) of the lowest."""
+        runs = []
+        for j, v in enumerate(variants):
+            shown = "".join(f", {k} {x:g}" for k, x in v.items() if k in ("beta", "p", "sigma_s", "b", "c", "n0", "k0"))
+            runs.append(run(f"{label} {j}{shown}", obj, origin | v, START_XTOL, min(max_nfev or START_NFEV, START_NFEV)))
+            best = min(runs, key=lambda t: t[1].cost)
+            if sum(same_minimum(best[0], f, compare, base) for f, _, _ in runs) >= 2:
+                log(f"  the lowest minimum reached from two starts: {label} stage done")
+                break
+        return best
 
     log(f"twoscale.fit: {len(data.s.wi)} samples × 3 channels, {len(_names(base, epd, lambertian))} parameters")
     halo_given = any(k in start for k in ("sigma_s", "b", "c"))
@@ -638,34 +684,36 @@ def fit(
                 variants.append({f"n{j}": n for j in range(3)} | {f"k{j}": k for j in range(3)})
             elif "index" not in v and not any(key in start for key in v):
                 variants.append(v)
-        obj = objective(False, guess)
-        runs = [run(f"EPD start {j}", obj, guess | free(v)) for j, v in enumerate(variants[:starts])]
-        candidates.append(min(runs, key=lambda t: t[1].cost))
+        compare = [n for n in ("beta", "p") if n not in fixed]
+        candidates.append(stage("EPD start", objective(False, guess), guess, [free(v) for v in variants[:starts]],
+                                compare))
     if not epd:
         # The two-scale stage from the EPD fit (or from the given start).
         origin = guess if halo_given else candidates[0][0] | free({"sigma_s": 0.0})
         halo = [{}] if halo_given else [free({"sigma_s": a, "b": b, "c": c}) for a, b, c in HALO_STARTS[:starts]]
-        obj = objective(True, origin)
-        for j, v in enumerate(halo):
-            label = f"start {j}" + "".join(f", {k} {x:g}" for k, x in v.items())
-            candidates.append(run(label, obj, origin | v))
+        compare = [n for n in ("beta", "p", "sigma_s", "b", "c") if n not in fixed]
+        candidates.append(stage("start", objective(True, origin), origin, halo, compare))
     flat, r, obj = min(candidates, key=lambda t: t[1].cost)
     with_halo = not obj.epd
-    if refine_samples and not isinstance(measured, tuple):
-        # The best minimum refined on a larger subsample: the estimate's
-        # noise falls as 1/√N, and a converged start needs few iterations.
+    # Parameters at a bound are held there (σs at its lower bound is no
+    # diffraction), and the rest refined to convergence on a larger
+    # subsample: the estimate's noise falls as 1/√N.
+    bounds = {}
+    refine = bool(refine_samples) and not isinstance(measured, tuple)
+    if refine:
         data = _Data.of(samples_of(measured, refine_samples, rng), grazing_k)
-        flat, r, obj = run(f"refined on {len(data.s.wi)} samples", objective(with_halo, flat), flat)
-    # Parameters at a bound are held there and the others refitted; σs at
-    # its lower bound is no diffraction.
-    bounds = _at_bounds(obj, r)
-    if bounds:
-        if bounds.get("sigma_s") == _BOUNDS["sigma_s"][0]:
+    for _ in range(2):
+        new = {k: v for k, v in _at_bounds(obj, r).items() if k not in bounds}
+        if not new and not refine:
+            break
+        if new.get("sigma_s") == _BOUNDS["sigma_s"][0]:
             with_halo = False
-            bounds = {k: v for k, v in bounds.items() if k not in ("sigma_s", "b", "c")}
+            new = {k: v for k, v in new.items() if k not in ("sigma_s", "b", "c")}
+        bounds |= new
+        label = f"on {len(data.s.wi)} samples" + ("".join(f", {k} = {v:g}" for k, v in bounds.items()) if bounds else "")
         held = flat | bounds
-        flat, r, obj = run("held at a bound: " + (", ".join(f"{k} = {v:g}" for k, v in bounds.items()) or "sigma_s = 0"),
-                           objective(with_halo, held, hold=bounds), held)
+        flat, r, obj = run(label, objective(with_halo, held, hold=bounds), held)
+        refine = False
     errors, undetermined = _errors(obj, r.x)
     # From the solver's coordinates to the parameter's units: dθ/dx.
     slope = {n: 1.0 if not _bound(n, base)[2] else (flat[n] - 1.0 if n == "c" else flat[n]) for n in errors}
@@ -714,6 +762,9 @@ def main(argv=None):
     parser.add_argument("--epd", action="store_true", help="plain EPD Cook–Torrance (σs = 0)")
     parser.add_argument("--no-lambertian", action="store_true", help="no Lambertian term")
     parser.add_argument("--seed", type=int, default=0, help="the subsample's seed")
+    parser.add_argument("--spectral-index", action="store_true",
+                        help="write the index as eta = { lambda, n, k } at the paper's wavelengths "
+                             "(for spectral renderers; the same RGB model)")
     a = parser.parse_args(argv)
     try:
         folder = os.path.dirname(os.path.abspath(a.out)) if a.out else None
@@ -721,7 +772,7 @@ def main(argv=None):
             raise ValueError(f"--out {a.out}: {folder} is not a writable directory")
         result = fit(a.file, a.base, samples=a.samples, refine_samples=a.refine_samples, starts=a.starts, grazing_k=a.grazing_k, epd=a.epd,
                      lambertian=not a.no_lambertian, seed=a.seed)
-        text = result.toml()
+        text = result.toml(spectral_index=a.spectral_index)
         if a.out:
             with open(a.out, "w", encoding="utf-8") as f:
                 f.write(text)
