@@ -4,6 +4,7 @@ settings for several seeds, the fitted β, p, σs, b, c against the truth.
 
     python python/examples/fit_recovery.py [--materials 20] [--seeds 3]
         [--case clean|noisy|both] [--log FILE] [--fit-module PATH]
+        [--compare BEFORE_LOG]
 
 Materials (material j is the same for any ``--materials``): conductors
 with β log-uniform in [0.02, 0.5], p in [0.4, 3], σs in [0.005, 0.05] µm,
@@ -15,8 +16,10 @@ bins missing (*clean*); *noisy* also multiplies each value by
 (1 + 0.02 N(0, 1)). Prints the Markdown table of docs/fitting.md on stdout
 (progress on stderr); ``--log`` appends one JSON line per fit (and skips
 fits already there, so an interrupted run resumes). ``--fit-module`` fits
-with another copy of ``twoscale/fit.py`` (the "before" column:
-``git show bee9a4e:python/twoscale/fit.py > /tmp/fit_before.py``).
+with another copy of ``twoscale/fit.py``, and ``--compare`` adds another
+run's log as "before" columns (docs/fitting.md's before: the fit before
+issue 46, ``git show e486546:python/twoscale/fit.py > /tmp/fit_before.py``,
+``--fit-module /tmp/fit_before.py --log before.jsonl``).
 """
 
 from __future__ import annotations
@@ -138,11 +141,22 @@ def covered(row, k=3.0):
     return all(u[g] is not None and abs(row["fitted"][g] - row["truth"][g]) <= k * u[g] for g in GEOMETRY)
 
 
-def table(rows):
-    lines = [
-        "| material (β, p, σs, b, c) | file | seed | β | p | σs | b | c | rel. RMS | time (s) | target |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
+def worst(row):
+    """The largest relative error of β, p, σs, b, c: "+12.3% (b)"."""
+    g = max(GEOMETRY, key=lambda g: abs(error(row, g)))
+    return f"{100 * error(row, g):+.2f}% ({g})"
+
+
+def table(rows, before=None):
+    """The Markdown table; with ``before`` ({(material, seed, case): row} of
+    another fit's log) each row also gives that fit's largest error, relative
+    RMS and target."""
+    head = "| material (β, p, σs, b, c) | file | seed | β | p | σs | b | c | rel. RMS | time (s) | target |"
+    rule = "|---|---|---|---|---|---|---|---|---|---|---|"
+    if before is not None:
+        head += " before: largest error | before: rel. RMS | before: target |"
+        rule += "---|---|---|"
+    lines = [head, rule]
     for row in rows:
         t = row["truth"]
         name = f"{row['material']} ({t['beta']:.3f}, {t['p']:.2f}, {t['sigma_s']:.4f}, {t['b']:.2f}, {t['c']:.2f})"
@@ -151,12 +165,17 @@ def table(rows):
         cov = covered(row)
         if cov is not None:
             ok += ", covered" if cov else ", **not covered**"
-        lines.append(f"| {name} | {row['case']} | {row['seed']} | {cells} | {row['relative_rms']:.1e} | "
-                     f"{row['seconds']:.1f} | {ok} |")
+        line = f"| {name} | {row['case']} | {row['seed']} | {cells} | {row['relative_rms']:.1e} | {row['seconds']:.1f} | {ok} |"
+        old = None if before is None else before.get((row["material"], row["seed"], row["case"]))
+        if old is not None:
+            line += f" {worst(old)} | {old['relative_rms']:.1e} | {'met' if passes(old) else '**missed**'} |"
+        elif before is not None:
+            line += " – | – | – |"
+        lines.append(line)
     return "\n".join(lines)
 
 
-def summary(rows):
+def summary(rows, label=""):
     out = []
     for case in ("clean", "noisy"):
         sel = [r for r in rows if r["case"] == case]
@@ -165,14 +184,24 @@ def summary(rows):
         met = sum(passes(r) for r in sel)
         t = sorted(r["seconds"] for r in sel)
         worst = {g: max(abs(error(r, g)) for r in sel) for g in GEOMETRY}
-        line = (f"{case}: {met} of {len(sel)} fits meet the target; worst error "
+        line = (f"{label}{case}: {met} of {len(sel)} fits meet the target; worst error "
                 + ", ".join(f"{g} {100 * e:.2f}%" for g, e in worst.items())
                 + f"; time {t[0]:.1f}–{t[-1]:.1f} s, median {t[len(t) // 2]:.1f} s")
+        load = sorted(r["load"] for r in sel if "load" in r)
+        if load:
+            line += f" (load average {load[0]:.1f}–{load[-1]:.1f} at the fits' ends)"
         cov = [covered(r) for r in sel if covered(r) is not None]
         if cov:
             line += f"; truth within 3 standard errors in {sum(cov)} of {len(cov)}"
         out.append(line)
     return "\n".join(out)
+
+
+def read_log(path):
+    """The rows of a ``--log`` file: {(material, seed, case): row}."""
+    with open(path) as f:
+        rows = [json.loads(line) for line in f if line.strip()]
+    return {(r["material"], r["seed"], r["case"]): r for r in rows}
 
 
 def main():
@@ -183,14 +212,11 @@ def main():
     parser.add_argument("--case", choices=["clean", "noisy", "both"], default="both")
     parser.add_argument("--log", help="append one JSON line per fit here; fits already there are not rerun")
     parser.add_argument("--fit-module", help="fit with this file instead of twoscale/fit.py")
+    parser.add_argument("--compare", metavar="LOG", help="another fit's --log: its largest error and target per row")
     a = parser.parse_args()
     module = fit_module(a.fit_module)
-    done = {}
-    if a.log and os.path.exists(a.log):
-        with open(a.log) as f:
-            for line in f:
-                row = json.loads(line)
-                done[(row["material"], row["seed"], row["case"])] = row
+    done = read_log(a.log) if a.log and os.path.exists(a.log) else {}
+    before = read_log(a.compare) if a.compare else None
     cases = ["clean", "noisy"] if a.case == "both" else [a.case]
     rows = []
     print(f"load average {os.getloadavg()}", file=sys.stderr, flush=True)
@@ -208,9 +234,12 @@ def main():
                       + ", ".join(f"{g} {100 * error(row, g):+.2f}%" for g in GEOMETRY)
                       + f", rel {row['relative_rms']:.1e}, {row['seconds']:.1f} s"
                       + ("" if passes(row) else "  MISSED"), file=sys.stderr, flush=True)
-    print(table(rows))
+    print(table(rows, before))
     print()
     print(summary(rows))
+    if before is not None:
+        keys = {(r["material"], r["seed"], r["case"]) for r in rows}
+        print(summary([r for k, r in before.items() if k in keys], "before: "))
 
 
 if __name__ == "__main__":
