@@ -99,9 +99,9 @@ def fit_module(path):
 def run_one(module, j, seed, case):
     truth = random_material(j)
     values = measured(truth, case == "noisy", j)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     r = module.fit(values, seed=seed, verbose=False)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     kw = r.keywords
     row = {
         "material": j,
@@ -111,6 +111,7 @@ def run_one(module, j, seed, case):
         "fitted": {g: kw.get(g) for g in GEOMETRY},
         "relative_rms": r.metrics["relative_rms"],
         "seconds": seconds,
+        "cpu_seconds": cpu,
         "load": os.getloadavg()[0],
     }
     if hasattr(r, "standard_error"):
@@ -187,6 +188,9 @@ def summary(rows, label=""):
         line = (f"{label}{case}: {met} of {len(sel)} fits meet the target; worst error "
                 + ", ".join(f"{g} {100 * e:.2f}%" for g, e in worst.items())
                 + f"; time {t[0]:.1f}–{t[-1]:.1f} s, median {t[len(t) // 2]:.1f} s")
+        cpu = sorted(r["cpu_seconds"] for r in sel if "cpu_seconds" in r)
+        if cpu:
+            line += f"; CPU time {cpu[0]:.1f}–{cpu[-1]:.1f} s, median {cpu[len(cpu) // 2]:.1f} s"
         load = sorted(r["load"] for r in sel if "load" in r)
         if load:
             line += f" (load average {load[0]:.1f}–{load[-1]:.1f} at the fits' ends)"

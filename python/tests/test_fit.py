@@ -150,6 +150,8 @@ def test_a_missing_file_or_a_directory_is_one_line_and_status_1(tmp_path):
     (["--samples", "-5"], ["samples must be an integer ≥ 100, got -5"]),
     (["--samples", "0"], ["samples must be an integer ≥ 100, got 0"]),
     (["--starts", "0"], ["starts must be an integer ≥ 1, got 0"]),
+    (["--seed", "-1"], ["seed must be an integer ≥ 0, got -1"]),
+    (["--refine-samples", "-3"], ["refine_samples must be 0 or an integer ≥ 100, got -3"]),
     (["--grazing-k", "-1"], ["grazing_k must be a finite number ≥ 0, got -1.0"]),
     (["--grazing-k", "nan"], ["grazing_k must be a finite number ≥ 0, got nan"]),
 ])
@@ -196,6 +198,8 @@ def test_the_module_runs_without_a_runtime_warning_and_the_package_attribute_is_
     (dict(samples=-5), ValueError, "samples must be an integer ≥ 100, got -5"),
     (dict(samples=2.5), ValueError, "samples must be an integer ≥ 100, got 2.5"),
     (dict(starts=True), ValueError, "starts must be an integer ≥ 1, got True"),
+    (dict(seed=-1), ValueError, "seed must be an integer ≥ 0, got -1"),
+    (dict(seed=0.5), ValueError, "seed must be an integer ≥ 0, got 0.5"),
     (dict(max_nfev=0), ValueError, "max_nfev must be None or an integer ≥ 1, got 0"),
     (dict(base="wood"), ValueError, "base must be one of conductor, plastic, subsurface, got 'wood'"),
     (dict(fixed=["bta"]), ValueError, "fixed names parameters of"),

@@ -43,6 +43,8 @@ def test_a_noisy_file_gives_every_parameter_within_5_percent_and_its_error_cover
     r = row(j, seed, "noisy")
     errors = {g: recovery.error(r, g) for g in recovery.GEOMETRY}
     assert all(abs(e) <= recovery.NOISY_TOLERANCE for e in errors.values()), errors
-    assert r["undetermined"] == []
+    # The geometry is determined (a dielectric-like index's k, ~0.01, may not be).
+    assert not set(r["undetermined"]) & set(recovery.GEOMETRY), r["undetermined"]
+    assert set(r["undetermined"]) <= ({"k0", "k1", "k2"} if j % 2 else set()), r["undetermined"]
     assert recovery.covered(r), (r["fitted"], r["truth"], r["standard_error"])
 

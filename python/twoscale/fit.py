@@ -30,13 +30,16 @@ a stratified subsample of ``samples`` directions (jittered strata of
 missing ones dropped). The Jacobian is by forward differences of step
 ``FD_STEP`` in those coordinates, one evaluation per geometric parameter,
 one for the three n and one for the three k (each channel's index moves
-that channel alone), k_d's column in closed form. Two stages, every start
-run to convergence: the EPD model (σs = 0) from a moment-based guess and
-``EPD_STARTS``; then the two-scale model from the EPD fit with each halo
-start of ``HALO_STARTS`` (σs, b, c), the EPD fit itself being the
-candidate "no diffraction". The lowest cost wins; a parameter the solver
-drives to its bound is held there and the rest refitted (a Lambertian
-term at 0 is written as 0, σs at its lower bound as 0: no diffraction).
+that channel alone), k_d's column in closed form. Two stages, each start
+run to convergence (``START_XTOL``, at most ``START_NFEV`` evaluations):
+the EPD model (σs = 0) from a moment-based guess and ``EPD_STARTS``; then
+the two-scale model from the EPD fit with each halo start of
+``HALO_STARTS`` (σs, b, c), the EPD fit itself being the candidate "no
+diffraction". A stage stops once its lowest minimum has been reached from
+two starts (``same_minimum``). The lowest cost wins and is refined on
+``refine_samples`` directions; a parameter the solver drives to its bound
+is held there and the rest refitted (a Lambertian term at 0 is written as
+0, σs at its lower bound as 0: no diffraction).
 The starts are fixed, so the seed changes only the subsample. Keywords of
 ``start`` (``beta=``, ``p=``, ``sigma_s=``, ``b=``, ``c=``, ``eta=``,
 ``albedo=``, ``lambertian=``) replace the guess (with σs, b or c given, the
@@ -566,7 +569,7 @@ def _sample_metrics(m, f):
 
 
 
-def _check_arguments(measured, base, samples, refine_samples, starts, grazing_k, fixed, max_nfev, start):
+def _check_arguments(measured, base, samples, refine_samples, starts, grazing_k, fixed, max_nfev, seed, start):
     """ValueError (TypeError for an unknown start keyword) naming a bad argument."""
     if isinstance(measured, np.ndarray) and measured.shape != merl.SHAPE:
         raise ValueError(f"measured: a MERL array has shape {merl.SHAPE}, got {measured.shape}")
@@ -577,7 +580,7 @@ def _check_arguments(measured, base, samples, refine_samples, starts, grazing_k,
         raise ValueError("measured: samples are (wi, wo, rgb), three (N, 3) arrays")
     if base not in BASES:
         raise ValueError(f"base must be one of {', '.join(BASES)}, got {base!r}")
-    for name, value, least in (("samples", samples, MIN_SAMPLES), ("starts", starts, 1)):
+    for name, value, least in (("samples", samples, MIN_SAMPLES), ("starts", starts, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
             raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
     if isinstance(refine_samples, bool) or not isinstance(refine_samples, (int, np.integer)) or (
@@ -632,7 +635,7 @@ def fit(
     "albedo", "lambertian"). Raises ValueError for a bad argument or a file
     that is not a MERL file, OSError for one that cannot be read."""
     t0 = time.perf_counter()
-    _check_arguments(measured, base, samples, refine_samples, starts, grazing_k, fixed, max_nfev, start)
+    _check_arguments(measured, base, samples, refine_samples, starts, grazing_k, fixed, max_nfev, seed, start)
     if isinstance(measured, (str, os.PathLike)):
         measured = merl.read(measured)
     log = (lambda *a: print(*a, file=sys.stderr, flush=True)) if verbose else (lambda *a: None)
@@ -783,6 +786,9 @@ def main(argv=None):
         return 1
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print(f"error: out of memory (--samples {a.samples}, --refine-samples {a.refine_samples})", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
