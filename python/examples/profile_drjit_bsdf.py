@@ -1,16 +1,17 @@
 """Where the Dr.Jit plugin's time goes: ``Model.eval``, ``pdf`` and
-``sample_direction`` of ``twoscale.drjit_bsdf`` and their parts, timed on
+``sample_direction`` of ``twoscale.drjit`` and their parts, timed on
 2^18 random pairs in ``llvm_ad_rgb``, one Dr.Jit thread, best of
 ``--rounds`` (each a traced kernel, compiled once and then cached).
 
-    python python/examples/profile_drjit_bsdf.py [--against OLD.py] [--rounds 15] [MATERIAL ...]
+    python python/examples/profile_drjit_bsdf.py [--against OLD] [--rounds 15] [MATERIAL ...]
 
 MATERIAL is a preset, ``beckmann`` (the render benchmark's p = 1, σs = 0
 gold conductor) or ``roughconductor`` (Mitsuba's, Beckmann, α 0.1, visible
 normals, the same index: its ``eval``, ``pdf`` and ``sample``, which also
 returns the weight); default ``beckmann gold-hp17-geometry``. ``--against``
-times the same three calls of another copy of ``drjit_bsdf.py`` (e.g.
-``git show main:python/twoscale/drjit_bsdf.py > /tmp/old.py``) in
+times the same three calls of another copy of the package
+``python/twoscale/drjit/`` (e.g. ``git archive REV python/twoscale/drjit |
+tar -x -C /tmp`` and ``--against /tmp/python/twoscale/drjit``) in
 alternation with this one, rounds interleaved, so that a change is
 compared under the same load. Prints ns per lane (one thread).
 """
@@ -18,6 +19,7 @@ compared under the same load. Prints ns per lane (one thread).
 import argparse
 import importlib.util
 import os
+import sys
 import time
 
 os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
@@ -28,7 +30,7 @@ import numpy as np  # noqa: E402
 
 mi.set_variant("llvm_ad_rgb")
 import twoscale  # noqa: E402
-import twoscale.drjit_bsdf as tb  # noqa: E402
+import twoscale.drjit as tb  # noqa: E402
 
 LANES = 1 << 18
 GOLD = [(0.163, 3.56), (0.584, 2.15), (1.403, 1.925)]
@@ -84,8 +86,11 @@ def main():
     dr.set_thread_count(1)
     modules = {"this": tb}
     if args.against:
-        spec = importlib.util.spec_from_file_location("against", args.against)
-        modules["against"] = importlib.util.module_from_spec(spec)
+        # The copy as a package of its own (its modules import each other relatively).
+        spec = importlib.util.spec_from_file_location(
+            "against", os.path.join(args.against, "__init__.py"),
+            submodule_search_locations=[args.against])
+        modules["against"] = sys.modules["against"] = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(modules["against"])
     rng = np.random.default_rng(1)
 

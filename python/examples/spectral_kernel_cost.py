@@ -45,7 +45,7 @@ def logged(run):
 def main():
     mi.set_variant("llvm_ad_spectral")
     import twoscale
-    import twoscale.drjit_bsdf as tb
+    import twoscale.drjit as tb
 
     name = sys.argv[1] if len(sys.argv) > 1 else "gold-hp17-geometry"
     material = (twoscale.Material(beta=0.1, p=1.0, sigma_s=0.0, eta=[(0.584, 2.15)] * 3)

@@ -691,11 +691,13 @@ impl Material {
     }
 
     /// bakes(): the model's per-channel constants and bakes as the runtime
-    /// built them, for ports of `eval` and `pdf` (`twoscale.drjit_bsdf`):
+    /// built them, for ports of `eval` and `pdf` (`twoscale.drjit`):
     /// a list of three dicts (red, green, blue) mapping names to float
-    /// scalars and float32 or float64 arrays (the names and layouts of
+    /// scalars, str (the base layer's kind and the options, by name) and
+    /// float32 or float64 arrays, and `columns` to a dict from an array's
+    /// name to the names of its last axis (the names and layouts of
     /// `TwoScale::visit_bakes` and `runtime/src/bake/`; not a stable
-    /// interface). For `rgb_mode="paper-wavelengths"` only.
+    /// interface: read by name). For `rgb_mode="paper-wavelengths"` only.
     fn bakes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let RgbModel::PaperWavelengths(model) = &*self.model else {
             return Err(value_error(
@@ -711,7 +713,7 @@ impl Material {
 
     /// integrated_bakes(): the colour weights and bakes of the integrated
     /// RGB model (`rgb_mode="integrated"`), for ports of `eval`, `pdf` and
-    /// `sample` (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 8
+    /// `sample` (`twoscale.drjit`): a dict of `wavelengths` (the 8
     /// models', µm), `surface` (`[nodes, 8, 3]`: the surface lobes' weights
     /// over `√cos θd`), `plain` (`[8, 3]`), `sampler_nodes` (the 3 models the
     /// sampler mixes) and `models`, a list of 8 dicts as `bakes()` gives
@@ -728,7 +730,7 @@ impl Material {
 
     /// spectral_bakes(): the constants and bakes of the model at any
     /// wavelength (`eval_spectral`'s), for ports of it
-    /// (`twoscale.drjit_bsdf`): a dict of `wavelengths` (the 19 models', µm),
+    /// (`twoscale.drjit`): a dict of `wavelengths` (the 19 models', µm),
     /// `fresnel` (F over λ every `eta_step` µm from `eta_first` and √cos θ),
     /// `eta` (n, k at those λ), `white`, `models`
     /// (one dict with the names of `bakes()`: a quantity equal in the 19
@@ -917,18 +919,27 @@ fn bake_dict<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut visitor = DictVisitor {
         dict: PyDict::new(py),
+        columns: PyDict::new(py),
         error: None,
     };
     visit(&mut visitor);
-    match visitor.error {
-        Some(e) => Err(e),
-        None => Ok(visitor.dict),
+    if let Some(e) = visitor.error {
+        return Err(e);
     }
+    if !visitor.columns.is_empty() {
+        visitor.dict.set_item(COLUMNS, visitor.columns)?;
+    }
+    Ok(visitor.dict)
 }
+
+/// The key of a bake dict's column names: a dict from an array's name to
+/// the names of its last axis (`BakeVisitor::columns`).
+const COLUMNS: &str = "columns";
 
 /// Collects `TwoScale::visit_bakes` into a dict (the first error is kept).
 struct DictVisitor<'py> {
     dict: Bound<'py, PyDict>,
+    columns: Bound<'py, PyDict>,
     error: Option<PyErr>,
 }
 
@@ -957,6 +968,16 @@ impl BakeVisitor for DictVisitor<'_> {
         let result = self.dict.set_item(name, value);
         self.keep(result);
     }
+
+    fn columns(&mut self, name: &'static str, columns: &'static [&'static str]) {
+        let result = self.columns.set_item(name, columns);
+        self.keep(result);
+    }
+
+    fn named(&mut self, name: &'static str, value: &'static str) {
+        let result = self.dict.set_item(name, value);
+        self.keep(result);
+    }
 }
 
 /// One quantity as `TwoScale::visit_bakes` hands it.
@@ -965,6 +986,8 @@ enum Quantity {
     F32(Vec<usize>, Vec<f32>),
     F64(Vec<usize>, Vec<f64>),
     Scalar(f64),
+    Named(&'static str),
+    Columns(&'static [&'static str]),
 }
 
 /// One model's quantities in the order visited.
@@ -985,6 +1008,14 @@ impl BakeVisitor for Collected {
     fn scalar(&mut self, name: &'static str, value: f64) {
         self.0.push((name, Quantity::Scalar(value)));
     }
+
+    fn columns(&mut self, name: &'static str, columns: &'static [&'static str]) {
+        self.0.push((name, Quantity::Columns(columns)));
+    }
+
+    fn named(&mut self, name: &'static str, value: &'static str) {
+        self.0.push((name, Quantity::Named(value)));
+    }
 }
 
 /// The models' quantities in one dict (`spectral_bakes`' `models`): one
@@ -995,6 +1026,7 @@ fn stacked<'py>(
     nodes: &[Collected],
 ) -> PyResult<(Bound<'py, PyDict>, Vec<&'static str>)> {
     let dict = PyDict::new(py);
+    let columns = PyDict::new(py);
     let mut per_node = Vec::new();
     let n = nodes.len();
     for (j, (name, first)) in nodes[0].0.iter().enumerate() {
@@ -1008,6 +1040,8 @@ fn stacked<'py>(
                     dict.set_item(name, shaped(py, shape, data.clone()))?
                 }
                 Quantity::Scalar(value) => dict.set_item(name, *value)?,
+                Quantity::Named(value) => dict.set_item(name, *value)?,
+                Quantity::Columns(names) => columns.set_item(name, *names)?,
             }
             continue;
         }
@@ -1035,7 +1069,18 @@ fn stacked<'py>(
                 });
                 dict.set_item(name, shaped(py, &[n], data.collect()))?;
             }
+            Quantity::Named(_) => {
+                let names = all().map(|q| match q {
+                    Quantity::Named(v) => *v,
+                    _ => unreachable!("every model visits the same quantities"),
+                });
+                dict.set_item(name, names.collect::<Vec<_>>())?;
+            }
+            Quantity::Columns(_) => unreachable!("a bake's columns are its type's"),
         }
+    }
+    if !columns.is_empty() {
+        dict.set_item(COLUMNS, columns)?;
     }
     Ok((dict, per_node))
 }

@@ -1,4 +1,4 @@
-"""The Dr.Jit port of the model (``twoscale.drjit_bsdf``, the ``twoscale``
+"""The Dr.Jit port of the model (``twoscale.drjit``, the ``twoscale``
 plugin) against the runtime, in ``llvm_ad_rgb`` with Mitsuba's default
 symbolic loops and calls (no file of python/tests switches them): agreement,
 χ², white furnace, Beckmann limit, gradients."""
@@ -20,7 +20,7 @@ import twoscale  # noqa: E402
 from render_checks import beckmann_limit, chi2, direction, furnace_albedo, furnace_render  # noqa: E402,E501
 
 mi.set_variant("llvm_ad_rgb")
-import twoscale.drjit_bsdf as tb  # noqa: E402
+import twoscale.drjit as tb  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
 
 tm.register()

@@ -1,5 +1,5 @@
 """The Dr.Jit plugin in ``llvm_ad_spectral`` (four wavelengths per path):
-``twoscale.drjit_bsdf.SpectralModel`` against the runtime's model at any
+``twoscale.drjit.SpectralModel`` against the runtime's model at any
 wavelength (``Material.eval_spectral``), Mitsuba's χ² test and the white
 furnace, with Mitsuba's default symbolic loops and calls."""
 
@@ -16,7 +16,7 @@ import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
 import twoscale  # noqa: E402
-import twoscale.drjit_bsdf as tb  # noqa: E402
+import twoscale.drjit as tb  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
 from render_checks import chi2, direction, furnace_albedo, furnace_render  # noqa: E402
 from test_drjit_bsdf import TOLERANCE, pairs, relative_error, seed  # noqa: E402

@@ -59,7 +59,7 @@ So ``eval``, ``pdf``, ``sample`` and ``eval_pdf`` are mutually consistent
 ``eval / pdf`` and that ``eval_pdf`` returns both).
 
 **Implementation and variants.** The BSDF is written in Dr.Jit
-(:mod:`twoscale.drjit_bsdf`: the runtime bakes each material, the plugin
+(:mod:`twoscale.drjit`: the runtime bakes each material, the plugin
 mirrors its ``eval``, ``pdf`` and ``sample`` with Dr.Jit operations), so it
 runs in Mitsuba's default symbolic mode and :func:`register` changes no
 Dr.Jit flag. Run in ``scalar_rgb``, ``llvm_ad_rgb`` and ``llvm_ad_spectral``
@@ -70,7 +70,7 @@ polarised and monochrome variants are refused.
 **Differentiable parameters** (``mi.traverse``): ``lambertian``, ``albedo``
 (plastic and subsurface bases) and ``halo_factor`` (a factor on the
 diffraction lobe, default 1, materials with σs > 0); see
-:mod:`twoscale.drjit_bsdf` for why only these.
+:mod:`twoscale.drjit` for why only these.
 """
 
 import mitsuba as mi
@@ -136,11 +136,11 @@ def _material(props):
 
 
 def register() -> None:
-    """register(): registers the ``twoscale`` BSDF (:mod:`twoscale.drjit_bsdf`)
+    """register(): registers the ``twoscale`` BSDF (:mod:`twoscale.drjit`)
     with the current Mitsuba variant. No Dr.Jit flag is changed."""
     if not mi.variant():
         raise RuntimeError("call mi.set_variant(...) before twoscale.mitsuba.register()")
-    from twoscale import drjit_bsdf
+    from twoscale import drjit
 
-    cls = drjit_bsdf.bsdf_class()
+    cls = drjit.bsdf_class()
     mi.register_bsdf(NAME, lambda props: cls(props))

@@ -178,12 +178,16 @@ impl ConvBake {
     }
 
     /// `C` at `sin θh`, `cos θh` (in [0, 1]) and `u ∈ [0, B]` (clamped).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
         c_of_ln(self.ln_at(sin_h, cos_h, u))
     }
 
     /// `ln C` of [`ConvBake::at`] (finite: the bake's floor bounds it below).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn ln_at(&self, sin_h: f32, cos_h: f32, u: f32) -> f32 {
         let u = u.max(0.0).min(self.big_b);
@@ -209,6 +213,8 @@ impl ConvBake {
 }
 
 /// `C = e^ln C` of [`ConvBake::ln_at`], 0 where it is not finite.
+///
+/// Mirrored in python/twoscale/drjit/lookups.py.
 #[inline]
 pub(crate) fn c_of_ln(ln_c: f32) -> f32 {
     // e^x is 0 in f32 below x ≈ −103.3.

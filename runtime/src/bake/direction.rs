@@ -28,6 +28,33 @@ pub(crate) struct DirectionBake {
 /// Values per [`DirectionBake`] row.
 const ROW: usize = 8;
 
+/// The row's columns: Q̄'s five factors ([`QFactors`]) from `Q`, then
+/// σrel/σs, F and `1 − E_s`.
+const Q: usize = 0;
+const SIGMA_RATIO: usize = 5;
+const FRESNEL: usize = 6;
+const LOST: usize = 7;
+
+/// The names of a [`DirectionBake`] row's columns (`direction_rows`, given
+/// to [`BakeVisitor::columns`]; ports read the columns by these).
+pub(crate) const ROW_COLUMNS: [&str; ROW] = {
+    let mut names = [""; ROW];
+    let q = ["q_a", "q_u_re", "q_u_im", "q_w_re", "q_w_im"];
+    let mut k = 0;
+    while k < q.len() {
+        names[Q + k] = q[k];
+        k += 1;
+    }
+    names[SIGMA_RATIO] = "sigma_ratio";
+    names[FRESNEL] = "fresnel";
+    names[LOST] = "lost";
+    names
+};
+
+/// The names of the lobe weights' columns (`direction_weights`), in
+/// `brdf::Lobe`'s order.
+pub(crate) const WEIGHT_COLUMNS: [&str; 4] = ["specular", "diffraction", "base", "multiple"];
+
 /// A `cos θ`'s place on [`DirectionBake`]'s axis (the same for every
 /// wavelength, so [`crate::brdf::Rgb`] finds it once for its three channels).
 #[derive(Clone, Copy, Debug)]
@@ -38,6 +65,8 @@ pub(crate) struct DirectionCell {
 
 impl DirectionCell {
     /// The cell of `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn new(cos: f32) -> Self {
         let (index, fraction) = cell(math::sqrtf(cos.max(0.0)), MU_NODES);
@@ -46,6 +75,8 @@ impl DirectionCell {
 
     /// The cell and fraction of the same `cos θ` on an axis of `N` nodes of
     /// `√cos θ` (`MU_NODES − 1` a multiple of `N − 1`).
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     pub fn coarser<const N: usize>(self) -> (usize, f32) {
         let step = ((MU_NODES - 1) / (N - 1)) as f32;
@@ -64,27 +95,27 @@ impl DirectionValues {
     /// F(η, cos θ).
     #[inline]
     pub fn fresnel(&self) -> f64 {
-        f64::from(self.v[6])
+        f64::from(self.v[FRESNEL])
     }
 
     /// The factors of Q̄.
     #[inline]
     pub fn q_factors(&self) -> QFactors {
         let v = &self.v;
-        [v[0], v[1], v[2], v[3], v[4]].map(f64::from)
+        [v[Q], v[Q + 1], v[Q + 2], v[Q + 3], v[Q + 4]].map(f64::from)
     }
 
     /// σrel/σs.
     #[inline]
     pub fn sigma_ratio(&self) -> f64 {
-        f64::from(self.v[5])
+        f64::from(self.v[SIGMA_RATIO])
     }
 
     /// `1 − E_s(μ)`, the light single scattering loses (0 unless the
     /// compensation lobe is on).
     #[inline]
     pub fn lost(&self) -> f64 {
-        f64::from(self.v[7])
+        f64::from(self.v[LOST])
     }
 }
 
@@ -111,16 +142,16 @@ impl DirectionBake {
             let cos = x * x;
             *cos_f32 = cos as f32;
             let factors = q.map(|q| q.factors(cos)).unwrap_or([0.0; 5]);
-            for (slot, value) in row[..5].iter_mut().zip(factors) {
+            for (slot, value) in row[Q..Q + 5].iter_mut().zip(factors) {
                 *slot = value as f32;
             }
-            row[6] = fresnel(eta, cos as f32);
-            row[7] = 0.0;
+            row[FRESNEL] = fresnel(eta, cos as f32);
+            row[LOST] = 0.0;
         }
         let mut ratios = [0.0f32; MU_NODES];
         sigma_ratio.sigma_ratio_cos_many(&cosines, big_b, c, &mut ratios);
         for (row, ratio) in self.rows.iter_mut().zip(ratios) {
-            row[5] = ratio;
+            row[SIGMA_RATIO] = ratio;
         }
         self.weights = [[0.0f32; 4]; MU_NODES];
     }
@@ -147,9 +178,9 @@ impl DirectionBake {
     pub fn set_albedo(&mut self, albedo: impl Fn(f64) -> f32) -> f64 {
         for (k, row) in self.rows.iter_mut().enumerate() {
             let x = k as f64 / (MU_NODES - 1) as f64;
-            row[7] = 1.0 - albedo(x * x).max(0.0).min(1.0);
+            row[LOST] = 1.0 - albedo(x * x).max(0.0).min(1.0);
         }
-        1.0 - crate::math::cosine_weighted_mean(MU_NODES, |k| self.rows[k][7])
+        1.0 - crate::math::cosine_weighted_mean(MU_NODES, |k| self.rows[k][LOST])
     }
 
     /// The lobe weights `weights(values at cos θ, cos θ)` at the nodes, for
@@ -176,19 +207,28 @@ impl DirectionBake {
     }
 
     /// F alone at a cell.
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn fresnel_at(&self, at: DirectionCell) -> f32 {
-        let (a, b) = (self.rows[at.index][6], self.rows[at.index + 1][6]);
+        let (a, b) = (
+            self.rows[at.index][FRESNEL],
+            self.rows[at.index + 1][FRESNEL],
+        );
         a + at.fraction * (b - a)
     }
 
     /// The values at `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn at(&self, cos: f32) -> DirectionValues {
         self.at_cell(DirectionCell::new(cos))
     }
 
     /// The values at a cell.
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn at_cell(&self, at: DirectionCell) -> DirectionValues {
         let (a, b) = (&self.rows[at.index], &self.rows[at.index + 1]);
@@ -200,18 +240,23 @@ impl DirectionBake {
     }
 
     /// Hands the node rows and lobe weights to `v` (`direction_rows`
-    /// `[257, 8]`, `direction_weights` `[257, 4]`; nodes even in `√cos θ`).
+    /// `[257, 8]`, columns [`ROW_COLUMNS`]; `direction_weights` `[257, 4]`,
+    /// columns [`WEIGHT_COLUMNS`]; nodes even in `√cos θ`).
     pub fn visit(&self, v: &mut dyn BakeVisitor) {
         v.array("direction_rows", &[MU_NODES, ROW], self.rows.as_flattened());
+        v.columns("direction_rows", &ROW_COLUMNS);
         v.array(
             "direction_weights",
             &[MU_NODES, 4],
             self.weights.as_flattened(),
         );
+        v.columns("direction_weights", &WEIGHT_COLUMNS);
     }
 
     /// The sampler's lobe weights `[specular, diffraction, base, multiple]`
     /// (sum 1) at `cos θ` (clamped to [0, 1]).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     #[inline]
     pub fn lobe_weights(&self, cos: f32) -> [f64; 4] {
         let at = DirectionCell::new(cos);
@@ -222,6 +267,22 @@ impl DirectionBake {
             w.map(|x| x / total)
         } else {
             [1.0, 0.0, 0.0, 0.0]
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ROW_COLUMNS, WEIGHT_COLUMNS};
+
+    /// Every column of the bakes a port reads by name has one, unique.
+    #[test]
+    fn every_column_has_its_own_name() {
+        for names in [&ROW_COLUMNS[..], &WEIGHT_COLUMNS[..]] {
+            for (k, name) in names.iter().enumerate() {
+                assert!(!name.is_empty(), "column {k} has no name");
+                assert!(!names[..k].contains(name), "{name} names two columns");
+            }
         }
     }
 }

@@ -155,7 +155,7 @@ impl HaloBake {
     }
 
     /// Hands the tables to `v` (`halo_zeta` `[33, 66]`, `halo_coef`
-    /// `[33, 66, 2]`; f64: `halo_cum` `[33, 66]`, `halo_u`, `halo_inv_du`,
+    /// `[33, 66, 2]`, columns `start`, `slope`; f64: `halo_cum` `[33, 66]`, `halo_u`, `halo_inv_du`,
     /// `halo_inv_total` `[33]`; rows as `conv_ln_c`'s without ghosts).
     pub fn visit(&self, v: &mut dyn BakeVisitor) {
         let shape = [CONV_U_NODES, NODES];
@@ -165,6 +165,7 @@ impl HaloBake {
             &[CONV_U_NODES, NODES, 2],
             self.coef.as_flattened().as_flattened(),
         );
+        v.columns("halo_coef", &["start", "slope"]);
         v.array_f64("halo_cum", &shape, self.cum.as_flattened());
         v.array_f64("halo_u", &[CONV_U_NODES], &self.u);
         v.array_f64("halo_inv_du", &[CONV_U_NODES], &self.inv_du);
@@ -176,6 +177,8 @@ impl HaloBake {
     /// `1 − t`) and, rescaled, the azimuth; `along` gives `ζ`. `None` when
     /// the row holds no density or no azimuth at the drawn θh reflects `i`
     /// above the horizon.
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py.
     pub fn sample_h(&self, wi: [f64; 3], u_i: f64, pick: f64, along: f64) -> Option<[f64; 3]> {
         let (j, t) = self.row_cell(u_i);
         let (row, azimuth) = if pick < 1.0 - t {
@@ -227,6 +230,8 @@ impl HaloBake {
     /// [`HaloBake::sample_h`]'s draw for `u = B cos θi`, at a half-vector
     /// with `sin θh`, `cos θh` and `cos θo` (module documentation:
     /// `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`).
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py and python/twoscale/drjit/lobes.py.
     pub fn pdf(&self, wi: [f64; 3], u_i: f64, sin_h: f64, cos_h: f64, cos_o: f64) -> f64 {
         let sin_i = math::sqrt(wi[0] * wi[0] + wi[1] * wi[1]).min(1.0);
         let Some(law) = Azimuth::new(sin_i, wi[2], sin_h, cos_h) else {
@@ -252,6 +257,8 @@ impl HaloBake {
 
     /// The row below `u` (clamped to the rows) and the fraction towards the
     /// next, `(u − u_j)/(u_j+1 − u_j)`.
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py.
     #[inline]
     fn row_cell(&self, u: f64) -> (usize, f64) {
         let u = u.max(0.0).min(self.u[CONV_U_NODES - 1]);
@@ -262,6 +269,8 @@ impl HaloBake {
 
     /// `p_j(ζ) = (start_k + slope_k (ζ − ζ_k)) / M_j` of row `j` on its cell
     /// `k` (module documentation); 0 beyond its last node.
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py.
     #[inline]
     fn row_pdf(&self, j: usize, z: f64) -> f64 {
         let zeta = &self.zeta[j];
@@ -299,6 +308,8 @@ pub(crate) struct Azimuth {
 impl Azimuth {
     /// The law at `(sin θi, cos θi)` and `(sin θh, cos θh)`; `None` where no
     /// azimuth gives `cos θo > 0` (or `cos θh ≤ 0`).
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py.
     pub fn new(sin_i: f64, cos_i: f64, sin_h: f64, cos_h: f64) -> Option<Self> {
         if !(cos_h > 0.0) {
             return None;
@@ -329,6 +340,8 @@ impl Azimuth {
     /// The `ψ ∈ [0, H]` with `F(ψ) = target` (`0 ≤ target ≤ F(H)`; F
     /// increases on [0, H]): Newton's method kept in a shrinking bracket (a
     /// step leaving it bisects), to `1e-12` in ψ.
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py and python/twoscale/drjit/math.py.
     pub fn solve(&self, target: f64) -> f64 {
         let (mut lo, mut hi) = (0.0f64, self.big_h);
         let mut psi = self.big_h * (target / self.half).max(0.0).min(1.0);
@@ -363,6 +376,8 @@ impl Azimuth {
 }
 
 /// `F(ψ) = A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ` of [`Azimuth`].
+///
+/// Mirrored in python/twoscale/drjit/halo.py.
 #[inline]
 fn cdf(coef: [f64; 3], psi: f64) -> f64 {
     let (s, c) = (math::sin(psi), math::cos(psi));

@@ -45,6 +45,8 @@ impl MaskingBake {
 
     /// G1 of a direction with `z = cos θ` and tangential length `r = sin θ`
     /// (both ≥ 0; 0 at or below the horizon).
+    ///
+    /// Mirrored in python/twoscale/drjit/lookups.py.
     #[inline]
     pub fn g1(&self, r: f32, z: f32) -> f32 {
         if !(z > 0.0) {

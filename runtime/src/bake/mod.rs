@@ -50,6 +50,8 @@ fn cell(x: f32, n: usize) -> (usize, f32) {
 }
 
 /// [`cell`] of a position `t` in nodes (`t ≥ 0`, clamped to `n − 1`).
+///
+/// Mirrored in python/twoscale/drjit/lookups.py.
 #[inline]
 fn cell_at(t: f32, n: usize) -> (usize, f32) {
     let t = t.min((n - 1) as f32);
@@ -68,10 +70,13 @@ fn cell_at(t: f32, n: usize) -> (usize, f32) {
 const ROUNDER: f32 = 12_582_912.0;
 
 /// Receives a model's bakes and constants by name, for ports of `eval` and
-/// `pdf` to array languages (the Python package's Dr.Jit plugin reads them
-/// through `Material.bakes()`): arrays are row-major f32 with their shape,
-/// scalars f64. The names and layouts are the bakes' own and may change
-/// with them; not a stable interface.
+/// `pdf` to array languages (the Python package's Dr.Jit plugin,
+/// python/twoscale/drjit/, reads them through `Material.bakes()`): arrays
+/// are row-major f32 with their shape, an array whose last axis holds
+/// different quantities names them ([`BakeVisitor::columns`]), scalars are
+/// f64, options and kinds are their [`crate::validate::Named`] spelling.
+/// The names and layouts are the bakes' own and may change with them; not a
+/// stable interface, but a port reads names only, never positions.
 #[doc(hidden)]
 pub trait BakeVisitor {
     /// An array of `shape` (row-major).
@@ -80,6 +85,12 @@ pub trait BakeVisitor {
     fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]);
     /// A scalar.
     fn scalar(&mut self, name: &'static str, value: f64);
+    /// The names of the columns (the last axis) of the array `name`, in
+    /// order.
+    fn columns(&mut self, name: &'static str, columns: &'static [&'static str]);
+    /// A quantity with named values (an option, the base layer's kind): the
+    /// value's name ([`crate::validate::Named::name`]).
+    fn named(&mut self, name: &'static str, value: &'static str);
 }
 
 #[cfg(all(test, feature = "embedded"))]

@@ -101,6 +101,8 @@ fn axis(a: f64, inv_sigma: f32, scale: f32) -> f32 {
 /// The cell `[nodes[k], nodes[k + 1]]` of `a` (clamped to the first and last
 /// cells) from its axis position, corrected by one node where the f32 axis
 /// and the f64 nodes disagree, and the fraction in it (in [0, 1]).
+///
+/// Mirrored in python/twoscale/drjit/visible.py.
 #[inline]
 fn locate<const N: usize>(a: f64, nodes: &[f64; N], position: f32) -> (usize, f64) {
     let mut k = (position.max(0.0) as usize).min(N - 2);
@@ -258,6 +260,8 @@ impl VisibleSlopeBake {
     }
 
     /// `∫₀^τ (c − s x̃)(P0 + k t) dt` over cell `j` from its left node.
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     #[inline]
     fn cell_integral(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau: f64) -> f64 {
         let a = c - s * x0;
@@ -301,6 +305,8 @@ impl VisibleSlopeBake {
 
     /// The per-incidence part of [`VisibleSlopeBake::sample`] and
     /// [`VisibleSlopeBake::pdf`] for the unit `wi` (`wi[2] > 0`).
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     #[inline]
     pub fn incidence(&self, wi: [f64; 3]) -> VisibleIncidence {
         let st = self.stretched(wi);
@@ -315,6 +321,8 @@ impl VisibleSlopeBake {
 
     /// Samples a microfacet normal for the unit incidence `wi` (`wi[2] > 0`)
     /// from `u ∈ [0, 1)²`; `None` where the tables give no mass.
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     #[cfg(test)]
     pub fn sample(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
         self.sample_at(&self.incidence(wi), u)
@@ -379,6 +387,8 @@ impl VisibleSlopeBake {
     /// The solid-angle density over `wo` of reflecting `wi` about a normal
     /// from [`VisibleSlopeBake::sample`] (module documentation); both unit,
     /// upper hemisphere.
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     pub fn pdf(&self, wi: [f64; 3], wo: [f64; 3]) -> f64 {
         let st = self.stretched(wi);
         // N_tab only where the density is not 0.
@@ -434,6 +444,8 @@ impl VisibleSlopeBake {
 
 /// The last index `k < n` with `below(k)` (`below` true at 0 and
 /// monotone), by halving without data-dependent branches.
+///
+/// Mirrored in python/twoscale/drjit/math.py.
 #[inline]
 pub(crate) fn last_at_most(n: usize, below: impl Fn(usize) -> bool) -> usize {
     let (mut base, mut len) = (0usize, n);
@@ -461,6 +473,8 @@ fn trapezoid<const N: usize>(x: &[f64; N], f: &[f64; N]) -> f64 {
 /// The `τ ∈ [0, τ_max]` with `∫₀^τ (c − s(x0 + t))(p0 + k t) dt = rest`
 /// (the density is ≥ 0 on the cell): Newton's method kept in a shrinking
 /// bracket.
+///
+/// Mirrored in python/twoscale/drjit/math.py and python/twoscale/drjit/visible.py.
 fn solve_cell(c: f64, s: f64, x0: f64, p0: f64, k: f64, tau_max: f64, rest: f64) -> f64 {
     let a = c - s * x0;
     let density = |t: f64| (a - s * t) * (p0 + k * t);

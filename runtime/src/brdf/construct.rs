@@ -21,6 +21,7 @@ use crate::math::{self, Complex};
 use crate::model::epd::Epd;
 use crate::model::fresnel::{QConstants, fresnel_average};
 use crate::tables::convolution::ConvSlice;
+use crate::validate::Named;
 use core::borrow::{Borrow, BorrowMut};
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
@@ -423,8 +424,10 @@ fn compensation(e_avg: f64, f_avg: f64) -> (f64, f64) {
 
 impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// Hands the model's constants and bakes to `v` (names in the
-    /// visitor's calls; layouts as [`crate::bake`] documents), for ports of
-    /// `eval` and `pdf` (the Python package's `Material.bakes()`).
+    /// visitor's calls; layouts as [`crate::bake`] documents; the base
+    /// layer's kind and the options `masking`, `sigma_rel`, `halo_weight`
+    /// and `colour` by their [`Named`] spelling), for ports of `eval` and
+    /// `pdf` (the Python package's `Material.bakes()`).
     #[doc(hidden)]
     pub fn visit_bakes(&self, v: &mut dyn BakeVisitor) {
         let s = &self.surface;
@@ -445,12 +448,21 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
         v.scalar("q_e_norm_sqr", e_norm_sqr);
         v.scalar("q_eta_sq_re", eta_sq[0]);
         v.scalar("q_eta_sq_im", eta_sq[1]);
-        let (base, albedo) = match self.base {
-            BaseLayer::Conductor => (0.0, 0.0),
-            BaseLayer::Plastic { albedo } => (1.0, f64::from(albedo)),
-            BaseLayer::Subsurface { albedo } => (2.0, f64::from(albedo)),
+        let albedo = match self.base {
+            BaseLayer::Conductor => 0.0,
+            BaseLayer::Plastic { albedo } | BaseLayer::Subsurface { albedo } => f64::from(albedo),
         };
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let o = &self.options;
+        for (name, value) in [
+            ("base", self.base.kind().name()),
+            (Masking::OPTION, o.masking.name()),
+            (SigmaRelMode::OPTION, o.sigma_rel.name()),
+            (HaloWeight::OPTION, o.halo_weight.name()),
+            (ColourTerms::OPTION, o.colour.name()),
+        ] {
+            v.named(name, value);
+        }
         for (name, value) in [
             ("lambda", self.lambda),
             ("big_b", self.big_b),
@@ -461,21 +473,7 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
             ("eta_re", self.eta_re),
             ("lambertian", self.lambertian),
             ("multiple_scale", self.multiple_scale),
-            ("base", base),
             ("albedo", albedo),
-            ("white", flag(self.white())),
-            (
-                "height_correlated",
-                flag(self.options.masking == Masking::HeightCorrelated),
-            ),
-            (
-                "symmetrised",
-                flag(self.options.sigma_rel == SigmaRelMode::Symmetrised),
-            ),
-            (
-                "halo_incident",
-                flag(self.options.halo_weight == HaloWeight::Incident),
-            ),
             ("conv_baked", flag(self.bake().conv_baked)),
         ] {
             v.scalar(name, value);

@@ -144,6 +144,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// The geometry of `(i, o)`; `None` below the horizon.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub(super) fn geometry(&self, i: [f32; 3], o: [f32; 3]) -> Option<Geometry> {
         let (wi, wo) = (upper_unit(i)?, upper_unit(o)?);
         let sum = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
@@ -172,6 +174,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// D(h) and G(i, o) added to `geometry`.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub(super) fn with_masking(&self, geometry: Geometry) -> Pair {
         let (wi, wo) = (geometry.wi, geometry.wo);
         let tangential = |w: [f64; 3]| math::sqrtf((w[0] * w[0] + w[1] * w[1]) as f32);
@@ -205,6 +209,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// The terms of ρ at a pair (HP17 24-33).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     pub(super) fn lobes(&self, pair: &Pair) -> Lobes {
         let t = self.surface_terms(pair, self.white());
         let (cos_i, cos_o) = (pair.geometry.wi[2], pair.geometry.wo[2]);
@@ -229,6 +235,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// [`TwoScale::surface_terms`] with C(θh; u) from `conv` (called only
     /// where the diffraction lobe is evaluated; `IntegratedRgb` hands in C
     /// interpolated over its wavelengths).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     #[inline(always)]
     pub(super) fn surface_terms_with(
         &self,
@@ -324,6 +332,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// `ρ_base + k_d/π` (docs/model.md §2.6; HP17 42-47).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     pub(super) fn base_value(
         &self,
         at_i: &DirectionValues,

@@ -151,6 +151,8 @@ impl ColourBake {
     }
 
     /// `R_kc` at `cos θd`, linear in `√cos θd` between nodes.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     fn surface_at(&self, cos_d: f64) -> [[f32; 3]; INTEGRATED_COUNT] {
         let t = math::sqrt(cos_d.max(0.0).min(1.0)) * (COLOUR_NODES - 1) as f64;
@@ -319,6 +321,8 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     }
 
     /// `ln C` at the [`CONV_NODES`]' wavelengths, when they are baked.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline(always)]
     fn ln_conv(&self, geometry: &Geometry) -> Option<[f32; 4]> {
         let mut ln = [0.0; 4];
@@ -332,6 +336,8 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
 
     /// ρ(i, o) per linear-sRGB channel (module documentation; C read at 4
     /// of the wavelengths and interpolated at the others).
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 3];

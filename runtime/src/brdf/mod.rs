@@ -183,6 +183,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// ([`math::exp_inline`], to 2e-15): `1 − e^−t` loses at most `3e-16/t`
 /// relatively, below 3e-8 for `t ≥ 1e-8`; below that its series; the second
 /// → `x` as `s → 0`.
+///
+/// Mirrored in python/twoscale/drjit/lobes.py.
 #[inline]
 fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
     let t = x * s;

@@ -107,6 +107,8 @@ impl<'a, B: BorrowMut<ChannelBake>> Rgb<'a, B> {
 
 impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
     /// ρ(i, o) per channel.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         match self.channels[0].pair(i, o) {
             Some(pair) => self.channels.each_ref().map(|ch| ch.lobes(&pair).total()),
@@ -117,6 +119,8 @@ impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
     /// The density of [`Rgb::sample`]: the mean of the channels' pdfs (one
     /// channel's sampler is picked uniformly; the channels' lobe weights are
     /// shared, `share_lobe_weights`).
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
         match self.channels[0].geometry(i, o) {
             Some(geometry) => finite_or_zero(self.pdf_at(&geometry)),
@@ -139,6 +143,8 @@ impl<B: Borrow<ChannelBake>> Rgb<'_, B> {
     /// Picks a channel's sampler with `u[0]` (uniformly; `u[0]` is rescaled
     /// and reused to pick the lobe), samples it, and returns the direction,
     /// the mixture density [`Rgb::pdf`] and the three values.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn sample(&self, i: [f32; 3], u: [f32; 3]) -> Option<RgbSample> {
         let pick = 3.0 * f64::from(u[0].max(0.0).min(BELOW_ONE));
         let k = (pick as usize).min(2);

@@ -114,6 +114,8 @@ fn shared_lobe_weights(s: [[f64; 4]; 3]) -> [[f64; 4]; 3] {
 
 /// The lobe whose cumulative-weight interval holds `pick ∈ [0, 1)`; rounding
 /// past the last interval falls on the last lobe of positive weight.
+///
+/// Mirrored in python/twoscale/drjit/lobes.py.
 fn pick_lobe(pick: f64, w: [f64; 4]) -> Lobe {
     const LOBES: [Lobe; 4] = [
         Lobe::Specular,
@@ -255,6 +257,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// `i`: `Σ_k w_k(i) pdf_k(i, o)` with the weights of
     /// [`TwoScale::lobe_weights`] and the lobe densities of
     /// [`TwoScale::pdf_lobe`]. 0 below the horizon.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3]) -> f32 {
         match self.geometry(i, o) {
             Some(geometry) => finite_or_zero(self.pdf_at(&geometry)),
@@ -357,6 +361,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
 
     /// The diffraction lobe's density: the half-vector draw of [`HaloBake`],
     /// `p(h) / (4 i·h)`, when the C bake is there; else the spectrum's draw.
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     fn diffraction_pdf(&self, geometry: &Geometry) -> f64 {
         let Geometry {
             wi,
@@ -410,6 +416,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     ///   centred on `+i_p` as written here (at ψ = 0, `o_p` moves from the
     ///   mirror direction towards `i`'s side);
     /// * base and multiple: cosine-weighted hemisphere.
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     pub fn sample_lobe(&self, lobe: Lobe, i: [f32; 3], u: [f32; 2]) -> Option<[f32; 3]> {
         let wi = upper_unit(i)?;
         let visible = match lobe {
@@ -454,6 +462,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     /// The diffraction lobe's draw: a half-vector from [`HaloBake`] (`u[1]`
     /// picks its row and then the azimuth, `u[0]` gives θh) reflected, when
     /// the C bake is there; else the spectrum's.
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     fn sample_diffraction(&self, wi: [f64; 3], u: [f64; 2]) -> Option<[f64; 3]> {
         let Some(halo) = self.bake().halo() else {
             return self.sample_spectrum(wi, u);
@@ -527,6 +537,8 @@ impl<'a, B: Borrow<ChannelBake>> TwoScale<'a, B> {
     }
 
     /// The direction and lobe of [`TwoScale::sample`].
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub(super) fn sample_direction(&self, i: [f32; 3], u: [f32; 3]) -> Option<([f32; 3], Lobe)> {
         let wi = upper_unit(i)?;
         let w = self.weights(wi[2]);

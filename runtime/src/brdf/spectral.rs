@@ -30,6 +30,7 @@ use crate::bake::DirectionCell;
 use crate::material::{ColourTerms, Options};
 use crate::model::fresnel::fresnel;
 use crate::spectrum::optical::SpectralMaterial;
+use crate::validate::Named;
 use core::borrow::{Borrow, BorrowMut};
 use zerocopy::FromZeros;
 
@@ -114,6 +115,8 @@ impl FresnelBake {
 
     /// F at `lambda` (clamped to the table) and at the `cos θ` of `cell`,
     /// bilinear.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     fn at(&self, lambda: f32, cell: DirectionCell) -> f32 {
         let (j, f) = Self::row(lambda);
@@ -157,6 +160,8 @@ const CELL_START: [u8; CELL_BINS] = {
 /// [`SPECTRAL_WAVELENGTHS`] (held at the ends): `(k, f)` with
 /// `hat_k = 1 − f`, `hat_{k+1} = f`. The search starts at [`CELL_START`]'s
 /// bin of λ.
+///
+/// Mirrored in python/twoscale/drjit/models.py.
 #[inline]
 fn cell(lambda: f32) -> (usize, f32) {
     let nodes = &SPECTRAL_WAVELENGTHS;
@@ -188,6 +193,8 @@ struct NodeTerms {
 impl NodeTerms {
     /// The terms of `node` at `pair`; `plain` 0 unless `diffuse` (the
     /// models have a base lobe, `k_d` or the compensation lobe).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     pub(super) fn new<B: Borrow<ChannelBake>>(
         node: &TwoScale<'_, B>,
         pair: &Pair,
@@ -295,7 +302,7 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// ([`SPECTRAL_WAVELENGTHS`], µm), `fresnel` ([`FresnelBake`],
     /// `[ETA_NODES, FRESNEL_COS_NODES]`: λ every `eta_step` µm from
     /// `eta_first`, `√cos θ` from 0 to 1), `eta` (`[ETA_NODES, 2]`: n, k at
-    /// those λ) and `white`. Each model's bakes are its node's
+    /// those λ, columns `n`, `k`) and `colour` ([`ColourTerms`]' name). Each model's bakes are its node's
     /// [`TwoScale::visit_bakes`].
     #[doc(hidden)]
     pub fn visit_index(&self, v: &mut dyn BakeVisitor) {
@@ -304,12 +311,20 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
         let shape = [ETA_NODES, FRESNEL_COS_NODES];
         v.array("fresnel", &shape, bake.rows.as_flattened());
         v.array("eta", &[ETA_NODES, 2], bake.eta.as_flattened());
+        v.columns("eta", &["n", "k"]);
         v.scalar("eta_first", f64::from(ETA_FIRST));
         v.scalar("eta_step", f64::from(ETA_STEP));
-        v.scalar("white", if self.white { 1.0 } else { 0.0 });
+        let colour = if self.white {
+            ColourTerms::White
+        } else {
+            ColourTerms::Physical
+        };
+        v.named(ColourTerms::OPTION, colour.name());
     }
 
     /// λ clamped to [0.36, 0.83] µm (NaN → 0.36).
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     fn clamped(lambda: f32) -> f32 {
         let (lo, hi) = (
@@ -341,6 +356,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// `Spectral::start` (F), `Spectral::terms`, `Spectral::at_lambda`.
     /// (Plain loops: `array::map`'s closures here were not inlined;
     /// docs/design/rgb-integration.md.)
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn eval4(&self, i: [f32; 3], o: [f32; 3], lambdas: [f32; 4]) -> [f32; 4] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 4];
@@ -399,6 +416,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// at `u = b cos θd/λ` from model `k`'s bake, which covers `[0, b/λ_k]`),
     /// σrel/σs and Q̄/F(θd) linear in λ between the models; the base lobes
     /// linear in λ.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     fn at_lambda(
         &self,
         pair: &Pair,
@@ -458,6 +477,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
 
     /// The model whose sampler serves `lambda`: the nearest of
     /// [`SAMPLER_NODES`] (the even ones), the lower on a tie.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     fn nearest(&self, lambda: f32) -> &TwoScale<'_, B> {
         let lambda = Self::clamped(lambda);
         // The even nodes around λ: `e` at or below the hats' cell, `e + 2`.
@@ -471,6 +492,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     }
 
     /// The density of [`Spectral::sample`] at `lambda`.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn pdf(&self, i: [f32; 3], o: [f32; 3], lambda: f32) -> f32 {
         self.nearest(lambda).pdf(i, o)
     }
@@ -478,6 +501,8 @@ impl<B: Borrow<ChannelBake>, T: Borrow<FresnelBake>> Spectral<'_, B, T> {
     /// Samples an outgoing direction for the (hero) wavelength `lambda`
     /// with the sampler of the nearest sampler model; the value is
     /// [`Spectral::eval`] at `lambda`.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     pub fn sample(&self, i: [f32; 3], u: [f32; 3], lambda: f32) -> Option<Sample> {
         let node = self.nearest(lambda);
         let (o, lobe) = node.sample_direction(i, u)?;

@@ -225,6 +225,8 @@ pub fn sanitised_wavelength(lambda: f32) -> f64 {
 /// slopes there are `log₂`'s (`1/ln 2` and `1/(2 ln 2)`). So it is exact at
 /// powers of two, has a continuous derivative, and is within 0.011 of `log₂ x`.
 /// Defined for normal `x > 0`; every finite input gives a finite output.
+///
+/// Mirrored in python/twoscale/drjit/math.py.
 #[inline]
 pub fn log2_axis(x: f32) -> f32 {
     let bits = x.to_bits();
@@ -282,6 +284,8 @@ const AXIS_C3: f32 = 1.5 * core::f32::consts::LOG2_E - 2.0;
 /// degree-7 polynomial of Abramowitz & Stegun 4.4.46, and `π − acos|x|`
 /// for `x < 0`. Absolute error ≤ 2.2e-8 (A&S give 2e-8; their 10-digit
 /// coefficients give 2.18e-8 at `x = 0`; tested against `acos`).
+///
+/// Mirrored in python/twoscale/drjit/math.py.
 #[inline]
 pub fn acos_approx(x: f64) -> f64 {
     let a = abs(x).min(1.0);

@@ -74,6 +74,8 @@ impl<'a> Epd<'a> {
     /// `tan²θ` is computed from the components, `(x² + y²) / z²`, not from
     /// `cos θ`: near the normal `1 − cos θ` loses all precision in f32, and for
     /// β = 0.002 that alone would make D wrong by percents.
+    ///
+    /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
     pub fn d(&self, m: [f32; 3]) -> f32 {
         let cos_theta = m[2];

@@ -405,6 +405,8 @@ impl QConstants {
     /// Q̄ from both directions' factors and `sin θi sin θo (cos φ, sin φ)`
     /// (its length is `sin θi sin θo`; φ is normalised out, φ = 0 when either
     /// sine is 0).
+    ///
+    /// Mirrored in python/twoscale/drjit/lobes.py.
     pub(crate) fn combine(&self, fi: &QFactors, fo: &QFactors, along: f64, across: f64) -> f64 {
         // With s² = along² + across² = (sin θi sin θo)², the bracket times s²
         // is a_i a_o along² + (a_i |U_o|² + |U_i|² a_o) across²

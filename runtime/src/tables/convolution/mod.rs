@@ -625,6 +625,8 @@ impl ConvSlice<'_> {
 pub const DEFAULT_CUBIC_AXES: [bool; 4] = [true, true, true, true];
 
 /// Catmull–Rom weights of nodes `i−1, i, i+1, i+2` at fraction `t` of cell `i`.
+///
+/// Mirrored in python/twoscale/drjit/lookups.py.
 #[inline]
 pub(crate) fn catmull_rom_weights(t: f32) -> [f32; 4] {
     let t2 = t * t;

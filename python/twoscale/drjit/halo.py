@@ -1,0 +1,129 @@
+"""The diffraction lobe's half-vector sampler (runtime/src/bake/halo.rs,
+`HaloBake`, `Azimuth`) in Dr.Jit: its density and draw."""
+
+import math
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+
+from .math import NEWTON_TOL, acos_approx, last_at_most, newton_in_bracket
+
+
+class Halo:
+    """`HaloBake::pdf` and `sample_h` over a :class:`~twoscale.drjit.lookups.Bakes`'
+    ``halo_*`` tables (a mixin of :class:`~twoscale.drjit.lobes.Channel`)."""
+
+    def _row_cell(self, wi):
+        """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
+        fraction `(u − u_j)/(u_j+1 − u_j)` (f64)."""
+        n_u = self.shapes["halo_u"][0]
+        u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_u_top)
+        j = last_at_most(
+            n_u - 1,
+            lambda j: dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u)) <= u, 6)
+        row = self._node_row(j, n_u)
+        u0 = dr.gather(mi.Float64, self.t["halo_u"], row)
+        inv_du = dr.gather(mi.Float64, self.t["halo_inv_du"], row)
+        return row, dr.clip((u - u0) * inv_du, 0.0, 1.0)
+
+    def _halo_zeta(self, row, k):
+        n_s = self.shapes["halo_zeta"][1]
+        return mi.Float64(dr.gather(mi.Float, self.t["halo_zeta"], row * n_s + k))
+
+    def _halo_cum(self, row, k):
+        n_s = self.shapes["halo_zeta"][1]
+        return dr.gather(mi.Float64, self.t["halo_cum"], row * n_s + k)
+
+    def _halo_coef(self, row, k):
+        """`[start, slope]` of row `row`'s cell `k` (f64)."""
+        n_s = self.shapes["halo_zeta"][1]
+        c = dr.gather(mi.Vector2f, self.t["halo_coef"], row * n_s + k)
+        column = self.columns["halo_coef"]
+        return mi.Float64(c[column["start"]]), mi.Float64(c[column["slope"]])
+
+    @staticmethod
+    def _azimuth(sin_i, cos_i, sin_h, cos_h):
+        """`halo::Azimuth::new`: `(H, [A₂, A₁, A₀], F(H))` of the azimuth law
+        `∝ (i·h)(cos θo)₊` and whether it exists (f64); `F(H)` from
+        `x = cos H` without a sine or cosine."""
+        a, b = sin_i * sin_h, cos_i * cos_h
+        kappa = cos_i / (2.0 * cos_h)
+        wide = b - a >= kappa
+        exists = (cos_h > 0.0) & (wide | (b + a > kappa))
+        x = dr.clip((kappa - b) / a, -1.0, 1.0)
+        big_h = dr.select(wide, math.pi, acos_approx(x))
+        sin = dr.select(wide, 0.0, dr.sqrt(dr.maximum(1.0 - x * x, 0.0)))
+        x = dr.select(wide, -1.0, x)
+        coef = (2.0 * cos_h * a * a, (4.0 * cos_h * b - cos_i) * a, (2.0 * cos_h * b - cos_i) * b)
+        half = 0.5 * coef[0] * (big_h + x * sin) + coef[1] * sin + coef[2] * big_h
+        return big_h, coef, half, exists & (half > 0.0)
+
+    @staticmethod
+    def _azimuth_cdf(coef, psi):
+        """`halo::cdf`: `A₂ (ψ + sin ψ cos ψ)/2 + A₁ sin ψ + A₀ ψ`."""
+        s, c = dr.sin(psi), dr.cos(psi)
+        return 0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
+
+    def _row_pdf(self, row, z):
+        """`HaloBake::row_pdf`: `(start_k + slope_k (ζ − ζ_k)) / M_j`."""
+        n_s = self.shapes["halo_zeta"][1]
+        k = last_at_most(n_s - 1, lambda k: self._halo_zeta(row, k) <= z, 8)
+        start, slope = self._halo_coef(row, k)
+        d = start + slope * (z - self._halo_zeta(row, k))
+        inv_total = dr.gather(mi.Float64, self.t["halo_inv_total"], row)
+        ok = z <= self._halo_zeta(row, n_s - 1)
+        return dr.select(ok, dr.maximum(d, 0.0) * inv_total, 0.0)
+
+    def halo_pdf(self, wi, sin_h, cos_h, cos_o):
+        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`, f64."""
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        _, _, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
+        zeta = sin_h * sin_h / (1.0 + cos_h)
+        j, t = self._row_cell(wi)
+        p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta), 0.0)
+        p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta), 0.0)
+        return dr.select(exists, p * dr.maximum(cos_o, 0.0) / (8.0 * half), 0.0)
+
+    def halo_sample(self, wi, pick, along):
+        """`HaloBake::sample_h`: a half-vector (f64) and whether the row had mass."""
+        below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
+        n_s = self.shapes["halo_zeta"][1]
+        j, t = self._row_cell(wi)
+        lower = pick < 1.0 - t
+        row = dr.select(lower, j, j + 1)
+        azimuth = dr.select(lower, pick / (1.0 - t), (pick - (1.0 - t)) / t)
+        azimuth = dr.clip(azimuth, 0.0, below_one)
+        total = self._halo_cum(row, n_s - 1)
+        target = along * total
+        k = last_at_most(n_s - 1, lambda k: self._halo_cum(row, k) <= target, 8)
+        rest = dr.maximum(target - self._halo_cum(row, k), 0.0)
+        start, slope = self._halo_coef(row, k)
+        z0, z1 = self._halo_zeta(row, k), self._halo_zeta(row, k + 1)
+        den = start + dr.sqrt(dr.maximum(start * start + 2.0 * slope * rest, 0.0))
+        s = dr.select(den > 0.0, 2.0 * rest / den, 0.0)
+        z = z0 + dr.minimum(s, z1 - z0)
+        cos_h = 1.0 - z
+        sin_h = dr.sqrt(dr.maximum(z * (2.0 - z), 0.0))
+        sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
+        side = dr.select(azimuth < 0.5, -1.0, 1.0)
+        rest = dr.select(azimuth < 0.5, 2.0 * azimuth, 2.0 * azimuth - 1.0)
+        big_h, coef, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
+        psi = side * self._solve_azimuth(coef, big_h, half, rest * half)
+        has = sin_i > 0.0
+        cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
+        sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
+        cp, sp = dr.cos(psi), dr.sin(psi)
+        h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
+                        sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
+        return h, (total > 0.0) & exists
+
+    @staticmethod
+    def _solve_azimuth(coef, big_h, half, target):
+        """`Azimuth::solve`: Newton's method in a shrinking bracket (a
+        symbolic loop, each lane until a step is ≤ `NEWTON_TOL`, at most 40 steps)."""
+        psi = dr.select(half > 0.0, big_h * dr.clip(target / half, 0.0, 1.0), 0.0)
+        return newton_in_bracket(
+            lambda psi: Halo._azimuth_cdf(coef, psi) - target,
+            lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
+            psi, mi.Float64(big_h), NEWTON_TOL)
