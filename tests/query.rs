@@ -252,8 +252,8 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
     };
     let (result, ..) = run("brdf", &options, "channel,ix,iy,iz,ox,oy,oz\n");
     let message = result.unwrap_err().to_string();
-    let uncovered = "--material: the f64 reference covers conductors without a Lambertian \
-                     term, and their energy compensation (multiple_scattering) without \
+    let uncovered = "--material: the f64 reference covers conductors (with a Lambertian term, \
+                     k_d/π), and their energy compensation (multiple_scattering) without \
                      diffraction (sigma_s = 0) at the paper's wavelengths";
     assert_eq!(message, uncovered);
     // The energy compensation of a surface with diffraction is refused too.
@@ -266,6 +266,67 @@ fn brdf_of_a_material_file_is_the_rgb_model() {
     };
     let (result, ..) = run("brdf", &options, "channel,ix,iy,iz,ox,oy,oz\n");
     assert_eq!(result.unwrap_err().to_string(), uncovered);
+}
+
+/// `query brdf --material FILE` of a conductor with a Lambertian term (what
+/// `python -m twoscale.fit` writes for a measured conductor): `table` is the
+/// RGB model bit for bit, `reference` the f64 reference plus k_d/π above
+/// the horizon, and both are 0 below it.
+#[test]
+fn brdf_of_a_conductor_with_a_lambertian_term() {
+    use twoscale::io::desc::MaterialDesc;
+    let text = "[material]\nbeta = 0.12\np = 1.3\neta = [[0.2, 3.0], [0.5, 2.5], [1.2, 1.9]]\n\
+                sigma_s = 0.02\nb = 3.0\nc = 2.2\nlambertian = 0.04\n";
+    let owned = MaterialDesc::from_toml_str(text).unwrap();
+    let desc = owned.get();
+    let options = query::Options {
+        material: Some(owned.clone()),
+        ..query::Options::default()
+    };
+    let pairs = [
+        ([0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
+        ([0.8, 0.0, 0.6], [0.1, 0.7, 0.7071]),
+        ([0.6, 0.0, 0.8], [0.6, 0.0, -0.8]),
+    ];
+    let mut input = String::from("channel,ix,iy,iz,ox,oy,oz\n");
+    for (i, o) in pairs {
+        for ch in 0..3 {
+            let v: Vec<String> = i
+                .iter()
+                .chain(&o)
+                .map(|x| f64::from(*x).to_string())
+                .collect();
+            input.push_str(&format!("{ch},{}\n", v.join(",")));
+        }
+    }
+    let (result, out, err) = run_with("brdf", &options, &input);
+    assert_eq!(result.unwrap().answered, 9, "{err}");
+    let set = twoscale::TableSet::open(suite::tables_dir()).unwrap();
+    let model = set.set().rgb(&desc.material, desc.options);
+    let mut surface = desc.material;
+    surface.layer.lambertian = 0.0;
+    let params = generator::reference::brdf::Params::rgb(&surface).unwrap();
+    let lambertian = 0.04f32 as f64 / std::f64::consts::PI;
+    for (k, row) in out.lines().skip(1).enumerate() {
+        let (i, o) = pairs[k / 3];
+        let fields: Vec<&str> = row.split(',').collect();
+        let table: f32 = fields[7].parse().unwrap();
+        assert_eq!(table.to_bits(), model.eval(i, o)[k % 3].to_bits(), "{row}");
+        let reference: f64 = fields[8].parse().unwrap();
+        let above = o[2] > 0.0;
+        let want = if above {
+            reference_total(&params[k % 3], i, o, &desc.options) + lambertian
+        } else {
+            0.0
+        };
+        assert_eq!(reference, want, "{row}");
+        // The term is what the rows differ by from the surface alone.
+        assert!(!above || reference > lambertian, "{row}");
+        assert!(
+            (f64::from(table) / reference - 1.0).abs() < 1e-3 || !above,
+            "{row}"
+        );
+    }
 }
 
 /// `query brdf --material FILE` with `multiple_scattering = "kulla-conty"`

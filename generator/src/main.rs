@@ -215,7 +215,7 @@ enum Command {
         clamp: bool,
         /// `brdf` of the material of this material file (TOML: a
         /// `[material]` table, what `python -m twoscale.fit` writes; a
-        /// conductor without a Lambertian term, as the reference covers):
+        /// conductor, its Lambertian term k_d/π added to the reference):
         /// the rows then give `channel,ix,iy,iz,ox,oy,oz` (channel 0, 1, 2:
         /// red, green, blue) and `table` is the RGB model's channel, or
         /// `lambda,ix,iy,iz,ox,oy,oz` (λ in [0.36, 0.83] µm) and `table` is

@@ -264,7 +264,8 @@ pub enum QueryError {
     ClampUnsupported(Quantity),
     /// `--material` was given for another quantity than `brdf`.
     MaterialUnsupported(Quantity),
-    /// The material of `--material` is one the reference does not cover.
+    /// The material of `--material` is one the reference does not cover
+    /// (a base layer, or the compensation of a surface with diffraction).
     Uncovered(brdf::Uncovered),
     /// The reference's compensation lobe of the `--material` could not be built.
     Reference(brdf::BrdfError),
@@ -311,7 +312,11 @@ impl fmt::Display for QueryError {
                 MATERIAL_COLUMNS.join(","),
                 q.name()
             ),
-            QueryError::Uncovered(e) => write!(f, "--material: {e}"),
+            QueryError::Uncovered(_) => f.write_str(
+                "--material: the f64 reference covers conductors (with a Lambertian term, \
+                 k_d/π), and their energy compensation (multiple_scattering) without \
+                 diffraction (sigma_s = 0) at the paper's wavelengths",
+            ),
             QueryError::Reference(e) => write!(f, "--material: the reference failed: {e}"),
             QueryError::IntegratedUnsupported => write!(
                 f,
@@ -531,6 +536,8 @@ enum MaterialModel<'a> {
         /// The reference's energy-compensation lobe per channel, when the
         /// material's options ask for it.
         compensation: Option<Box<[brdf::Compensation; 3]>>,
+        /// The Lambertian term k_d/π the reference adds.
+        lambertian: f64,
     },
     /// Rows of [`SPECTRAL_COLUMNS`]: the spectral model, and the reference's
     /// parameters with `n`, `k`, `λ` set per row from the material's index.
@@ -539,6 +546,8 @@ enum MaterialModel<'a> {
         spectral: SpectralMaterial<'a>,
         params: brdf::Params,
         options: twoscale::material::Options,
+        /// The Lambertian term k_d/π the reference adds.
+        lambertian: f64,
     },
 }
 
@@ -548,12 +557,13 @@ impl MaterialModel<'_> {
     fn evaluate(&self, x: &[f64]) -> Result<Vec<String>, RowError> {
         let (i, o) = ([x[1], x[2], x[3]], [x[4], x[5], x[6]]);
         let f = |v: f64| v as f32;
-        let (value, params, options, multiple) = match self {
+        let (value, params, options, multiple, lambertian) = match self {
             MaterialModel::Channels {
                 model,
                 params,
                 options,
                 compensation,
+                lambertian,
             } => {
                 let channel = x[0];
                 let ch = [0.0, 1.0, 2.0]
@@ -571,6 +581,7 @@ impl MaterialModel<'_> {
                     params[ch],
                     options,
                     multiple,
+                    *lambertian,
                 )
             }
             MaterialModel::Spectral {
@@ -578,6 +589,7 @@ impl MaterialModel<'_> {
                 spectral,
                 params,
                 options,
+                lambertian,
             } => {
                 let lambda = f(x[0]);
                 let (lo, hi) = (
@@ -598,12 +610,27 @@ impl MaterialModel<'_> {
                     lambda: lambda.into(),
                     ..*params
                 };
-                (model.eval(i.map(f), o.map(f), lambda), params, options, 0.0)
+                (
+                    model.eval(i.map(f), o.map(f), lambda),
+                    params,
+                    options,
+                    0.0,
+                    *lambertian,
+                )
             }
         };
         let reference = brdf::two_scale(&params, i, o, options)
             .map_err(|e| RowError::Reference(e.to_string()))?;
-        Ok(vec![short32(value), short(reference.total() + multiple)])
+        // k_d/π above the horizon, as the runtime (docs/model.md §2.6).
+        let lambertian = if i[2] > 0.0 && o[2] > 0.0 {
+            lambertian
+        } else {
+            0.0
+        };
+        Ok(vec![
+            short32(value),
+            short(reference.total() + multiple + lambertian),
+        ])
     }
 }
 
@@ -637,11 +664,16 @@ pub fn run(
         Some(_) if quantity != Quantity::Brdf => {
             return Err(QueryError::MaterialUnsupported(quantity));
         }
-        Some(desc) => Some((
-            desc.get(),
-            brdf::Params::rgb_with(&desc.get().material, &desc.get().options)
-                .map_err(QueryError::Uncovered)?,
-        )),
+        Some(desc) => {
+            // The reference's parameters of the surface; its Lambertian
+            // term is k_d/π in closed form, added per row.
+            let desc = desc.get();
+            let mut surface = desc.material;
+            surface.layer.lambertian = 0.0;
+            let params =
+                brdf::Params::rgb_with(&surface, &desc.options).map_err(QueryError::Uncovered)?;
+            Some((desc, params))
+        }
         None => None,
     };
     let mut lines = input.lines().enumerate();
@@ -708,21 +740,26 @@ pub fn run(
         None => None,
     };
     let material = match (params, &set) {
-        (Some((desc, params)), Some(set)) => Some(match desc.spectral {
-            Some(spectral) if spectral_rows => MaterialModel::Spectral {
-                model: Box::new(Spectral::boxed(&set.brdf_tables(), &spectral, desc.options)),
-                spectral,
-                params: params[0],
-                options: desc.options,
-            },
-            _ => MaterialModel::Channels {
-                model: Box::new(Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options)),
-                params,
-                options: desc.options,
-                compensation: brdf::Compensation::rgb(&params, &desc.options)
-                    .map_err(QueryError::Reference)?
-                    .map(Box::new),
-            },
+        (Some((desc, params)), Some(set)) => Some({
+            let lambertian = f64::from(desc.material.layer.lambertian) / std::f64::consts::PI;
+            match desc.spectral {
+                Some(spectral) if spectral_rows => MaterialModel::Spectral {
+                    model: Box::new(Spectral::boxed(&set.brdf_tables(), &spectral, desc.options)),
+                    spectral,
+                    params: params[0],
+                    options: desc.options,
+                    lambertian,
+                },
+                _ => MaterialModel::Channels {
+                    model: Box::new(Rgb::boxed(&set.brdf_tables(), &desc.material, desc.options)),
+                    params,
+                    options: desc.options,
+                    compensation: brdf::Compensation::rgb(&params, &desc.options)
+                        .map_err(QueryError::Reference)?
+                        .map(Box::new),
+                    lambertian,
+                },
+            }
         }),
         _ => None,
     };

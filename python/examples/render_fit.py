@@ -33,6 +33,7 @@ import numpy as np  # noqa: E402
 mi.set_variant("llvm_ad_rgb")
 
 import twoscale  # noqa: E402
+import twoscale.fit  # noqa: E402
 import twoscale.mitsuba as tm  # noqa: E402
 from fit_report import degrade, mitsuba_cases  # noqa: E402
 from render_presets import scene, write_png  # noqa: E402
@@ -62,7 +63,7 @@ def main():
             binary = pathlib.Path(tmp) / "measured.binary"
             merl.write(binary, values)
             t0 = time.perf_counter()
-            fitted = twoscale.fit(str(binary), base, verbose=False)
+            fitted = twoscale.fit.fit(str(binary), base, verbose=False)
             seconds = time.perf_counter() - t0
             params = pathlib.Path(tmp) / "params.toml"
             params.write_text(fitted.toml(), encoding="utf-8")

@@ -32,8 +32,9 @@ MATERIALS = {
                     base="plastic", albedo=0.7),
     "subsurface": dict(beta=0.05, p=1.0, eta=[(1.4, 0.0)] * 3, base="subsurface", albedo=0.9),
 }
-# What the generator's f64 reference covers (`query brdf --material`).
-CONDUCTORS = ["fit-conductor", "options"]
+# What the generator's f64 reference covers (`query brdf --material`):
+# conductors, with a Lambertian term as a fit of measured data has one.
+CONDUCTORS = ["fit-conductor", "options", "lambertian"]
 
 # Bad files: each refused by all three with one message.
 _OK = "beta = 0.1\np = 1\neta = [[1.5, 0], [1.5, 0], [1.5, 0]]\n"

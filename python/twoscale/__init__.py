@@ -4,7 +4,9 @@
 evaluated over NumPy arrays of directions; ``lookup`` holds the table
 lookups and ``reference`` the f64 reference of each quantity; ``mitsuba``
 registers a Mitsuba 3 BSDF (imported on first use of ``twoscale.mitsuba``:
-it needs the ``mitsuba`` package).
+it needs the ``mitsuba`` package); ``fit`` fits the model to a measured
+BRDF (``twoscale.fit.fit``, ``python -m twoscale.fit``; imported on first
+use of ``twoscale.fit``, with SciPy).
 
 Directions are unit vectors in the local frame (normal +z), arrays of shape
 ``(..., 3)`` that broadcast together as NumPy's do; ``wi`` points towards
@@ -23,7 +25,6 @@ from types import ModuleType
 
 from . import lookup, merl, reference
 from ._native import BASES, OPTIONS, RGB_MODES, RGB_WAVELENGTHS, Material
-from .fit import fit  # the function; the module runs as `python -m twoscale.fit`
 
 __all__ = [
     "BASES", "Material", "OPTIONS", "RGB_MODES", "RGB_WAVELENGTHS", "fit", "lookup", "merl",
@@ -37,7 +38,10 @@ __all__.append("__version__")
 
 
 def __getattr__(name: str) -> ModuleType:
-    """``twoscale.mitsuba`` without an explicit import (PEP 562)."""
-    if name == "mitsuba":
-        return importlib.import_module(".mitsuba", __name__)
+    """``twoscale.fit`` and ``twoscale.mitsuba`` without an explicit import
+    (PEP 562): not imported with the package, so ``import twoscale`` needs
+    neither SciPy's optimiser nor Mitsuba, and ``python -m twoscale.fit``
+    runs the module once."""
+    if name in ("fit", "mitsuba"):
+        return importlib.import_module("." + name, __name__)
     raise AttributeError(f"module 'twoscale' has no attribute '{name}'")

@@ -74,9 +74,14 @@ def encode(values, *, raw: bool = False) -> bytes:
 
 
 def read(path: str | os.PathLike, *, raw: bool = False) -> np.ndarray:
-    """``decode`` of the file at ``path``."""
+    """``decode`` of the file at ``path``; its ``ValueError`` starts with
+    the path (``OSError`` if the file cannot be read)."""
     with open(path, "rb") as f:
-        return decode(f.read(), raw=raw)
+        data = f.read()
+    try:
+        return decode(data, raw=raw)
+    except ValueError as e:
+        raise ValueError(f"{os.fspath(path)}: {e}") from None
 
 
 def write(path: str | os.PathLike, values, *, raw: bool = False) -> None:
