@@ -285,7 +285,7 @@ fn brdf_of_a_conductor_with_a_lambertian_term() {
     };
     let pairs = [
         ([0.5f32, 0.0, 0.866], [-0.45f32, 0.05, 0.89]),
-        ([0.8, 0.0, 0.6], [0.1, 0.7, 0.7071]),
+        ([0.8, 0.0, 0.6], [0.1, 0.7, 0.71]),
         ([0.6, 0.0, 0.8], [0.6, 0.0, -0.8]),
     ];
     let mut input = String::from("channel,ix,iy,iz,ox,oy,oz\n");
