@@ -56,10 +56,10 @@ pub const DEFAULT_SIZE: Size = Size {
 };
 
 /// Largest angle of a near-mirror exit direction from the mirror direction.
-const MIRROR_CAP_DEG: f64 = 5.0;
+pub const MIRROR_CAP_DEG: f64 = 5.0;
 /// A point or node counts where its reference is at least this fraction of
 /// its material's largest.
-const FLOOR: f64 = 1e-6;
+pub const FLOOR: f64 = 1e-6;
 
 /// One random material of the practical domain (module documentation).
 #[derive(Clone, Copy, Debug)]
@@ -155,7 +155,7 @@ fn near_mirror(rng: &mut SplitMix64, i: [f64; 3]) -> [f64; 3] {
 
 /// The pairs of directions of one material (module documentation): `i`
 /// by [`direction`], `o` by [`direction`] for even pairs, else
-/// [`near_mirror`] of `i`.
+/// a direction within [`MIRROR_CAP_DEG`] of the mirror direction of `i`.
 pub fn pairs(rng: &mut SplitMix64, count: usize) -> Vec<([f32; 3], [f32; 3])> {
     (0..count)
         .map(|k| {
