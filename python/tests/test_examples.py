@@ -46,6 +46,7 @@ def test_render_energy_writes_its_strip(tmp_path):
 # only shows when it runs (an OSError: status 1). The modules each needs.
 BAD_INPUT = {
     "benchmark_render.py": (["--size", "-5"], ["mitsuba"]),
+    "fit_recovery.py": (["--case", "nope"], ["scipy"]),
     "fit_report.py": (["--materials", "0"], ["scipy"]),
     "profile_drjit_bsdf.py": (["no-such-material"], ["mitsuba"]),
     "render_energy.py": (["--spp", "0"], ["mitsuba"]),
