@@ -214,6 +214,7 @@ struct LnC {
 impl BakeVisitor for LnC {
     fn scalar(&mut self, _name: &'static str, _value: f64) {}
     fn array_f64(&mut self, _name: &'static str, _dims: &[usize], _values: &[f64]) {}
+    fn array_u8(&mut self, _name: &'static str, _dims: &[usize], _values: &[u8]) {}
     fn columns(&mut self, _name: &'static str, _columns: &'static [&'static str]) {}
     fn named(&mut self, _name: &'static str, _value: &'static str) {}
     fn array(&mut self, name: &'static str, dims: &[usize], values: &[f32]) {

@@ -1096,6 +1096,11 @@ impl DictVisitor<'_> {
 }
 
 impl BakeVisitor for DictVisitor<'_> {
+    fn array_u8(&mut self, name: &'static str, shape: &[usize], data: &[u8]) {
+        let values: Vec<f32> = data.iter().map(|&x| f32::from(x)).collect();
+        self.array(name, shape, &values);
+    }
+
     fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]) {
         let array = shaped(self.dict.py(), shape, data.to_vec());
         let result = self.dict.set_item(name, array);
@@ -1139,6 +1144,11 @@ enum Quantity {
 struct Collected(Vec<(&'static str, Quantity)>);
 
 impl BakeVisitor for Collected {
+    fn array_u8(&mut self, name: &'static str, shape: &[usize], data: &[u8]) {
+        let values: Vec<f32> = data.iter().map(|&x| f32::from(x)).collect();
+        self.array(name, shape, &values);
+    }
+
     fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]) {
         self.0
             .push((name, Quantity::F32(shape.to_vec(), data.to_vec())));

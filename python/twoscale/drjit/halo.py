@@ -7,21 +7,36 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-from .math import NEWTON_TOL, acos_approx, last_at_most, newton_in_bracket
+from .math import NEWTON_TOL, acos_approx, log2_axis, newton_in_bracket
+from .visible import guide_bin, guide_scan
 
 
 class Halo:
     """`HaloBake::pdf` and `sample_h` over a :class:`~twoscale.drjit.lookups.Bakes`'
     ``halo_*`` tables (a mixin of :class:`~twoscale.drjit.lobes.Channel`)."""
 
+    @staticmethod
+    def _at_node(x, node, position, n):
+        """`halo::at_node`: the last node `k ≤ n − 2` with `node(k) ≤ x`
+        from a `position` within one node of it (the three nodes around
+        it gathered at once: no dependent second gather)."""
+        k = mi.UInt32(dr.clip(position, 0.0, float(n - 2)))
+        lower = (k > 0) & (x < node(k))
+        upper = (k + 2 < n) & (x >= node(dr.minimum(k + 1, n - 1)))
+        return dr.select(lower, k - 1, dr.select(upper, k + 1, k))
+
     def _row_cell(self, wi):
-        """`HaloBake::row_cell` at `u = B cos θi`: the row below and the
-        fraction `(u − u_j)/(u_j+1 − u_j)` (f64)."""
+        """`HaloBake::row_cell` at `u = B cos θi`: the row below (from the C
+        bake's u axis, as its own look-up finds it) and the fraction
+        `(u − u_j)/(u_j+1 − u_j)` (f64)."""
         n_u = self.shapes["halo_u"][0]
         u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_u_top)
-        j = last_at_most(
-            n_u - 1,
-            lambda j: dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u)) <= u, 6)
+        uf = mi.Float(u)
+        position = ((log2_axis(1.0 + uf / self.s["conv_u0"]) + uf * self.f["conv_u_linear"])
+                    * self.f["conv_u_scale"])
+        j = self._at_node(
+            u, lambda j: dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u)),
+            position, n_u)
         row = self._node_row(j, n_u)
         u0 = dr.gather(mi.Float64, self.t["halo_u"], row)
         inv_du = dr.gather(mi.Float64, self.t["halo_inv_du"], row)
@@ -65,10 +80,18 @@ class Halo:
         s, c = dr.sin(psi), dr.cos(psi)
         return 0.5 * coef[0] * (psi + s * c) + coef[1] * s + coef[2] * psi
 
-    def _row_pdf(self, row, z):
+    def _zeta_cell(self, row, z, sec_h, tan_h):
+        """`HaloBake::zeta_cell`: the cell of ζ in `row` from the C bake's θh
+        axis at `sec θh`, `tan θh` (f32), corrected by one node."""
+        n_s = self.shapes["halo_zeta"][1]
+        x = sec_h + tan_h * dr.gather(mi.Float, self.t["halo_row_inv_w"], row)
+        position = log2_axis(x) * dr.gather(mi.Float, self.t["halo_row_node_scale"], row)
+        return self._at_node(z, lambda k: self._halo_zeta(row, k), position, n_s)
+
+    def _row_pdf(self, row, z, sec_h, tan_h):
         """`HaloBake::row_pdf`: `(start_k + slope_k (ζ − ζ_k)) / M_j`."""
         n_s = self.shapes["halo_zeta"][1]
-        k = last_at_most(n_s - 1, lambda k: self._halo_zeta(row, k) <= z, 8)
+        k = self._zeta_cell(row, z, sec_h, tan_h)
         start, slope = self._halo_coef(row, k)
         d = start + slope * (z - self._halo_zeta(row, k))
         inv_total = dr.gather(mi.Float64, self.t["halo_inv_total"], row)
@@ -81,8 +104,11 @@ class Halo:
         _, _, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
         zeta = sin_h * sin_h / (1.0 + cos_h)
         j, t = self._row_cell(wi)
-        p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta), 0.0)
-        p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta), 0.0)
+        # The C bake's θh axis variables (`HaloBake::pdf_zeta`).
+        sec_h = 1.0 / dr.maximum(mi.Float(cos_h), 1e-3)
+        tan_h = dr.clip(mi.Float(sin_h), 0.0, 1.0) * sec_h
+        p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta, sec_h, tan_h), 0.0)
+        p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta, sec_h, tan_h), 0.0)
         return dr.select(exists, p * dr.maximum(cos_o, 0.0) / (8.0 * half), 0.0)
 
     def halo_sample(self, wi, pick, along):
@@ -96,7 +122,12 @@ class Halo:
         azimuth = dr.clip(azimuth, 0.0, below_one)
         total = self._halo_cum(row, n_s - 1)
         target = along * total
-        k = last_at_most(n_s - 1, lambda k: self._halo_cum(row, k) <= target, 8)
+        # The row's guide (`guide::scan` in `HaloBake::sample_h`).
+        edges = self.shapes["halo_guide"][1]
+        b = guide_bin(self.s, along)
+        lo = mi.UInt32(dr.gather(mi.Float, self.t["halo_guide"], row * edges + b))
+        hi = mi.UInt32(dr.gather(mi.Float, self.t["halo_guide"], row * edges + b + 1))
+        k = guide_scan(lo, hi, self._halo_scan_cells(), target, lambda k: self._halo_cum(row, k))
         rest = dr.maximum(target - self._halo_cum(row, k), 0.0)
         start, slope = self._halo_coef(row, k)
         z0, z1 = self._halo_zeta(row, k), self._halo_zeta(row, k + 1)
@@ -117,6 +148,13 @@ class Halo:
         h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
                         sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
         return h, (total > 0.0) & exists
+
+    def _halo_scan_cells(self):
+        """The widest bracket of the rows' guides: the fixed scan's length."""
+        if not hasattr(self, "_halo_scan"):
+            g = np.asarray(self.t["halo_guide"].numpy()).reshape(-1, self.shapes["halo_guide"][-1])
+            self._halo_scan = max(int(np.max(np.diff(g.astype(np.int64), axis=1))), 0)
+        return self._halo_scan
 
     @staticmethod
     def _solve_azimuth(coef, big_h, half, target):

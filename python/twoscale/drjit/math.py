@@ -1,6 +1,6 @@
 """The runtime's arithmetic (runtime/src/math/) in Dr.Jit: the cheap
-logarithm of the bakes' axes, the arc cosine, the bracketed Newton solve and
-the halving search that the samplers share."""
+logarithm of the bakes' axes, the arc cosine and the bracketed Newton solve
+that the samplers share."""
 
 import math
 
@@ -66,17 +66,6 @@ def newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
         body,
     )
     return t
-
-
-def last_at_most(n, below, steps):
-    """`visible::last_at_most`: the last `k < n` with `below(k)` (true at 0,
-    monotone), by halving (`steps ≥ ⌈log₂ n⌉`)."""
-    base, size = mi.UInt32(0), mi.UInt32(n)
-    for _ in range(steps):
-        half = size // 2
-        base = dr.select(below(base + half), base + half, base)
-        size -= half
-    return base
 
 
 def acos_approx(x):

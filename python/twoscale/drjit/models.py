@@ -196,7 +196,8 @@ class NodeChannel(Channel):
 
     # The tables read through `_node_row`: stacked even where the models agree.
     ROWS = ("direction_rows", "direction_weights", "conv_ln_c", "radial_inv_m", "halo_u",
-            "halo_inv_du", "halo_inv_total", "halo_zeta", "halo_coef", "halo_cum")
+            "halo_inv_du", "halo_inv_total", "halo_zeta", "halo_coef", "halo_cum", "halo_guide",
+            "halo_row_inv_w", "halo_row_node_scale")
 
     def __init__(self, models, per_node, count):
         clash = sorted(n for n in per_node if n in self.SHARED or n.startswith("visible_"))

@@ -5,8 +5,41 @@ import types
 
 import drjit as dr
 import mitsuba as mi
+import numpy as np
 
-from .math import NEWTON_TOL, last_at_most, log2_axis, newton_in_bracket
+from .math import NEWTON_TOL, log2_axis, newton_in_bracket
+
+
+def guide_bin(s, u):
+    """`guide::bin` of `u` (f64) on the guide axis of the constants `s`
+    (`guide_octaves`, `guide_linear`): `guide::position`, `e + f + octaves`
+    (`min(u, 1 − u) = 2^e (1 + f)`, floored at 0) plus `linear · min(u, 1 − u)`,
+    mirrored about `u = ½`. In f64: the bin must be the one whose edges
+    bracket `u` exactly (an f32 position could put `u` one bin off near an
+    edge, and its quantile outside the bracket)."""
+    octaves, linear = s["guide_octaves"], s["guide_linear"]
+    half_pos = octaves - 1.0 + 0.5 * linear
+    bins = int(2 * half_pos)
+    u = mi.Float64(u)
+    lower = u < 0.5
+    m = dr.maximum(dr.select(lower, u, 1.0 - u), 0.0)
+    bits = dr.reinterpret_array(mi.UInt64, m)
+    exponent = mi.Float64(mi.Int64((bits >> 52) & 0x7FF) - 1023)
+    frac = dr.reinterpret_array(mi.Float64, (bits & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000) - 1.0
+    half = dr.maximum(exponent + frac + octaves, 0.0) + linear * m
+    position = dr.select(lower, half, 2.0 * half_pos - half)
+    return mi.UInt32(dr.clip(position, 0.0, float(bins - 1)))
+
+
+def guide_scan(lo, hi, cells, target, cum):
+    """`guide::scan` with a fixed `cells` comparisons (the widest bracket
+    of the guide): `lo` plus the count of `k ∈ (lo, hi]` with `cum(k) ≤
+    target`, gathers that do not wait on one another."""
+    j = mi.UInt32(lo)
+    for step in range(1, cells + 1):
+        k = dr.minimum(lo + step, hi)
+        j += dr.select((lo + step <= hi) & (cum(k) <= target), 1, 0)
+    return j
 
 
 class Visible:
@@ -15,6 +48,24 @@ class Visible:
 
     def _visible_node(self, name, k):
         return dr.gather(mi.Float64, self.t[name], k)
+
+    def _visible_guide(self, name, k):
+        return mi.UInt32(dr.gather(mi.Float, self.t[name], k))
+
+    def _visible_scan_cells(self):
+        """The widest brackets of the marginal's and the conditional's guides
+        (`VisibleSlopeBake::marginal_bracket`, `conditional_bracket`): the
+        fixed scans' lengths, from the tables."""
+        if not hasattr(self, "_scan_cells"):
+            g = np.asarray(self.t["visible_marginal_guide"].numpy()).reshape(
+                self.shapes["visible_marginal_guide"]).astype(np.int64)
+            c = np.asarray(self.t["visible_conditional_guide"].numpy()).reshape(
+                self.shapes["visible_conditional_guide"]).astype(np.int64)
+            marginal = int(np.max(g[1:, 1:] - g[:-1, :-1]))
+            conditional = int(np.max(np.maximum(c[1:, 1:], c[:-1, 1:])
+                                     - np.minimum(c[1:, :-1], c[:-1, :-1])))
+            self._scan_cells = (max(marginal, 0), max(conditional, 0))
+        return self._scan_cells
 
     def _visible_locate(self, a, name, scale):
         """`visible::locate`: the cell `[a0, a1]` of the nodes `name` that
@@ -74,8 +125,13 @@ class Visible:
         tau_end = dr.select(reaches, mu - x0, self.d["visible_h_end"])
         norm = dr.select(reaches, self._visible_phi(c, sn, j_mu)
                          + self._visible_cell_integral(c, sn, x0, p0, k, mu - x0), phi_end)
+        # `VisibleSlopeBake::guide_incidence`: μ's row cell, or beyond r_max
+        # the cell of r_max/μ among the guide's tail nodes.
+        tail = self.shapes["visible_marginal_guide"][0] - rows_n
+        k_tail = mi.UInt32(dr.clip((1.0 - sn * r_max / c) * tail, 0.0, float(tail - 1)))
+        guide_a = dr.select(reaches, i_mu, rows_n - 1 + k_tail)
         return types.SimpleNamespace(c=c, sn=sn, length=length, t0=t0, t1=t1, j_end=j_end,
-                                     tau_end=tau_end, norm=norm)
+                                     tau_end=tau_end, norm=norm, guide_a=guide_a)
 
     def visible_pdf(self, wi, wo):
         """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
@@ -118,13 +174,18 @@ class Visible:
         (f64) from two uniforms, and whether the tables gave mass."""
         beta = self.d["visible_beta"]
         cols_n = self.shapes["visible_cols"][0]
-        x_nodes = self.shapes["visible_mass"][0]
         inc = self._visible_incidence(wi)
         c, sn = inc.c, inc.sn
         target = u0 * inc.norm
-        # The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0).
-        j = last_at_most(inc.j_end + 1, lambda j: self._visible_phi(c, sn, j) <= target,
-                          (x_nodes - 2).bit_length())
+        # The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0), in the
+        # guide's bracket (`VisibleSlopeBake::marginal_bracket`).
+        edges = self.shapes["visible_marginal_guide"][1]
+        scan_marginal, scan_conditional = self._visible_scan_cells()
+        b = guide_bin(self.s, u0)
+        hi = dr.minimum(self._visible_guide("visible_marginal_guide",
+                                            (inc.guide_a + 1) * edges + b + 1), inc.j_end)
+        lo = dr.minimum(self._visible_guide("visible_marginal_guide", inc.guide_a * edges + b), hi)
+        j = guide_scan(lo, hi, scan_marginal, target, lambda j: self._visible_phi(c, sn, j))
         x0, p0 = self._visible_node("visible_x", j), self._visible_node("visible_px", j)
         x1 = self._visible_node("visible_x", j + 1)
         h = x1 - x0
@@ -151,7 +212,13 @@ class Visible:
 
         signed = 2.0 * u1 - 1.0
         q = dr.abs(signed) * cum(cols_n - 1)
-        kk = last_at_most(cols_n - 1, lambda kc: cum(kc) <= q, (cols_n - 2).bit_length())
+        # `VisibleSlopeBake::conditional_bracket`: between the rows' own cells.
+        bq = guide_bin(self.s, dr.abs(signed))
+        gi = [self._visible_guide("visible_conditional_guide", i * edges + bq + d) for d in (0, 1)]
+        gn = [self._visible_guide("visible_conditional_guide", (i + 1) * edges + bq + d)
+              for d in (0, 1)]
+        kk = guide_scan(dr.minimum(gi[0], gn[0]), dr.maximum(gi[1], gn[1]), scan_conditional,
+                        q, cum)
         y0 = self._visible_node("visible_cols", kk)
         w = self._visible_node("visible_cols", kk + 1) - y0
         g0, g1 = dens(kk), dens(kk + 1)

@@ -26,7 +26,7 @@ const LINEAR_SHARE: f32 = 2.0;
 /// profile keeps narrowing; for large `B` the linear part is capped at twice
 /// the logarithmic one so that small `u` keeps its rows.
 #[inline]
-fn u_axis(u: f32, linear: f32) -> f32 {
+pub(crate) fn u_axis(u: f32, linear: f32) -> f32 {
     math::log2_axis(1.0 + u / U0) + u * linear
 }
 /// Smallest `cos θh` of [`ConvBake`]'s angle axis.
@@ -182,6 +182,11 @@ impl ConvBake {
         math::sqrtf(16.0 + v * v / (1.0 / 64.0 + nv * nv))
     }
 
+    /// The rows' axis: `(linear, scale)` with row `j` at `u_axis(u, linear) · scale = j`.
+    pub(crate) fn u_axis_constants(&self) -> (f32, f32) {
+        (self.u_linear, self.u_scale)
+    }
+
     /// Hands the axes' constants and the padded `ln C` grid to `v`
     /// (`conv_ln_c` `[35, 132]`, ghost nodes included; `conv_*` scalars,
     /// and the axes' constants `conv_u0`, `conv_cos_h_min`).
@@ -245,7 +250,7 @@ pub(crate) fn c_of_ln(ln_c: f32) -> f32 {
 
 /// The θh axis's value at `cos θh = 10⁻³` (its last node) for `1/w`.
 #[inline]
-fn angle_span(inv_w: f32) -> f32 {
+pub(crate) fn angle_span(inv_w: f32) -> f32 {
     math::log2_axis((1.0 + inv_w) * (1.0 / COS_H_MIN) as f32)
 }
 

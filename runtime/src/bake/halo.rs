@@ -39,7 +39,9 @@
 //! (`θh < 45° + θi/2`), and the lower row's weight is positive unless the
 //! incidence is the upper row's own.
 
-use crate::bake::{BakeVisitor, CONV_S_NODES, CONV_U_NODES, ConvBake, row_tans};
+use crate::bake::{
+    BakeVisitor, CONV_S_NODES, CONV_U_NODES, ConvBake, angle_span, guide, row_tans, u_axis,
+};
 
 /// ζ nodes per row: every other θh node of the C bake's row (and its last).
 const NODES: usize = CONV_S_NODES / 2 + 1;
@@ -49,13 +51,12 @@ const NODES: usize = CONV_S_NODES / 2 + 1;
 fn conv_node(k: usize) -> usize {
     (2 * k).min(CONV_S_NODES - 1)
 }
-use crate::bake::visible::last_at_most;
 use crate::math;
 use core::f64::consts::PI;
 use zerocopy::FromZeros;
 
 /// The halo sampler's per-row densities over `ζ = 1 − cos θh` (module
-/// documentation), as per-cell coefficients: 44 KB.
+/// documentation), as per-cell coefficients, with their guides: 48 KB.
 #[derive(Clone, Debug, FromZeros)]
 pub(crate) struct HaloBake {
     /// The `u` of each row (increasing from 0 to `B`).
@@ -74,6 +75,15 @@ pub(crate) struct HaloBake {
     cum: [[f64; NODES]; CONV_U_NODES],
     /// `1/M_j` (0 for a row without density).
     inv_total: [f64; CONV_U_NODES],
+    /// Each row's guide ([`guide`]) of `cum`.
+    guide: [[u8; guide::EDGES]; CONV_U_NODES],
+    /// `1/w` of each row's θh axis (the C bake's) and the halo nodes per unit
+    /// of `log2_axis(x)`, `x = (1 + sin θh / w)/cos θh`: the cell of ζ in O(1).
+    row_inv_w: [f32; CONV_U_NODES],
+    row_node_scale: [f32; CONV_U_NODES],
+    /// The rows' `u` axis of the C bake: `u_axis(u) · u_scale` is the row position.
+    u_linear: f32,
+    u_scale: f32,
 }
 
 impl HaloBake {
@@ -105,7 +115,19 @@ impl HaloBake {
                 }
             }
             self.set_row(j, &f, integral);
+            let inv_w = conv.row_inv_w[j];
+            self.row_inv_w[j] = inv_w;
+            // The halo's node k is the C bake's 2k (its last the C bake's last).
+            self.row_node_scale[j] = 0.5 * (CONV_S_NODES - 1) as f32 / angle_span(inv_w);
         }
+        for j in 0..CONV_U_NODES {
+            let cum = &self.cum[j];
+            guide::build(NODES, |k| cum[k], &mut self.guide[j]);
+        }
+        // The row axis: the C bake's u position, as `row_cell` reads it.
+        let (u_linear, u_scale) = conv.u_axis_constants();
+        self.u_linear = u_linear;
+        self.u_scale = u_scale;
         for j in 0..CONV_U_NODES {
             let du = if j + 1 < CONV_U_NODES {
                 self.u[j + 1] - self.u[j]
@@ -170,6 +192,13 @@ impl HaloBake {
         v.array_f64("halo_u", &[CONV_U_NODES], &self.u);
         v.array_f64("halo_inv_du", &[CONV_U_NODES], &self.inv_du);
         v.array_f64("halo_inv_total", &[CONV_U_NODES], &self.inv_total);
+        v.array_u8(
+            "halo_guide",
+            &[CONV_U_NODES, guide::EDGES],
+            self.guide.as_flattened(),
+        );
+        v.array("halo_row_inv_w", &[CONV_U_NODES], &self.row_inv_w);
+        v.array("halo_row_node_scale", &[CONV_U_NODES], &self.row_node_scale);
     }
 
     /// Draws `h` for the incidence `wi` and `u = B cos θi` from two
@@ -193,7 +222,12 @@ impl HaloBake {
             return None;
         }
         let target = along * total;
-        let k = last_at_most(NODES - 1, |k| cum[k] <= target);
+        let b = guide::bin(along);
+        let (lo, hi) = (
+            usize::from(self.guide[row][b]),
+            usize::from(self.guide[row][b + 1]),
+        );
+        let k = guide::scan(lo, hi, target, |k| cum[k]);
         // ∫₀^s (start + slope x) dx = rest, the root in [0, Δζ].
         let rest = (target - cum[k]).max(0.0);
         let (start, slope) = (f64::from(coef[k][0]), f64::from(coef[k][1]));
@@ -239,18 +273,22 @@ impl HaloBake {
         };
         let zeta = sin_h * sin_h / (1.0 + cos_h);
         // N(θh) = 2 F(H).
-        self.pdf_zeta(u_i, zeta) * cos_o.max(0.0) / (8.0 * law.half)
+        self.pdf_zeta(u_i, zeta, sin_h, cos_h) * cos_o.max(0.0) / (8.0 * law.half)
     }
 
-    /// The density of ζ drawn for `u = B cos θi`, `Σ_j w_j p_j(ζ)`.
-    fn pdf_zeta(&self, u_i: f64, zeta: f64) -> f64 {
+    /// The density of ζ drawn for `u = B cos θi`, `Σ_j w_j p_j(ζ)`, at the
+    /// half-vector of `sin θh`, `cos θh`.
+    fn pdf_zeta(&self, u_i: f64, zeta: f64, sin_h: f64, cos_h: f64) -> f64 {
         let (j, t) = self.row_cell(u_i);
+        // The C bake's θh axis variables (as `ConvBake::ln_at`).
+        let sec_h = 1.0 / (cos_h as f32).max(1e-3);
+        let tan_h = (sin_h as f32).max(0.0).min(1.0) * sec_h;
         let mut p = 0.0;
         if t < 1.0 {
-            p += (1.0 - t) * self.row_pdf(j, zeta);
+            p += (1.0 - t) * self.row_pdf(j, zeta, sec_h, tan_h);
         }
         if t > 0.0 {
-            p += t * self.row_pdf(j + 1, zeta);
+            p += t * self.row_pdf(j + 1, zeta, sec_h, tan_h);
         }
         p
     }
@@ -262,9 +300,24 @@ impl HaloBake {
     #[inline]
     fn row_cell(&self, u: f64) -> (usize, f64) {
         let u = u.max(0.0).min(self.u[CONV_U_NODES - 1]);
-        let j = last_at_most(CONV_U_NODES - 1, |j| self.u[j] <= u);
+        let j = at_node(u, &self.u, u_axis(u as f32, self.u_linear) * self.u_scale);
         let t = ((u - self.u[j]) * self.inv_du[j]).max(0.0).min(1.0);
         (j, t)
+    }
+
+    /// The cell of `z = ζ` in row `j` from the C bake's θh axis at `sec θh`,
+    /// `tan θh` (f32, as `ConvBake::ln_at` computes them), corrected by one
+    /// node where it and the nodes disagree.
+    ///
+    /// Mirrored in python/twoscale/drjit/halo.py.
+    #[inline]
+    fn zeta_cell(&self, j: usize, z: f64, sec_h: f32, tan_h: f32) -> usize {
+        let x = sec_h + tan_h * self.row_inv_w[j];
+        at_node(
+            z,
+            &self.zeta[j],
+            math::log2_axis(x) * self.row_node_scale[j],
+        )
     }
 
     /// `p_j(ζ) = (start_k + slope_k (ζ − ζ_k)) / M_j` of row `j` on its cell
@@ -272,16 +325,32 @@ impl HaloBake {
     ///
     /// Mirrored in python/twoscale/drjit/halo.py.
     #[inline]
-    fn row_pdf(&self, j: usize, z: f64) -> f64 {
+    fn row_pdf(&self, j: usize, z: f64, sec_h: f32, tan_h: f32) -> f64 {
         let zeta = &self.zeta[j];
         if !(z <= f64::from(zeta[NODES - 1])) {
             return 0.0;
         }
-        let k = last_at_most(NODES - 1, |k| f64::from(zeta[k]) <= z);
+        let k = self.zeta_cell(j, z, sec_h, tan_h);
         let [start, slope] = self.coef[j][k];
         let d = f64::from(start) + f64::from(slope) * (z - f64::from(zeta[k]));
         d.max(0.0) * self.inv_total[j]
     }
+}
+
+/// The last node `k ≤ N − 2` with `nodes[k] ≤ x` (`nodes` increasing, `x`
+/// within them) from an estimate `position` of `x` in nodes that is within
+/// one node of it.
+///
+/// Mirrored in python/twoscale/drjit/halo.py.
+#[inline]
+fn at_node<T: Copy + Into<f64>, const N: usize>(x: f64, nodes: &[T; N], position: f32) -> usize {
+    let mut k = (position.max(0.0) as usize).min(N - 2);
+    if k > 0 && x < nodes[k].into() {
+        k -= 1;
+    } else if k + 2 < N && x >= nodes[k + 1].into() {
+        k += 1;
+    }
+    k
 }
 
 /// The azimuth law of `h` about the normal for the incidence
@@ -549,5 +618,69 @@ mod tests {
                 "{worst:?}"
             );
         }
+    }
+
+    /// The O(1) cells (rows from the u axis, ζ cells from the θh axis, the
+    /// draw's cell from the guide) are the binary search's, for the
+    /// materials of the Jacobian test, at random `u`, θh and uniforms; and
+    /// the guides' brackets stay short.
+    #[test]
+    fn cells_are_the_searched_ones() {
+        use crate::bake::visible::last_at_most;
+        let set = TableSet::embedded();
+        let mut rng = Lcg(31);
+        let mut halo = HaloBake::new_zeroed();
+        let mut widest = 0u8;
+        for &(c, beta, p, big_b) in &[
+            (2.0f32, 0.0598f32, 1.0f32, 9.2f32),
+            (1.6, 0.1, 1.0, 5.5),
+            (2.0, 0.01, 1.0, 1.8),
+            (2.0, 0.5, 1.0, 36.0),
+            (2.5, 0.35, 1.5, 12.0),
+        ] {
+            let slice = set.convolution.slice(c, beta, p).unwrap();
+            let conv = ConvBake::new(&slice, big_b, beta, p).unwrap();
+            halo.init(&conv, &|cos_i, cos_d, cos_o, _, _| {
+                (0.5 + cos_i) * cos_d * (0.2 + cos_o.max(0.0))
+            });
+            for g in &halo.guide {
+                for b in 0..guide::BINS {
+                    widest = widest.max(g[b + 1] - g[b]);
+                }
+            }
+            for _ in 0..20_000 {
+                let u = f64::from(big_b) * rng.next();
+                let (j, _) = halo.row_cell(u);
+                assert_eq!(
+                    j,
+                    last_at_most(CONV_U_NODES - 1, |j| halo.u[j] <= u),
+                    "u {u}"
+                );
+                let row = (rng.next() * CONV_U_NODES as f64) as usize;
+                let zeta = &halo.zeta[row];
+                let z = f64::from(zeta[NODES - 1]) * rng.next().powi(3);
+                let (cos_h, sin_h) = (1.0 - z, (z * (2.0 - z)).sqrt());
+                let sec = 1.0 / (cos_h as f32).max(1e-3);
+                let k = halo.zeta_cell(row, z, sec, sin_h as f32 * sec);
+                assert_eq!(
+                    k,
+                    last_at_most(NODES - 1, |k| f64::from(zeta[k]) <= z),
+                    "z {z}"
+                );
+                let cum = &halo.cum[row];
+                let along = rng.next();
+                let target = along * cum[NODES - 1];
+                let b = guide::bin(along);
+                let (lo, hi) = (
+                    usize::from(halo.guide[row][b]),
+                    usize::from(halo.guide[row][b + 1]),
+                );
+                let k = guide::scan(lo, hi, target, |k| cum[k]);
+                let searched = last_at_most(NODES - 1, |k| cum[k] <= target);
+                assert!(k == searched || (cum[k.max(searched)] - target).abs() <= 1e-14);
+            }
+        }
+        std::eprintln!("widest bracket {widest}");
+        assert!(widest <= 6, "{widest}");
     }
 }

@@ -32,6 +32,7 @@
 
 mod conv;
 mod direction;
+pub(crate) mod guide;
 pub(crate) mod halo;
 mod masking;
 mod radial;
@@ -83,6 +84,8 @@ pub trait BakeVisitor {
     fn array(&mut self, name: &'static str, shape: &[usize], data: &[f32]);
     /// An f64 array of `shape` (row-major).
     fn array_f64(&mut self, name: &'static str, shape: &[usize], data: &[f64]);
+    /// An array of cell indices of `shape` (row-major; the samplers' guides).
+    fn array_u8(&mut self, name: &'static str, shape: &[usize], data: &[u8]);
     /// A scalar.
     fn scalar(&mut self, name: &'static str, value: f64);
     /// The names of the columns (the last axis) of the array `name`, in

@@ -34,6 +34,7 @@
 //! rate (`1 − O(1e-7)` of sampled normals reflect below the horizon or
 //! nowhere).
 
+use crate::bake::guide;
 use crate::math;
 use crate::math::gamma::GammaShape;
 use zerocopy::FromZeros;
@@ -46,6 +47,13 @@ pub(crate) const COLS: usize = 48;
 const X_NODES: usize = 2 * ROWS - 1;
 /// The EPD's radial tail mass left outside the tables.
 const TAIL_MASS: f64 = 1e-7;
+/// Incidence nodes of the marginal's guide beyond `μ = r_max`, even in
+/// `r_max/μ` (`μ = c/s = cot θ'` of the stretched incidence).
+const GUIDE_TAIL: usize = 8;
+/// Incidence nodes of the marginal's guide: `μ` at each row node (the rows
+/// are the x̃ nodes, where the marginal's shape changes), then
+/// [`GUIDE_TAIL`] more up to `μ = ∞`.
+const GUIDE_INCIDENCES: usize = ROWS + GUIDE_TAIL;
 
 /// The tabulated visible-slope sampler at one (β, p) (module documentation).
 #[derive(Clone, Debug, FromZeros)]
@@ -69,6 +77,11 @@ pub(crate) struct VisibleSlopeBake {
     dens: [[f32; COLS]; ROWS],
     /// Its integral from 0 to each column (of the f32 densities, in f64).
     cum: [[f64; COLS]; ROWS],
+    /// The marginal's guide ([`guide`]) at each incidence node `μ_a`: the
+    /// cell of `Φ`'s quantile at each edge.
+    marginal_guide: [[u8; guide::EDGES]; GUIDE_INCIDENCES],
+    /// The conditional's guide per row.
+    conditional_guide: [[u8; guide::EDGES]; ROWS],
 }
 
 /// The stretched incidence: `c = cos θ'`, `s = sin θ'`, `|i'|` and the unit
@@ -192,6 +205,83 @@ impl VisibleSlopeBake {
             bake.moment[j + 1] =
                 bake.moment[j] + h * (0.5 * x0 * (p0 + p1) + h * (p0 + 2.0 * p1) / 6.0);
         }
+        bake.init_guides();
+    }
+
+    /// The guides of the marginal and the conditional (after the tables).
+    ///
+    /// The marginal's quantile at `u` increases with `μ = c/s` (its density
+    /// `(μ − x̃)₊ P2_tab` has a likelihood ratio between two `μ` increasing
+    /// in `x̃`), so for `μ` in `[μ_a, μ_{a+1}]` and `u` in bin `b` its cell
+    /// lies in `[G_{a, b}, G_{a+1, b+1}]`. A blend of two conditional rows
+    /// has its quantile between the rows' own.
+    fn init_guides(&mut self) {
+        let r_max = self.rows[ROWS - 1];
+        for a in 0..GUIDE_INCIDENCES {
+            // Φ is homogeneous in (c, s): (μ, 1) stands for them, (1, 0) at μ = ∞.
+            let (c, s) = if a < ROWS {
+                (self.rows[a], 1.0)
+            } else {
+                let k = a + 1 - ROWS;
+                let w = (GUIDE_TAIL - k) as f64 / GUIDE_TAIL as f64;
+                if w > 0.0 { (r_max, w) } else { (1.0, 0.0) }
+            };
+            let st = Stretched {
+                c,
+                s,
+                len: 1.0,
+                t: [1.0, 0.0],
+            };
+            let (j_end, _, norm) = self.extent(&st);
+            let phi = |k: usize| {
+                if k <= j_end {
+                    self.phi_node(st.c, st.s, k)
+                } else {
+                    norm
+                }
+            };
+            let mut row = [0u8; guide::EDGES];
+            guide::build(j_end + 2, phi, &mut row);
+            self.marginal_guide[a] = row;
+        }
+        for i in 0..ROWS {
+            let cum = &self.cum[i];
+            guide::build(COLS, |k| cum[k], &mut self.conditional_guide[i]);
+        }
+    }
+
+    /// The marginal's cells for incidence cell `a` and bin `b`, the last
+    /// clamped to `j_end`.
+    #[inline]
+    fn marginal_bracket(&self, a: usize, b: usize, j_end: usize) -> (usize, usize) {
+        let hi = usize::from(self.marginal_guide[a + 1][b + 1]).min(j_end);
+        let lo = usize::from(self.marginal_guide[a][b]).min(hi);
+        (lo, hi)
+    }
+
+    /// The columns of the blend of rows `i`, `i + 1` for bin `b`.
+    #[inline]
+    fn conditional_bracket(&self, i: usize, b: usize) -> (usize, usize) {
+        let (gi, gn) = (&self.conditional_guide[i], &self.conditional_guide[i + 1]);
+        (
+            usize::from(gi[b].min(gn[b])),
+            usize::from(gi[b + 1].max(gn[b + 1])),
+        )
+    }
+
+    /// The incidence cell of the marginal's guide for the stretched `(c, s)`
+    /// whose marginal ends in cell `j_end`: `μ`'s row cell where `μ < r_max`
+    /// (which [`VisibleSlopeBake::extent`] found), else the cell of
+    /// `r_max/μ`.
+    #[inline]
+    fn guide_incidence(&self, c: f64, s: f64, j_end: usize) -> usize {
+        let r_max = self.rows[ROWS - 1];
+        if s * r_max > c {
+            j_end + 1 - ROWS
+        } else {
+            let k = ((1.0 - s * r_max / c) * GUIDE_TAIL as f64) as usize;
+            ROWS - 1 + k.min(GUIDE_TAIL - 1)
+        }
     }
 
     /// Hands the tables to `v` (`visible_*`: β, the axis constants, the
@@ -209,6 +299,17 @@ impl VisibleSlopeBake {
         v.array_f64("visible_moment", &[X_NODES], &self.moment);
         v.array("visible_dens", &[ROWS, COLS], self.dens.as_flattened());
         v.array_f64("visible_cum", &[ROWS, COLS], self.cum.as_flattened());
+        guide::visit(v);
+        v.array_u8(
+            "visible_marginal_guide",
+            &[GUIDE_INCIDENCES, guide::EDGES],
+            self.marginal_guide.as_flattened(),
+        );
+        v.array_u8(
+            "visible_conditional_guide",
+            &[ROWS, guide::EDGES],
+            self.conditional_guide.as_flattened(),
+        );
     }
 
     /// The `x̃` node `j` (`j = ROWS − 1` is 0).
@@ -341,8 +442,10 @@ impl VisibleSlopeBake {
             return None;
         }
         let target = u[0] * norm;
-        // The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0).
-        let j = last_at_most(j_end + 1, |j| self.phi_node(c, s, j) <= target);
+        // The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0), in the guide's bracket.
+        let a = self.guide_incidence(c, s, j_end);
+        let (lo, hi) = self.marginal_bracket(a, guide::bin(u[0]), j_end);
+        let j = guide::scan(lo, hi, target, |j| self.phi_node(c, s, j));
         let (x0, h, p0, k) = self.x_cell(j);
         let tau_max = if j == j_end { tau_end } else { h };
         let rest = target - self.phi_node(c, s, j);
@@ -362,7 +465,8 @@ impl VisibleSlopeBake {
         let (di, dn) = (&self.dens[i], &self.dens[i + 1]);
         let signed = 2.0 * u[1] - 1.0;
         let q = signed.abs() * blend(ci[COLS - 1], cn[COLS - 1]);
-        let kk = last_at_most(COLS - 1, |k| blend(ci[k], cn[k]) <= q);
+        let (lo, hi) = self.conditional_bracket(i, guide::bin(signed.abs()));
+        let kk = guide::scan(lo, hi, q, |k| blend(ci[k], cn[k]));
         let w = self.cols[kk + 1] - self.cols[kk];
         let g0 = blend(f64::from(di[kk]), f64::from(dn[kk]));
         let g1 = blend(f64::from(di[kk + 1]), f64::from(dn[kk + 1]));
@@ -443,10 +547,8 @@ impl VisibleSlopeBake {
 }
 
 /// The last index `k < n` with `below(k)` (`below` true at 0 and
-/// monotone), by halving without data-dependent branches.
-///
-/// Mirrored in python/twoscale/drjit/math.py.
-#[inline]
+/// monotone), by halving: the reference the guides are tested against.
+#[cfg(test)]
 pub(crate) fn last_at_most(n: usize, below: impl Fn(usize) -> bool) -> usize {
     let (mut base, mut len) = (0usize, n);
     while len > 1 {
@@ -589,6 +691,64 @@ mod tests {
             worst.3
         );
         assert!(q(0.99) < 3e-5 && worst.0 < 1e-3, "{worst:?}");
+    }
+
+    /// The guides' cells are the binary search's, over p ∈ [0.2, 5] (the
+    /// tables depend on p only), θi to 89.9° and random `u`; and the
+    /// brackets stay short (the scan's comparisons, `scan_cells`).
+    #[test]
+    fn guides_find_the_searched_cells() {
+        let mut rng = Lcg(29);
+        let (mut widest, mut mismatches, mut n) = ([0u8; 2], 0usize, 0usize);
+        for step in 0..=48 {
+            let p = 0.2 * 25.0f32.powf(step as f32 / 48.0);
+            let bake = VisibleSlopeBake::new(0.5, p);
+            for b in 0..guide::BINS {
+                for a in 0..GUIDE_INCIDENCES - 1 {
+                    let (lo, hi) = bake.marginal_bracket(a, b, X_NODES - 2);
+                    widest[0] = widest[0].max((hi - lo) as u8);
+                }
+                for i in 0..ROWS - 1 {
+                    let (lo, hi) = bake.conditional_bracket(i, b);
+                    widest[1] = widest[1].max((hi - lo) as u8);
+                }
+            }
+            for _ in 0..2000 {
+                let theta = 89.9 * rng.next().powf(0.5);
+                let inc = bake.incidence(unit(theta, 0.0));
+                let (c, s) = (inc.st.c, inc.st.s);
+                let u = [rng.next(), rng.next()];
+                let target = u[0] * inc.norm;
+                let searched = last_at_most(inc.j_end + 1, |j| bake.phi_node(c, s, j) <= target);
+                let a = bake.guide_incidence(c, s, inc.j_end);
+                let (lo, hi) = bake.marginal_bracket(a, guide::bin(u[0]), inc.j_end);
+                let j = guide::scan(lo, hi, target, |j| bake.phi_node(c, s, j));
+                // A different cell only where the target is a node's Φ to rounding.
+                if j != searched {
+                    let gap = (bake.phi_node(c, s, j.max(searched)) - target).abs();
+                    assert!(
+                        gap <= 1e-14 * inc.norm,
+                        "p {p} θ {theta} u {u:?}: {j} {searched}"
+                    );
+                    mismatches += 1;
+                }
+                let i = (rng.next() * (ROWS - 1) as f64) as usize;
+                let lambda = rng.next();
+                let blend =
+                    |k: usize| bake.cum[i][k] + lambda * (bake.cum[i + 1][k] - bake.cum[i][k]);
+                let q = u[1] * blend(COLS - 1);
+                let searched = last_at_most(COLS - 1, |k| blend(k) <= q);
+                let (lo, hi) = bake.conditional_bracket(i, guide::bin(u[1]));
+                let k = guide::scan(lo, hi, q, blend);
+                if k != searched {
+                    assert!((blend(k.max(searched)) - q).abs() <= 1e-14, "p {p} row {i}");
+                    mismatches += 1;
+                }
+                n += 2;
+            }
+        }
+        std::eprintln!("{n} cells, {mismatches} at a node's rounding; widest brackets {widest:?}");
+        assert!(widest[0] <= 6 && widest[1] <= 6, "{widest:?}");
     }
 
     /// The tables' cost in variance: the relative variance of `D(m) / pdf`

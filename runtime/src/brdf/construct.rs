@@ -78,7 +78,7 @@ impl<'a> TwoScale<'a> {
     /// The model for `layer` at wavelength `lambda` (µm) and index `eta`.
     /// Construct once per material and wavelength: it bakes the tables of
     /// [`ChannelBake`] (cost: `cargo bench --bench brdf -- construct`). The
-    /// value is 122 KB: on small stacks use `TwoScale::boxed` or
+    /// value is 141 KB: on small stacks use `TwoScale::boxed` or
     /// [`TwoScale::new_in`].
     ///
     /// Sanitising: β and p as [`Epd::new`]; σs, b negative or NaN → 0; c NaN

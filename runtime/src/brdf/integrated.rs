@@ -226,7 +226,7 @@ pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
 /// [`INTEGRATED_WAVELENGTHS`] sharing the surface's bakes, and the colour
 /// weights. The bakes are held as `B` as [`super::Rgb`]'s: boxed
 /// (`IntegratedRgb::boxed`, feature `std`) or in caller-provided storage
-/// ([`IntegratedRgb::new_in`]); 984 KB by value (8 models of 122 KB, the colour weights 6 KB).
+/// ([`IntegratedRgb::new_in`]); 1 136 KB by value (8 models of 141 KB, the colour weights 6 KB).
 #[derive(Clone)]
 pub struct IntegratedRgb<'a, B = ChannelBake> {
     nodes: [TwoScale<'a, B>; INTEGRATED_COUNT],

@@ -199,8 +199,8 @@ fn exp_and_one_minus_over(x: f64, s: f64) -> (f64, f64) {
 /// What a [`TwoScale`] bakes for its material and wavelength (F, Q̄'s
 /// factors and σrel over `cos θ`, G1 over the slope, the sampler's
 /// visible-slope density, and C over `(u, θh)` when the source of C is T3b;
-/// modules `bake`, `visible` and `halo`): 122 KB of plain numbers (the
-/// visible-slope tables 40 KB, the halo sampler's densities 44 KB, C 19 KB,
+/// modules `bake`, `visible` and `halo`): 141 KB of plain numbers (the
+/// visible-slope tables 55 KB, the halo sampler's densities 48 KB, C 19 KB,
 /// the direction bake 12 KB, G1 4 KB, the diffraction sampler's `1/M` 2 KB).
 ///
 /// All zeros is a valid (empty) value, so storage can be allocated zeroed on
@@ -242,7 +242,7 @@ impl ChannelBake {
         })
     }
 
-    /// Empty storage by value (122 KB on the caller's stack).
+    /// Empty storage by value (141 KB on the caller's stack).
     pub fn zeroed() -> ChannelBake {
         ChannelBake::new_zeroed()
     }
@@ -264,7 +264,7 @@ impl ChannelBake {
 ///
 /// Construction bakes what depends only on the material and wavelength into
 /// a [`ChannelBake`] (so that `eval` reads small tables), held as `B`: by
-/// value (the default, 122 KB; [`TwoScale::new`]), boxed
+/// value (the default, 141 KB; [`TwoScale::new`]), boxed
 /// (`TwoScale::boxed`, feature `std`) or borrowed (`&mut ChannelBake`),
 /// any `B: Borrow<ChannelBake>`; [`Rgb`] is three of them. `Clone` (when `B`
 /// is), not `Copy`.

@@ -16,7 +16,7 @@ use core::borrow::{Borrow, BorrowMut};
 /// The model at the three [`RGB_WAVELENGTHS`], one complex index per channel.
 /// The channels share the geometry, D and G of each evaluation (they must
 /// share the surface, as [`Rgb::new`] makes them). The bakes are held as `B`,
-/// as [`TwoScale`]'s: by value ([`Rgb::new`], 367 KB), boxed (`Rgb::boxed`)
+/// as [`TwoScale`]'s: by value ([`Rgb::new`], 424 KB), boxed (`Rgb::boxed`)
 /// or in caller-provided storage ([`Rgb::new_in`]).
 #[derive(Clone)]
 pub struct Rgb<'a, B = ChannelBake> {
@@ -37,7 +37,7 @@ pub struct RgbSample {
 
 impl<'a> Rgb<'a> {
     /// The three channels of `material` at [`RGB_WAVELENGTHS`]. The value is
-    /// 367 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
+    /// 424 KB: on small stacks use `Rgb::boxed` or [`Rgb::new_in`].
     pub fn new(tables: &Tables<'a>, material: &Material, options: Options) -> Self {
         let bakes = [
             ChannelBake::zeroed(),
