@@ -153,7 +153,10 @@ class Halo:
         """The widest bracket of the rows' guides: the fixed scan's length."""
         if not hasattr(self, "_halo_scan"):
             g = np.asarray(self.t["halo_guide"].numpy()).reshape(-1, self.shapes["halo_guide"][-1])
-            self._halo_scan = max(int(np.max(np.diff(g.astype(np.int64), axis=1))), 0)
+            widths = np.diff(g.astype(np.float64), axis=1)
+            # Models no lane reads may hold anything (NaN where a test poisons them).
+            widths = widths[np.isfinite(widths)]
+            self._halo_scan = int(widths.max()) if widths.size else 0
         return self._halo_scan
 
     @staticmethod

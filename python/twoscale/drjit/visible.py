@@ -54,7 +54,7 @@ class Visible:
 
     def _visible_scan_cells(self):
         """The widest brackets of the marginal's and the conditional's guides
-        (`VisibleSlopeBake::marginal_bracket`, `conditional_bracket`): the
+        (`VisibleSlopeBake::marginal_bracket`, `VisibleSlopeBake::conditional_bracket`): the
         fixed scans' lengths, from the tables."""
         if not hasattr(self, "_scan_cells"):
             g = np.asarray(self.t["visible_marginal_guide"].numpy()).reshape(

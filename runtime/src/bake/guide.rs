@@ -64,10 +64,16 @@ pub(crate) const fn position(u: f64) -> f64 {
     }
 }
 
-/// The bin of `u` (`0 … BINS − 1`).
+/// The bin of `u` (`0 … BINS − 1`): `⌊position⌋` by the rounding trick
+/// of `bake::cell_at` in f64 (a tie, `u` on an edge, may give the bin
+/// below, whose bracket holds that edge's cell too).
+///
+/// Mirrored in python/twoscale/drjit/visible.py.
 #[inline]
 pub(crate) fn bin(u: f64) -> usize {
-    (position(u) as usize).min(BINS - 1)
+    const ROUNDER: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
+    let rounded = (position(u) - 0.5) + ROUNDER;
+    (rounded.to_bits().wrapping_sub(ROUNDER.to_bits()) as i64).clamp(0, BINS as i64 - 1) as usize
 }
 
 /// The partition's edges: `e_b` the least f64 with `position(e_b) ≥ b`
@@ -147,9 +153,15 @@ mod tests {
             assert!(p >= last, "{u}");
             last = p;
         }
-        for (b, &edge) in EDGE_VALUES.iter().enumerate().take(BINS).skip(1) {
+        for b in 1..BINS {
+            let (edge, next) = (EDGE_VALUES[b], EDGE_VALUES[b + 1]);
             let below = f64::from_bits(edge.to_bits() - 1);
-            assert!(bin(edge) == b && bin(below) == b - 1, "{b}");
+            assert!(
+                position(below) < b as f64 && position(edge) >= b as f64,
+                "{b}"
+            );
+            // ⌊position⌋ by rounding: exact but within rounding of an edge.
+            assert_eq!(bin(0.5 * (edge + next)), b, "{b}");
         }
     }
 }

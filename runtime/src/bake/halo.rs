@@ -344,7 +344,7 @@ impl HaloBake {
 /// Mirrored in python/twoscale/drjit/halo.py.
 #[inline]
 fn at_node<T: Copy + Into<f64>, const N: usize>(x: f64, nodes: &[T; N], position: f32) -> usize {
-    let mut k = (position.max(0.0) as usize).min(N - 2);
+    let (mut k, _) = crate::bake::cell_at(position.max(0.0), N);
     if k > 0 && x < nodes[k].into() {
         k -= 1;
     } else if k + 2 < N && x >= nodes[k + 1].into() {

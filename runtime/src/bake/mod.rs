@@ -54,7 +54,7 @@ fn cell(x: f32, n: usize) -> (usize, f32) {
 ///
 /// Mirrored in python/twoscale/drjit/lookups.py.
 #[inline]
-fn cell_at(t: f32, n: usize) -> (usize, f32) {
+pub(crate) fn cell_at(t: f32, n: usize) -> (usize, f32) {
     let t = t.min((n - 1) as f32);
     // ⌊t⌋ without a saturating float-to-integer conversion: `t − ½ + 1.5·2²³`
     // rounds to an integer (f32's spacing there is 1), which the low bits

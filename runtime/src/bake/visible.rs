@@ -252,6 +252,8 @@ impl VisibleSlopeBake {
 
     /// The marginal's cells for incidence cell `a` and bin `b`, the last
     /// clamped to `j_end`.
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     #[inline]
     fn marginal_bracket(&self, a: usize, b: usize, j_end: usize) -> (usize, usize) {
         let hi = usize::from(self.marginal_guide[a + 1][b + 1]).min(j_end);
@@ -260,6 +262,8 @@ impl VisibleSlopeBake {
     }
 
     /// The columns of the blend of rows `i`, `i + 1` for bin `b`.
+    ///
+    /// Mirrored in python/twoscale/drjit/visible.py.
     #[inline]
     fn conditional_bracket(&self, i: usize, b: usize) -> (usize, usize) {
         let (gi, gn) = (&self.conditional_guide[i], &self.conditional_guide[i + 1]);
