@@ -24,13 +24,14 @@
 //! ```
 //!
 //! with `w_j` the weights of the rows around `u`, linear in `u` between the
-//! rows' own `u_j` (a mixture: the row is picked with its weight; found in
-//! f64 by a binary search, so that ports reproduce the pick), `s_jk`,
+//! rows' own `u_j` (a mixture: the row is picked with its weight; found on
+//! the C bake's `u` axis and checked against the f64 `u_j`), `s_jk`,
 //! `σ_jk` the start and slope of the piecewise-linear density on cell `k`
 //! (baked in f32 from the node values: a gather and one multiply-add per
 //! row) and `M_j` the row's total, the integral of the stored coefficients
-//! in f64. Within a cell the CDF of ζ is a
-//! quadratic, solved in closed form; the azimuth's CDF `F(ψ)/F(H)` on each
+//! in f64. The cell of ζ is found in O(1): in `pdf` from the row's θh axis,
+//! in the draw from the row's guide ([`guide`]). Within a cell the CDF of ζ
+//! is a quadratic, solved in closed form; the azimuth's CDF `F(ψ)/F(H)` on each
 //! side is inverted by Newton's method in a shrinking bracket.
 //! [`HaloBake::pdf`] evaluates the same expression, so the density is the
 //! one drawn (to rounding). Where no azimuth gives `cos θo > 0` nothing is

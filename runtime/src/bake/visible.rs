@@ -19,7 +19,8 @@
 //! conditional piecewise linear in `|ỹ|` on [`COLS`] nodes per row, rows
 //! blended linearly in `|x̃|`. The sampler draws exactly that tabulated
 //! density (the marginal's CDF is a cubic per cell, solved by Newton's
-//! method; the conditional's a quadratic per cell, solved in closed form),
+//! method; the conditional's a quadratic per cell, solved in closed form;
+//! the cells found in O(1) by guide tables, [`guide`]),
 //! and [`VisibleSlopeBake::pdf`] evaluates the same tabulated density, so the
 //! pdf is the density drawn by construction (to rounding), whatever the
 //! tables' distance to the exact `D_vis`; that distance only costs variance.
