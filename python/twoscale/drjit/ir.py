@@ -109,6 +109,56 @@ def plugin_float_ops(props, n=4096, seed=1):
     }
 
 
+def sampler_float_ops(model, n=4096, seed=1):
+    """:func:`kernel_float_ops` of the samplers' own functions
+    (:mod:`~twoscale.drjit.visible`, :mod:`~twoscale.drjit.halo`) as
+    `model` (a :class:`~twoscale.drjit.models.Model` or subclass) calls them,
+    each alone, on f32 unit directions: ``visible_pdf`` and
+    ``visible_sample`` of the shared surface, ``halo_pdf`` summed over the
+    channels (models) `pdf` reads and ``halo_sample`` over those `sample`
+    draws from. An upper bound of the f64 these functions put into the
+    plugin's kernels (fused there, Dr.Jit's common-subexpression elimination
+    only removes operations)."""
+    import mitsuba as mi
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+
+    def upper(v):
+        v[:, 2] = np.abs(v[:, 2]) + 1e-3
+        return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32)
+
+    wi = mi.Vector3f(upper(rng.normal(size=(n, 3))).T)
+    wo = mi.Vector3f(upper(rng.normal(size=(n, 3))).T)
+    u = rng.random((3, n)).astype(np.float32)
+    u1, u2, k = mi.Float(u[1]), mi.Float(u[2]), mi.UInt32(np.minimum(3 * u[0], 2).astype(np.uint32))
+    dr.eval(wi, wo, u1, u2, k)
+    _, geo = model.geometry(wi, wo)
+    dr.eval(geo)
+    surface = model.channels[0]
+    if hasattr(model, "stack"):  # spectral: the sampler model of each lane
+        halo_pdf = halo_draw = [model.stack.at(2 * k)] if model.stack.diffraction else []
+    else:
+        halo_pdf = [ch for ch in model.channels if ch.diffraction]
+        stack = getattr(model, "diffraction_stack", None)
+        halo_draw = [stack.at(k)] if stack is not None else halo_pdf
+
+    def total(calls):
+        out = {"float": 0, "double": 0, "kernels": 0}
+        for call in calls:
+            counts = kernel_float_ops(lambda: dr.eval(call()))
+            out = {key: out[key] + counts[key] for key in out}
+        return out
+
+    return {
+        "visible_pdf": total([lambda: surface.visible_pdf(wi, wo)]),
+        "visible_sample": total([lambda: surface.visible_sample(wi, u1, u2)]),
+        "halo_pdf": total([lambda ch=ch: ch.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z)
+                           for ch in halo_pdf]),
+        "halo_sample": total([lambda ch=ch: ch.halo_sample(wi, u1, u2) for ch in halo_draw]),
+    }
+
+
 def main():
     """Prints the f64 share of the plugin's kernels (``python -m
     twoscale.drjit.ir``): the Beckmann limit and presets, llvm_ad_rgb and
@@ -145,6 +195,10 @@ def main():
         parts = "  ".join(f"{m} {c['double']}/{c['float'] + c['double']} ({f64_share(c):.1%})"
                           for m, c in counts.items())
         print(f"{args.variant:16s} {label:40s} f64 {f64_share(total):6.1%}  {parts}")
+        model = mi.load_dict(props).model
+        parts = "  ".join(f"{m} {c['double']}/{c['float'] + c['double']}"
+                          for m, c in sampler_float_ops(model).items())
+        print(f"{'':16s} {'  the samplers alone (f64/all)':40s} {parts}")
 
 
 #: What :func:`main` measures: the Beckmann limit and presets (the

@@ -39,7 +39,7 @@ def newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
     steps (`visible::solve_cell`, `halo::Azimuth::solve`)."""
-    lo = dr.zeros(mi.Float64, dr.width(t))
+    lo = dr.zeros(type(t), dr.width(t))
 
     def body(step, done, t, lo, hi):
         f = residual(t)
