@@ -22,7 +22,8 @@ import drjit as dr
 
 #: `%x = OP <16 x double> …`, `%x = call <16 x float> @f(…)`, scalar forms too.
 _OP = re.compile(
-    r"=\s*(?:(fadd|fsub|fmul|fdiv|frem|fneg)(?:\s+[a-z]+)*\s+(<\d+ x (float|double)>|float\b|double\b)"
+    r"=\s*(?:(fadd|fsub|fmul|fdiv|frem|fneg)(?:\s+[a-z]+)*\s+"
+    r"(<\d+ x (float|double)>|float\b|double\b)"
     r"|(?:tail\s+)?call(?:\s+[a-z]+)*\s+(<\d+ x (float|double)>|float|double)\s+@([\w.$]+))")
 
 #: Intrinsics that read or move memory rather than compute.
@@ -205,7 +206,8 @@ def main():
 #: presets' default RGB is the integrated one).
 CASES = {
     "Beckmann limit (β = 0.1, p = 1, σs = 0)": {
-        "type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0, "eta": "0.163 3.56, 0.584 2.15, 1.403 1.925"},
+        "type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
+        "eta": "0.163 3.56, 0.584 2.15, 1.403 1.925"},
     "gold-hp17-geometry (integrated RGB)": {"type": "twoscale", "material": "gold-hp17-geometry"},
     "gold-hp17-geometry (paper's wavelengths)": {
         "type": "twoscale", "material": "gold-hp17-geometry", "rgb_mode": "paper-wavelengths"},

@@ -196,7 +196,8 @@ def draw(model, selected, w, pick, wi, u1, u2, valid):
     direction from `u1, u2`: a visible normal of the shared specular bake, the
     diffraction law of the channel (model) where `selected[n]`, the cosine lobe
     for the base and the compensation lobe. Returns the direction
-    (``mi.Vector3f``, `upper_unit(to_f32(o))`) and whether one was drawn."""
+    (``mi.Vector3f``, normalised: `upper_unit`; all in f32, the samplers'
+    normals cast to f32) and whether one was drawn."""
     cumulative, last, chosen = mi.Float(0.0), mi.UInt32(0), mi.Int32(-1)
     for n in range(4):
         positive = w[n] > 0.0
