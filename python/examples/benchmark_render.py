@@ -124,13 +124,19 @@ def measure(variant, scene_name, size, spp, repeat, evaluated, presets=()):
     for preset in presets:
         bsdfs.setdefault(f"twoscale {preset}", {"type": "twoscale", "material": preset})
     scenes = {name: SCENES[scene_name](bsdf, size, spp) for name, bsdf in bsdfs.items()}
+    def render(scene, **kwargs):
+        # The image is evaluated and the kernels finished here: otherwise
+        # the next render (another BSDF's, in turn) would run this one's.
+        dr.eval(mi.render(scene, spp=spp, **kwargs))
+        dr.sync_thread()
+
     for scene in scenes.values():
-        mi.render(scene, spp=spp)  # warm-up
+        render(scene)  # warm-up
     seconds = dict.fromkeys(scenes, 0.0)
     for seed in range(repeat):
         for name, scene in scenes.items():
             start = time.process_time()
-            mi.render(scene, seed=seed + 1, spp=spp)
+            render(scene, seed=seed + 1)
             seconds[name] += time.process_time() - start
     cost = {name: t / (repeat * size * size * spp) for name, t in seconds.items()}
     base = cost["roughconductor beckmann"]
