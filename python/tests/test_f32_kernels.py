@@ -2,7 +2,7 @@
 arithmetic of the LLVM IR of `eval`, `pdf` and `sample` by precision
 (`twoscale.drjit.ir`, Dr.Jit's ``KernelHistory``), in ``llvm_ad_rgb`` and
 ``llvm_ad_spectral``, at the Beckmann limit and for presets (gold-hp17-geometry
-in its default integrated RGB, its paper's wavelengths, copper).
+in its default integrated RGB, its paper's wavelengths, copper: `ir.CASES`).
 
 Outside the samplers the port computes in f32: `eval` has no f64 operation,
 and every f64 operation of `pdf` and `sample` is one of the samplers' own
@@ -25,15 +25,6 @@ if os.path.exists(LLVM):
 #: visible.py and halo.py in f64); to be set to 0.02 once they are f32.
 SAMPLER_F64_SHARE = 0.55
 
-CASES = {
-    "beckmann-limit": {"type": "twoscale", "beta": 0.1, "p": 1.0, "sigma_s": 0.0,
-                       "eta": "0.584 2.15, 0.584 2.15, 0.584 2.15"},
-    "gold-hp17-geometry": {"type": "twoscale", "material": "gold-hp17-geometry"},
-    "gold-hp17-geometry-paper": {"type": "twoscale", "material": "gold-hp17-geometry",
-                                 "rgb_mode": "paper-wavelengths"},
-    "copper": {"type": "twoscale", "material": "copper"},
-}
-
 #: Run in a process per variant (one Mitsuba variant per process's tests).
 SCRIPT = r"""
 import json, sys
@@ -42,30 +33,35 @@ mi.set_variant(sys.argv[1])
 import twoscale.mitsuba as tm
 from twoscale.drjit import ir
 tm.register()
-props = json.loads(sys.argv[2])
+props = ir.case(sys.argv[2], mi.is_spectral)
+if props is None:
+    print(json.dumps(None))
+    sys.exit()
 counts = ir.plugin_float_ops(props)
 counts["samplers"] = ir.sampler_float_ops(mi.load_dict(props).model)
 print(json.dumps(counts))
 """
 
 
-def kernel_counts(variant, props):
+def kernel_counts(variant, label):
     import json
 
-    done = subprocess.run([sys.executable, "-c", SCRIPT, variant, json.dumps(props)],
+    done = subprocess.run([sys.executable, "-c", SCRIPT, variant, label],
                           capture_output=True, text=True, env=dict(os.environ))
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout.splitlines()[-1])
 
 
 @pytest.mark.parametrize("variant", ["llvm_ad_rgb", "llvm_ad_spectral"])
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", ["Beckmann limit (β = 0.1, p = 1, σs = 0)",
+                                  "gold-hp17-geometry (integrated RGB)",
+                                  "gold-hp17-geometry (paper's wavelengths)", "copper"])
 def test_f64_share(variant, case):
     """`eval` is f32 throughout; `pdf` and `sample` have f64 only where the
-    samplers do, within :data:`SAMPLER_F64_SHARE`."""
-    if variant == "llvm_ad_spectral" and case == "gold-hp17-geometry-paper":
+    samplers do, within :data:`SAMPLER_F64_SHARE` (`twoscale.drjit.ir.CASES`)."""
+    counts = kernel_counts(variant, case)
+    if counts is None:
         pytest.skip("rgb_mode is an RGB option")
-    counts = kernel_counts(variant, CASES[case])
     for method in ("eval", "pdf", "sample"):
         assert counts[method]["kernels"] >= 1 and counts[method]["float"] > 0, method
     assert counts["eval"]["double"] == 0, counts["eval"]

@@ -183,12 +183,10 @@ def main():
     import twoscale.mitsuba as tm
 
     tm.register()
-    for label, props in CASES.items():
-        if mi.is_spectral and "rgb_mode" in props:
+    for label in CASES:
+        props = case(label, mi.is_spectral)
+        if props is None:
             continue
-        if mi.is_spectral and "eta" in props:
-            # An explicit material needs one index for every channel in spectral variants.
-            props = dict(props, eta=", ".join(["0.584 2.15"] * 3))
         if mi.is_spectral:
             label = label.replace(" (integrated RGB)", "")
         counts = plugin_float_ops(props)
@@ -214,6 +212,18 @@ CASES = {
     "gold-rough": {"type": "twoscale", "material": "gold-rough"},
     "copper": {"type": "twoscale", "material": "copper"},
 }
+
+
+def case(label, spectral):
+    """The plugin's properties of :data:`CASES`' `label` in an RGB or a
+    spectral variant (None where it is an RGB mode's): an explicit
+    material's index for every channel in spectral variants."""
+    props = CASES[label]
+    if spectral and "rgb_mode" in props:
+        return None
+    if spectral and "eta" in props:
+        return dict(props, eta=", ".join(["0.584 2.15"] * 3))
+    return props
 
 
 if __name__ == "__main__":
