@@ -104,8 +104,7 @@ def main():
 
     wi, wo = directions(), directions()
     u = mi.Vector3f(rng.random((3, LANES)).astype(np.float32))
-    wid, wod = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
-    dr.eval(wi, wo, u, wid, wod)
+    dr.eval(wi, wo, u)
     for name in args.materials:
         if name == "roughconductor":
             calls = roughconductor_calls(wi, wo, u)
@@ -122,16 +121,17 @@ def main():
         model = tb.Model(m)
         ch = model.channels[0]
         calls["  geometry + masking"] = lambda: model.masking(model.geometry(wi, wo)[1])
-        calls["  lobe_weights (one channel)"] = lambda: ch.lobe_weights(wid.z)
-        calls["  visible_pdf"] = lambda: ch.visible_pdf(wid, wod)
-        calls["  visible_sample"] = lambda: ch.visible_sample(wid, mi.Float64(u.x), mi.Float64(u.y))
+        # As the model calls them: f32 unit directions and uniforms.
+        calls["  lobe_weights (one channel)"] = lambda: ch.lobe_weights(wi.z)
+        calls["  visible_pdf"] = lambda: ch.visible_pdf(wi, wo)
+        calls["  visible_sample"] = lambda: ch.visible_sample(wi, u.x, u.y)
         if ch.diffraction:
             geo = model.geometry(wi, wo)[1]
-            calls["  halo_pdf (one channel)"] = lambda: ch.halo_pdf(wid, geo["sin_h"], geo["cos_h"], wod.z)
+            calls["  halo_pdf (one channel)"] = lambda: ch.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z)
             calls["  diffraction_sample (one channel)"] = lambda: ch.diffraction_sample(
-                wid, mi.Float64(u.x), mi.Float64(u.y))
+                wi, u.x, u.y)
             calls["  conv (one channel)"] = lambda: ch.conv(
-                mi.Float(geo["sin_h"]), mi.Float(geo["cos_h"]), mi.Float(ch.d["big_b"] * geo["cos_d"]))
+                geo["sin_h"], geo["cos_h"], ch.f["big_b"] * geo["cos_d"])
         for key, t in best_times(calls, args.rounds).items():
             print(f"{name:20s} {key:36s} {t / LANES * 1e9:8.1f} ns/lane")
 

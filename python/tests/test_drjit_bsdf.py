@@ -28,8 +28,18 @@ tm.register()
 #: Pairs per preset (issue 25 item 4 asks for 10⁵ in CI; 10⁴ keeps this file
 #: under ~30 s).
 PAIRS = 10_000
-#: Relative agreement asked by issue 25 item 4, where ρ exceeds 1e-6 of the peak.
-TOLERANCE = 2e-4
+#: Agreement in distribution (issue 43 item 6), where a value exceeds 1e-6
+#: of its peak: `eval` within 1e-4 relative of the runtime's at the 99th
+#: percentile and 1e-3 at most; `pdf` within 1e-3 at most where both
+#: directions are at least :data:`GRAZING` above the horizon (and 1e-4 at
+#: the 99th percentile everywhere). The port computes in f32, the runtime its
+#: geometry in f64: f32's rounding of a unit direction (6e-8) moves h by as
+#: much, which the narrow peaks (gold-polished) and, at grazing outgoing
+#: directions, the halo density (its azimuth range shrinks to 0 there: a
+#: relative 1.5e-7 in cos θh moves it 1.2e-3) amplify.
+EVAL_P99, EVAL_MAX, PDF_P99, PDF_MAX = 1e-4, 1e-3, 1e-4, 1e-3
+#: The cosine above which `pdf` is held to :data:`PDF_MAX`.
+GRAZING = 1e-3
 
 
 @pytest.fixture(autouse=True)
@@ -63,14 +73,44 @@ def pairs(seed, n=PAIRS):
     return light, camera
 
 
-def relative_error(got, ref):
-    """Largest |got − ref|/ref over the values above 1e-6 of each channel's
-    peak; and whether `got` is 0 (to 1e-30 absolute) elsewhere below it."""
+def agreement(got, ref, rows=None):
+    """`(p99, worst, small_ok)`: the 99th percentile of |got − ref|/ref over
+    the values above 1e-6 of each channel's peak, its largest over those of
+    the `rows` given (a boolean mask; all by default), and whether `got` is
+    within 1e-6 of the peak of `ref` elsewhere."""
     peak = ref.max(axis=0)
     big = ref > 1e-6 * peak
     rel = np.where(big, np.abs(got - ref) / np.where(big, ref, 1.0), 0.0)
+    rows = np.ones(len(ref), bool) if rows is None else rows
     small_ok = np.all(np.abs(got - ref)[~big] <= (1e-6 * np.broadcast_to(peak, ref.shape))[~big])
-    return rel.max(), small_ok
+    return np.quantile(rel[big], 0.99), rel[rows].max(), small_ok
+
+
+def assert_eval_agrees(got, ref, what=""):
+    """`eval` agrees in distribution (:data:`EVAL_P99`, :data:`EVAL_MAX`)."""
+    p99, worst, small_ok = agreement(got, ref)
+    assert p99 <= EVAL_P99 and worst <= EVAL_MAX, f"{what}: eval p99 {p99:.2e} max {worst:.2e}"
+    assert small_ok, what
+
+
+def assert_pdf_agrees(got, ref, light, camera, what=""):
+    """`pdf` agrees (:data:`PDF_P99` everywhere; :data:`PDF_MAX` where both
+    cosines are ≥ :data:`GRAZING`)."""
+    rows = np.minimum(light[:, 2], camera[:, 2]) >= GRAZING
+    p99, worst, small_ok = agreement(got[:, None], ref[:, None], rows)
+    assert p99 <= PDF_P99 and worst <= PDF_MAX, f"{what}: pdf p99 {p99:.2e} max {worst:.2e}"
+    assert small_ok, what
+
+
+def assert_same_mean(a, b, what=""):
+    """Two samples of sampling weights, row `k` of each at the same incidence
+    (and wavelength) from independent uniforms, have the same mean per
+    channel: the mean of the paired differences is 0 within 4 of its
+    standard errors. Returns the differences' means in standard errors."""
+    d = np.asarray(a, np.float64) - np.asarray(b, np.float64)
+    diff, se = d.mean(axis=0), d.std(axis=0) / np.sqrt(len(d))
+    assert np.all(np.abs(diff) <= 4.0 * se), f"{what}: means {np.mean(a, 0)} {np.mean(b, 0)} ± {se}"
+    return diff / se
 
 
 def test_bakes_are_the_runtime_bakes():
@@ -139,10 +179,11 @@ def test_specular_only_material_is_specialised():
 
 
 @pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
-def test_eval_equals_the_runtime(name, options):
-    """`Model.eval` equals `Material.eval` within 2e-4 relative where ρ exceeds
-    1e-6 of the channel's peak, on 10⁴ pairs, evaluated inside a symbolic
-    loop (symbolic mode on: nothing in eval may be evaluated eagerly)."""
+def test_eval_agrees_with_the_runtime(name, options):
+    """`Model.eval` agrees with `Material.eval` (:func:`assert_eval_agrees`)
+    on 10⁴ pairs, evaluated inside a symbolic loop (symbolic mode on:
+    nothing in eval may be evaluated eagerly). Measured on 10⁵ pairs: p99
+    ≤ 6.0e-5 and max ≤ 6.8e-4 (gold-polished), ≤ 2.6e-5 / 3.8e-4 for the other presets."""
     for key, value in options.items():
         assert value in twoscale.OPTIONS.get(key, twoscale.RGB_MODES), key
     material = material_of(name, options)
@@ -156,18 +197,17 @@ def test_eval_equals_the_runtime(name, options):
 
     _, acc = dr.while_loop((mi.UInt32(0), mi.Color3f(0.0)), lambda k, acc: k < 2, body)
     got = np.array(acc).T / 2.0
-    worst, small_ok = relative_error(got, ref)
-    assert worst < TOLERANCE, f"{name} {options}: worst relative error {worst:.2e}"
-    assert small_ok
+    assert_eval_agrees(got, ref, f"{name} {options}")
 
 
 @pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
-def test_pdf_equals_the_runtime(name, options):
-    """`Model.pdf` (the runtime's sampler density: the visible-slope tables,
-    the diffraction sampler's law, the cosine lobe and the bake's lobe
-    weights, averaged over the channels) equals `Material.pdf` within 2e-4
-    relative where it exceeds 1e-6 of its peak, on 10⁴ pairs, inside a
-    symbolic loop."""
+def test_pdf_agrees_with_the_runtime(name, options):
+    """`Model.pdf` (the sampler's density: the visible-slope tables, the
+    diffraction sampler's law, the cosine lobe and the bake's lobe weights,
+    averaged over the channels) agrees with `Material.pdf`
+    (:func:`assert_pdf_agrees`) on 10⁴ pairs, inside a symbolic loop.
+    Measured on 10⁵ pairs: p99 ≤ 5.1e-5, max ≤ 8.6e-4 where both cosines
+    are ≥ 1e-3 (gold-polished), 1.4e-2 below (aluminium's halo)."""
     material = material_of(name, options)
     model = tb.rgb_model(material)
     light, camera = pairs(seed(name, "pdf", options))
@@ -178,40 +218,50 @@ def test_pdf_equals_the_runtime(name, options):
         return k + 1, acc + model.pdf(wi, wo)
 
     _, acc = dr.while_loop((mi.UInt32(0), mi.Float(0.0)), lambda k, acc: k < 2, body)
-    got = np.array(acc)[:, None] / 2.0
-    worst, small_ok = relative_error(got, ref)
-    assert worst < TOLERANCE, f"{name} {options}: worst relative error {worst:.2e}"
-    assert small_ok
+    got = np.array(acc) / 2.0
+    assert_pdf_agrees(got, ref[:, 0], light, camera, f"{name} {options}")
+
+
+def sampling_weights(model, material, light, u_port, u_ref):
+    """The sampling weights `ρ(wi, o) cos θo / pdf(wi, o)` (0 where no
+    direction is drawn) of the port's draws from `u_port` and the runtime's
+    from `u_ref` (each its own `eval` and `pdf`), at the incidences `light`."""
+    wi = mi.Vector3f(light.T)
+    o, ok = model.sample_direction(wi, mi.Vector3f(u_port.T))
+    value, pdf = model.eval(wi, o), model.pdf(wi, o)
+    ok = np.array(ok).astype(bool) & (np.array(pdf) > 0.0)
+    o = np.array(o).T
+    port = np.where(ok[:, None], np.array(value).T * o[:, 2:3]
+                    / np.where(ok, np.array(pdf), 1.0)[:, None], 0.0)
+    ref_o, ref_pdf, _ = material.sample(light, u_ref)
+    has = ref_pdf > 0.0
+    ref = np.where(has[:, None], material.eval(light, ref_o) * ref_o[:, 2:3]
+                   / np.where(has, ref_pdf, 1.0)[:, None], 0.0)
+    return port, ref
 
 
 @pytest.mark.parametrize("name,options", MATERIALS, ids=lambda x: str(x))
-def test_sample_equals_the_runtime(name, options):
-    """`Model.sample_direction` returns `Material.sample`'s direction for the
-    same uniforms and fails on the same rows, on 10⁴ incidences. Not bit for
-    bit: the runtime takes the diffraction sampler's ln(1 − M u) and its
-    inverse in f32 (`ln_1pf`, `exp_m1f`), the port in f64, and the halo's
-    azimuth inversion amplifies rounding where its density vanishes.
-    Measured on 2·10⁵ uniform incidences per preset: 0.01–1.9% of the
-    directions differ, 0.03% at most by more than 1e-6, none by more than
-    4.7e-5."""
+def test_sample_agrees_in_distribution(name, options):
+    """`Model.sample_direction` draws what `Material.sample` draws, in
+    distribution (issue 43 item 6; the directions for the same uniforms are
+    not compared): over 2·10⁴ incidences with independent uniforms, the mean
+    sampling weight `ρ cos θo/pdf` of each channel is the runtime's within 4
+    standard errors of the difference (≈ 0.1–0.3% of the mean); the χ²
+    tests check the shape."""
     material = material_of(name, options)
     model = tb.rgb_model(material)
     rng = np.random.default_rng(seed(name, "sample", options))
-    light, _ = pairs(int(rng.integers(2**31)))
-    u = rng.random((len(light), 3)).astype(np.float32)
-    ref_o, ref_pdf, _ = material.sample(light, u)
-    o, ok = model.sample_direction(mi.Vector3f(light.T), mi.Vector3f(u.T))
-    o, ok = np.array(o).T, np.array(ok).astype(bool)
-    assert np.array_equal(ok, ref_pdf > 0)
-    assert np.abs(o - ref_o)[ok].max() <= 1e-4
-    assert np.mean(np.abs(o - ref_o).max(axis=1)[ok] > 1e-6) < 3e-3
+    light, _ = pairs(int(rng.integers(2**31)), 20_000)
+    u = rng.random((2, len(light), 3)).astype(np.float32)
+    port, ref = sampling_weights(model, material, light, u[0], u[1])
+    assert_same_mean(port, ref, f"{name} {options}")
 
 
 def test_plugin_through_a_symbolic_call():
     """The plugin through a `BSDFPtr` (a symbolic call): `eval` is
     ρ(wi=wo, wo=si.wi) cos θ(wo), the convention of `twoscale.mitsuba`, 0
-    below the horizon; `pdf` is `Material.pdf(si.wi, wo)`; `sample` draws
-    `Material.sample(si.wi, u)`'s direction with weight eval / pdf."""
+    below the horizon; `pdf` is `Material.pdf(si.wi, wo)`; `sample` returns
+    that pdf at its direction and weight eval / pdf, of the runtime's mean."""
     assert dr.flag(dr.JitFlag.SymbolicCalls)
     name = "gold-rough"
     material = twoscale.Material.preset(name)
@@ -226,23 +276,26 @@ def test_plugin_through_a_symbolic_call():
     value, pdf = ptr.eval_pdf(ctx, si, mi.Vector3f(light.T), mi.Bool(True))
     ref = material.eval(light, camera) * np.maximum(light[:, 2:3], 0.0)
     got = np.array(value).T
-    worst, small_ok = relative_error(got[100:], ref[100:])
-    assert worst < TOLERANCE and small_ok
+    assert_eval_agrees(got[100:], ref[100:], name)
     assert np.all(got[:100] == 0.0)
     ref_pdf = material.pdf(camera, light)
-    worst, small_ok = relative_error(np.array(pdf)[100:, None], ref_pdf[100:, None])
-    assert worst < TOLERANCE and small_ok
+    assert_pdf_agrees(np.array(pdf)[100:], ref_pdf[100:], camera[100:], light[100:], name)
     assert np.all(np.array(pdf)[:100] == 0.0)
     rng = np.random.default_rng(9)
-    u = rng.random((3, n)).astype(np.float32)
-    bs, weight = ptr.sample(ctx, si, mi.Float(u[0]), mi.Point2f(u[1:]), mi.Bool(True))
-    ref_o, ref_p, ref_w = material.sample(camera, u.T)
+    u = rng.random((2, 3, n)).astype(np.float32)
+    bs, weight = ptr.sample(ctx, si, mi.Float(u[0, 0]), mi.Point2f(u[0, 1:]), mi.Bool(True))
     p2 = np.array(bs.pdf)
     ok = p2 > 0
-    assert np.array_equal(ok, ref_p > 0)
-    assert np.abs(np.array(bs.wo).T - ref_o)[ok].max() <= 1e-5
+    wo = np.array(bs.wo).T
+    assert ok.mean() > 0.9
+    assert_pdf_agrees(p2[ok], material.pdf(camera[ok], wo[ok]), camera[ok], wo[ok], name)
     v2 = np.array(ptr.eval(ctx, si, bs.wo, mi.Bool(True))).T
     assert np.allclose(np.array(weight).T[ok], v2[ok] / p2[ok, None], rtol=1e-5)
+    ref_o, ref_p, _ = material.sample(camera, u[1].T)
+    has = ref_p > 0
+    ref_w = np.where(has[:, None], material.eval(ref_o, camera) * ref_o[:, 2:3]
+                     / np.where(has, ref_p, 1.0)[:, None], 0.0)
+    assert_same_mean(np.where(ok[:, None], np.array(weight).T, 0.0), ref_w, name)
 
 
 GOLD = "0.163 3.56, 0.584 2.15, 1.403 1.925"
@@ -368,7 +421,7 @@ def test_gradient_equals_finite_differences(name, key, x0):
 
 def test_parameters_changed_rebakes():
     """Setting k_d through `mi.traverse` gives the runtime's material with
-    that k_d: `eval` and `pdf` (whose lobe weights k_d changes) equal those
+    that k_d: `eval` and `pdf` (whose lobe weights k_d changes) agree with those
     of `Material.with_layer(lambertian=...)`; the exposed keys are the
     material's (no albedo for a conductor, no halo factor without σs)."""
     bsdf = mi.load_dict({"type": tm.NAME, "material": "gold-hp17-geometry"})
@@ -381,11 +434,8 @@ def test_parameters_changed_rebakes():
     si = dr.zeros(mi.SurfaceInteraction3f, len(light))
     si.wi = mi.Vector3f(camera.T)
     value, pdf = bsdf.eval_pdf(mi.BSDFContext(), si, mi.Vector3f(light.T))
-    worst, small_ok = relative_error(
-        np.array(value).T, ref.eval(light, camera) * light[:, 2:3])
-    assert worst < TOLERANCE and small_ok
-    worst, small_ok = relative_error(np.array(pdf)[:, None], ref.pdf(camera, light)[:, None])
-    assert worst < TOLERANCE and small_ok
+    assert_eval_agrees(np.array(value).T, ref.eval(light, camera) * light[:, 2:3], "k_d 0.3")
+    assert_pdf_agrees(np.array(pdf), ref.pdf(camera, light), camera, light, "k_d 0.3")
     plain = mi.traverse(mi.load_dict({"type": tm.NAME, "beta": 0.2, "p": 1.0, "eta": GOLD}))
     assert set(plain.keys()) == {"lambertian"}
 

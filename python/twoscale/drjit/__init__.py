@@ -31,6 +31,14 @@ a node axis, the two models around each of the path's four wavelengths
 interpolated in λ, with F(θd) at λ from the runtime's table; ``pdf`` and ``sample``
 those of the sampler model, every other one, nearest the hero wavelength).
 
+**Precision.** f32 (``mi.Float``), as Mitsuba's BSDFs: the geometry,
+the lobes, the lobe weights, ``pdf``'s mixture and the draws; only the
+samplers' own arithmetic (:mod:`~twoscale.drjit.visible`,
+:mod:`~twoscale.drjit.halo`) is still f64, cast to f32 at their boundary
+(:mod:`twoscale.drjit.ir` counts each kernel's f64 operations). The port
+agrees with the runtime in distribution, not per uniform
+(docs/design/mitsuba-drjit.md).
+
 **Gradients.** The bakes are fixed per material (the runtime interprets the
 tables; a lookup's node positions have no useful derivative), so
 ``traverse`` exposes only the parameters that enter *after* the lookups, in

@@ -35,18 +35,18 @@ class Channel(Bakes, Visible, Halo):
 
     def lobe_weights(self, cos_i):
         """`DirectionBake::lobe_weights`: `[specular, diffraction, base, multiple]`,
-        sum 1 (f64)."""
+        sum 1 (f32)."""
         columns = self.weight_columns
         if columns in ([], [0]):
             # The specular lobe alone (or no lobe): weights [1, 0, 0, 0] everywhere.
-            return [mi.Float64(1.0)] + [mi.Float64(0.0)] * 3
-        i, frac = self.direction_cell(mi.Float(cos_i))
+            return [mi.Float(1.0)] + [mi.Float(0.0)] * 3
+        i, frac = self.direction_cell(cos_i)
         a = gather4(self.t["direction_weights"], i)
         b = gather4(self.t["direction_weights"], i + 1)
         col = self.weight_index
         # Lobes whose weight is 0 at every node contribute exact zeros.
-        w = [mi.Float64(dr.maximum(dr.fma(frac, b[col[k]] - a[col[k]], a[col[k]]), 0.0))
-             if k in columns else mi.Float64(0.0) for k in range(len(LOBES))]
+        w = [dr.maximum(dr.fma(frac, b[col[k]] - a[col[k]], a[col[k]]), 0.0)
+             if k in columns else mi.Float(0.0) for k in range(len(LOBES))]
         total = sum(w[k] for k in columns)
         ok = total > 0.0
         return [dr.select(ok, w[0] / total, 1.0)] + [
@@ -55,14 +55,17 @@ class Channel(Bakes, Visible, Halo):
 
     def diffraction_pdf(self, wi, wo, geo):
         """`TwoScale::diffraction_pdf` where C is baked (the plugin requires
-        it): the half-vector draw's `HaloBake::pdf`, f64."""
-        return dr.select(geo["cos_d"] > 0.0, self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z), 0.0)
+        it): the half-vector draw's `HaloBake::pdf`, returned in f32."""
+        return dr.select(geo["cos_d"] > 0.0,
+                         mi.Float(self.halo_pdf(wi, geo["sin_h"], geo["cos_h"], wo.z)), 0.0)
+
     def diffraction_sample(self, wi, u0, u1):
         """The diffraction lobe's direction where C is baked
         (`TwoScale::sample_diffraction`: a reflected half-vector of
-        `halo_sample`) and whether it exists (f64)."""
+        `halo_sample`) and whether it exists (f32)."""
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
         m, ok = self.halo_sample(wi, dr.minimum(u1, below_one), u0)
+        m = mi.Vector3f(m)
         k = 2.0 * dr.dot(wi, m)
         return k * m - wi, ok & (k > 0.0)
 
@@ -193,8 +196,9 @@ def draw(model, selected, w, pick, wi, u1, u2, valid):
     direction from `u1, u2`: a visible normal of the shared specular bake, the
     diffraction law of the channel (model) where `selected[n]`, the cosine lobe
     for the base and the compensation lobe. Returns the direction
-    (``mi.Vector3f``, `upper_unit(to_f32(o))`) and whether one was drawn."""
-    cumulative, last, chosen = mi.Float64(0.0), mi.UInt32(0), mi.Int32(-1)
+    (``mi.Vector3f``, normalised: `upper_unit`; all in f32, the samplers'
+    normals cast to f32) and whether one was drawn."""
+    cumulative, last, chosen = mi.Float(0.0), mi.UInt32(0), mi.Int32(-1)
     for n in range(4):
         positive = w[n] > 0.0
         cumulative += dr.select(positive, w[n], 0.0)
@@ -202,6 +206,7 @@ def draw(model, selected, w, pick, wi, u1, u2, valid):
         chosen = dr.select((chosen < 0) & positive & (pick < cumulative), n, chosen)
     lobe = dr.select(chosen < 0, last, mi.UInt32(chosen))
     m, ok = model.channels[0].visible_sample(wi, u1, u2)
+    m = mi.Vector3f(m)
     o = 2.0 * dr.dot(wi, m) * m - wi
     if getattr(model, "diffraction_stack", None) is not None:
         # One draw from each lane's own channel.
@@ -221,10 +226,11 @@ def draw(model, selected, w, pick, wi, u1, u2, valid):
     if any(n in ch.weight_columns for ch in model.channels for n in (2, 3)):
         # The cosine lobe (traced only when some channel can pick lobe 2 or 3).
         r, phi = dr.sqrt(u1), 2.0 * math.pi * u2
-        ob = mi.Vector3d(r * dr.cos(phi), r * dr.sin(phi), dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
+        sin_phi, cos_phi = dr.sincos(phi)
+        ob = mi.Vector3f(r * cos_phi, r * sin_phi, dr.sqrt(dr.maximum(1.0 - u1, 0.0)))
         o = dr.select(lobe >= 2, ob, o)
         ok = dr.select(lobe >= 2, True, ok)
     ok &= ~((lobe == 1) & ~model.channels_have_diffraction)
-    o = mi.Vector3f(dr.normalize(mi.Vector3d(mi.Vector3f(o))))
+    o = dr.normalize(o)
     ok &= valid & (o.z > 0.0) & dr.all(dr.isfinite(o))
     return o, ok

@@ -33,7 +33,8 @@ def lerp_gather(table, width, column, i, frac):
 
 
 def upload(values):
-    """A bake as a Dr.Jit array (``mi.Float``, or ``mi.Float64`` for f64)
+    """A bake as a Dr.Jit array (``mi.Float``, or ``mi.Float64`` for f64:
+    the samplers' cumulative tables, read by visible.py and halo.py only)
     over a copy of `values` aligned to 64 bytes. Dr.Jit maps a NumPy
     array's memory rather than copying it, and gathers a packet
     (:func:`gather4`) as one load only from an aligned table: elsewhere it
@@ -114,6 +115,7 @@ class Bakes:
         f_dr = s["f_dr_int"]
         s["base_inv_n_sq"] = 1.0 / (n * n)
         s["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
+        # f32 constants; the f64 ones (`d`) are the samplers' (visible.py, halo.py) only.
         self.f, self.d = Opaque(s, mi.Float), Opaque(s, mi.Float64)
         # ln C as overlapping packets: packet j holds nodes j … j + 3 of the
         # flattened grid (so that a Catmull–Rom row is one packet gather).

@@ -38,8 +38,8 @@ def newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
     """The root in [0, hi] of the increasing `residual` from `t`: Newton's
     method kept in a shrinking bracket (a step leaving it, or a slope ≤ 0,
     bisects), a symbolic loop, each lane until a step is ≤ `tol`, at most 40
-    steps (`visible::solve_cell`, `halo::Azimuth::solve`)."""
-    lo = dr.zeros(mi.Float64, dr.width(t))
+    steps (`visible::solve_cell`, `halo::Azimuth::solve`), in the type of `t`."""
+    lo = dr.zeros(type(t), dr.width(t))
 
     def body(step, done, t, lo, hi):
         f = residual(t)
@@ -69,7 +69,7 @@ def newton_in_bracket(residual, slope, t, hi, tol, curvature=None):
 
 
 def acos_approx(x):
-    """`math::acos_approx` (Abramowitz & Stegun 4.4.46), f64."""
+    """`math::acos_approx` (Abramowitz & Stegun 4.4.46), in the type of `x`."""
     a = dr.minimum(dr.abs(x), 1.0)
     p = 1.5707963050 + a * (-0.2145988016 + a * (0.0889789874 + a * (
         -0.0501743046 + a * (0.0308918810 + a * (-0.0170881256 + a * (

@@ -60,21 +60,29 @@ class Model:
         return dr.select((h.z > 0.0) & (y < 104.0) & dr.isfinite(value), value, 0.0)
 
     def geometry(self, wi, wo):
-        """The pair's geometry and D(h) (as `TwoScale::geometry`: directions
-        and h in f64, D of h rounded to f32), and whether both directions
-        are above the horizon."""
+        """The pair's geometry and D(h) (`TwoScale::geometry`), in f32, and
+        whether both directions are above the horizon. From `s = wi + wo`
+        (unit `wi`, `wo`): `h = s/|s|`, `cos θd = wi·h = |s|/2` (one root,
+        no dot product to round), `sin θh` from `s`'s tangential part;
+        where `wi` and `wo` mirror each other the tangential sums cancel
+        exactly (Sterbenz), so `sin θh` near the peak keeps the inputs'
+        rounding only."""
         wi, wo = mi.Vector3f(wi), mi.Vector3f(wo)
         valid = dr.all(dr.isfinite(wi)) & dr.all(dr.isfinite(wo))
-        wi, wo = dr.normalize(mi.Vector3d(wi)), dr.normalize(mi.Vector3d(wo))
+        wi, wo = dr.normalize(wi), dr.normalize(wo)
         valid &= (wi.z > 0.0) & (wo.z > 0.0)
-        h = dr.normalize(wi + wo)
+        s = wi + wo
+        tangential_sq = s.x * s.x + s.y * s.y
+        norm_sq = tangential_sq + s.z * s.z
+        inv_norm = dr.rsqrt(norm_sq)
+        h = s * inv_norm
         return valid, {
             "wi": wi,
             "wo": wo,
-            "cos_d": dr.clip(dr.dot(wi, h), 0.0, 1.0),
+            "cos_d": dr.clip(0.5 * norm_sq * inv_norm, 0.0, 1.0),
             "cos_h": dr.clip(h.z, 0.0, 1.0),
-            "sin_h": dr.minimum(dr.sqrt(h.x * h.x + h.y * h.y), 1.0),
-            "d": self.d(mi.Vector3f(h)),
+            "sin_h": dr.minimum(dr.sqrt(tangential_sq) * inv_norm, 1.0),
+            "d": self.d(h),
             "along": -(wi.x * wo.x + wi.y * wo.y),
             "across": -(wi.x * wo.y - wi.y * wo.x),
         }
@@ -102,13 +110,13 @@ class Model:
         """The terms of a pair every channel's (model's) lobes share, f32:
         the cosines, G, `rho_geo = G D/(4 cos θi cos θo)` and the
         half-vector's and Q̄'s arguments."""
-        cos_i, cos_o, cos_d = mi.Float(geo["wi"].z), mi.Float(geo["wo"].z), mi.Float(geo["cos_d"])
+        cos_i, cos_o, cos_d = geo["wi"].z, geo["wo"].z, geo["cos_d"]
         g = self.masking(geo)
         return {
             "cos_i": cos_i, "cos_o": cos_o, "cos_d": cos_d, "cos_d_sq": cos_d * cos_d,
             "g": g, "rho_geo": g * geo["d"] / (4.0 * cos_i * cos_o),
-            "sin_h": mi.Float(geo["sin_h"]), "cos_h": mi.Float(geo["cos_h"]),
-            "along": mi.Float(geo["along"]), "across": mi.Float(geo["across"]),
+            "sin_h": geo["sin_h"], "cos_h": geo["cos_h"],
+            "along": geo["along"], "across": geo["across"],
         }
 
     def eval(self, wi, wo):
@@ -128,9 +136,9 @@ class Model:
         `Σ_k w_k(wi) pdf_k(wi, wo)`, as an ``mi.Float``; 0 below the horizon."""
         valid, geo = self.geometry(wi, wo)
         wi, wo = geo["wi"], geo["wo"]
-        specular = self.channels[0].visible_pdf(wi, wo)
-        base = wo.z / math.pi
-        total = mi.Float64(0.0)
+        specular = mi.Float(self.channels[0].visible_pdf(wi, wo))
+        base = wo.z * (1.0 / math.pi)
+        total = mi.Float(0.0)
         for channel in self.channels:
             w = channel.lobe_weights(wi.z)
             value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
@@ -138,8 +146,8 @@ class Model:
                 value += dr.select(w[1] > 0.0, w[1] * channel.diffraction_pdf(wi, wo, geo), 0.0)
             # The base and the compensation lobe share the cosine-weighted density.
             value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
-            total += mi.Float64(finite_or_zero(mi.Float(value)))
-        return dr.select(valid, finite_or_zero(mi.Float(total / 3.0)), 0.0)
+            total += finite_or_zero(value)
+        return dr.select(valid, finite_or_zero(total * (1.0 / 3.0)), 0.0)
 
     def sample_direction(self, wi, u):
         """``Rgb::sample``'s direction for incidence `wi` and three uniforms
@@ -149,14 +157,13 @@ class Model:
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
         wi_f = mi.Vector3f(wi)
         valid = dr.all(dr.isfinite(wi_f))
-        wi = dr.normalize(mi.Vector3d(wi_f))
+        wi = dr.normalize(wi_f)
         valid &= wi.z > 0.0
-        pick = 3.0 * mi.Float64(dr.clip(u.x, 0.0, below_one))
+        pick = 3.0 * dr.clip(u.x, 0.0, below_one)
         k = dr.minimum(mi.UInt32(pick), 2)
-        rest = mi.Float(pick - mi.Float64(k))
-        lobe_pick = mi.Float64(dr.clip(rest, 0.0, below_one))
-        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
-        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        lobe_pick = dr.clip(pick - mi.Float(k), 0.0, below_one)
+        u1 = dr.clip(u.y, 0.0, below_one)
+        u2 = dr.clip(u.z, 0.0, below_one)
         # The picked channel's lobe weights.
         weights = [ch.lobe_weights(wi.z) for ch in self.channels]
         w = [dr.select(k == 0, weights[0][n], dr.select(k == 1, weights[1][n], weights[2][n]))
@@ -399,14 +406,14 @@ class SpectralModel(Model):
         valid, geo = self.geometry(wi, wo)
         wi, wo = geo["wi"], geo["wo"]
         node = self.stack.at(self.nearest(lam))
-        specular = self.channels[0].visible_pdf(wi, wo)
-        base = wo.z / math.pi
+        specular = mi.Float(self.channels[0].visible_pdf(wi, wo))
+        base = wo.z * (1.0 / math.pi)
         w = node.lobe_weights(wi.z)
         value = dr.select(w[0] > 0.0, w[0] * specular, 0.0)
         if node.diffraction:
             value += dr.select(w[1] > 0.0, w[1] * node.diffraction_pdf(wi, wo, geo), 0.0)
         value += dr.select(w[2] + w[3] > 0.0, (w[2] + w[3]) * base, 0.0)
-        return dr.select(valid, finite_or_zero(mi.Float(value)), 0.0)
+        return dr.select(valid, finite_or_zero(value), 0.0)
 
     def sample_spectral(self, wi, u, lam):
         """`Spectral::sample`'s direction: `TwoScale::sample_direction` of
@@ -415,12 +422,12 @@ class SpectralModel(Model):
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
         wi_f = mi.Vector3f(wi)
         valid = dr.all(dr.isfinite(wi_f))
-        wi = dr.normalize(mi.Vector3d(wi_f))
+        wi = dr.normalize(wi_f)
         valid &= wi.z > 0.0
         node = self.stack.at(self.nearest(lam))
-        pick = mi.Float64(dr.clip(u.x, 0.0, below_one))
-        u1 = mi.Float64(dr.clip(u.y, 0.0, below_one))
-        u2 = mi.Float64(dr.clip(u.z, 0.0, below_one))
+        pick = dr.clip(u.x, 0.0, below_one)
+        u1 = dr.clip(u.y, 0.0, below_one)
+        u2 = dr.clip(u.z, 0.0, below_one)
         # The nearest model as the one channel `draw` reads (the visible
         # slopes are shared by the models).
         one = types.SimpleNamespace(channels=[node],

@@ -21,10 +21,10 @@
 //! comes out negative (a spectrum outside the sRGB gamut) is clamped to 0.
 
 use super::construct::{NodeBakes, SurfaceBakes};
-use super::eval::Geometry;
+use super::eval::{Geometry, Pair};
 use super::{BakeVisitor, ChannelBake, RgbSample, Tables, TwoScale, finite_or_zero};
 use crate::bake::c_of_ln;
-use crate::material::{ColourTerms, Options};
+use crate::material::{ColourTerms, HaloWeight, Options, SigmaRelMode};
 use crate::math::{self, BELOW_ONE};
 use crate::model::fresnel::fresnel;
 use crate::spectrum::colour::{self, SRGB_WEIGHTS, WAVELENGTH_COUNT};
@@ -55,6 +55,21 @@ const CONV_NODES: [usize; 4] = [0, 2, 5, 7];
 /// `u_k ∝ 1/λ_k` at every pair, so the weights are constants; the rows of
 /// the `CONV_NODES` themselves are unit vectors.
 const CONV_WEIGHTS: [[f32; 4]; INTEGRATED_COUNT] = conv_weights();
+
+/// [`CONV_WEIGHTS`] transposed, `[j][k]`: the f32 path's lanes.
+const CONV_LANES: [[f32; INTEGRATED_COUNT]; 4] = {
+    let mut out = [[0.0; INTEGRATED_COUNT]; 4];
+    let mut k = 0;
+    while k < INTEGRATED_COUNT {
+        let mut j = 0;
+        while j < 4 {
+            out[j][k] = CONV_WEIGHTS[k][j];
+            j += 1;
+        }
+        k += 1;
+    }
+    out
+};
 
 const fn conv_weights() -> [[f32; 4]; INTEGRATED_COUNT] {
     const fn x(k: usize) -> f64 {
@@ -101,7 +116,9 @@ fn hat_cell(lambda: f32) -> (usize, f64) {
 /// `R_kc` over `√cos θd` and `P_kc` (module documentation): 6 KB.
 #[derive(Clone)]
 pub(super) struct ColourBake {
-    surface: [[[f32; 3]; INTEGRATED_COUNT]; COLOUR_NODES],
+    /// `R_kc` per node as `[c][k]`: a channel's 8 weights side by side, as
+    /// the lanes of [`IntegratedRgb::eval`]'s f32 path read them.
+    surface: [[[f32; INTEGRATED_COUNT]; 3]; COLOUR_NODES],
     plain: [[f32; 3]; INTEGRATED_COUNT],
 }
 
@@ -145,7 +162,7 @@ impl ColourBake {
             }
         }
         ColourBake {
-            surface,
+            surface: surface.map(|row| core::array::from_fn(|c| row.map(|r| r[c]))),
             plain: plain_f32,
         }
     }
@@ -154,12 +171,19 @@ impl ColourBake {
     ///
     /// Mirrored in python/twoscale/drjit/models.py.
     #[inline]
-    fn surface_at(&self, cos_d: f64) -> [[f32; 3]; INTEGRATED_COUNT] {
+    fn surface_at(&self, cos_d: f64) -> [[f32; INTEGRATED_COUNT]; 3] {
         let t = math::sqrt(cos_d.max(0.0).min(1.0)) * (COLOUR_NODES - 1) as f64;
         let m = (math::floor(t) as usize).min(COLOUR_NODES - 2);
         let f = (t - m as f64) as f32;
         let (a, b) = (&self.surface[m], &self.surface[m + 1]);
-        core::array::from_fn(|k| core::array::from_fn(|c| a[k][c] + f * (b[k][c] - a[k][c])))
+        // Plain loops: `array::from_fn`'s closures do not vectorise.
+        let mut out = [[0.0; INTEGRATED_COUNT]; 3];
+        for c in 0..3 {
+            for k in 0..INTEGRATED_COUNT {
+                out[c][k] = a[c][k] + f * (b[c][k] - a[c][k]);
+            }
+        }
+        out
     }
 }
 
@@ -221,12 +245,54 @@ pub(super) fn models_at<'a, B: BorrowMut<ChannelBake>, const N: usize>(
     nodes
 }
 
+/// The models' constants that [`IntegratedRgb::eval`]'s f32 path reads, one
+/// lane per model: `(4π/λ_k)²`, `σs²`, `(c−1) σs² b² / (2π λ_k²)`,
+/// `|η_k² − 1|²/2` (0 without an index) and `η_k²`.
+#[derive(Clone, Copy)]
+struct Lanes {
+    x_scale: [f32; INTEGRATED_COUNT],
+    sigma_s_sq: [f32; INTEGRATED_COUNT],
+    halo_scale: [f32; INTEGRATED_COUNT],
+    half_e: [f32; INTEGRATED_COUNT],
+    eta_sq: [[f32; 2]; INTEGRATED_COUNT],
+    symmetrised: bool,
+}
+
+impl Lanes {
+    /// The constants of `nodes`, or `None` where the f32 path does not
+    /// apply: a base or compensation lobe (`diffuse`), white colour terms,
+    /// or the halo weighted at θi ([`HaloWeight::Incident`]).
+    fn new<B: Borrow<ChannelBake>>(
+        nodes: &[TwoScale<'_, B>; INTEGRATED_COUNT],
+        diffuse: bool,
+    ) -> Option<Lanes> {
+        let options = nodes[0].options;
+        if diffuse
+            || options.colour == ColourTerms::White
+            || options.halo_weight != HaloWeight::Printed
+        {
+            return None;
+        }
+        let constants = nodes
+            .each_ref()
+            .map(|node| node.q.map(|q| q.combine_constants()));
+        Some(Lanes {
+            x_scale: nodes.each_ref().map(|node| node.x_scale as f32),
+            sigma_s_sq: nodes.each_ref().map(|node| node.sigma_s_sq as f32),
+            halo_scale: nodes.each_ref().map(|node| node.halo_scale as f32),
+            half_e: constants.map(|c| c.map_or(0.0, |(e, _)| (0.5 * e) as f32)),
+            eta_sq: constants.map(|c| c.map_or([0.0; 2], |(_, eta_sq)| eta_sq.map(|x| x as f32))),
+            symmetrised: options.sigma_rel == SigmaRelMode::Symmetrised,
+        })
+    }
+}
+
 /// The two-scale BRDF in linear sRGB by integration over the spectrum
 /// (module documentation): one [`TwoScale`] per wavelength of
 /// [`INTEGRATED_WAVELENGTHS`] sharing the surface's bakes, and the colour
 /// weights. The bakes are held as `B` as [`super::Rgb`]'s: boxed
 /// (`IntegratedRgb::boxed`, feature `std`) or in caller-provided storage
-/// ([`IntegratedRgb::new_in`]); 1 136 KB by value (8 models of 141 KB, the colour weights 6 KB).
+/// ([`IntegratedRgb::new_in`]); 1 137 KB by value (8 models of 141 KB, the colour weights 6 KB).
 #[derive(Clone)]
 pub struct IntegratedRgb<'a, B = ChannelBake> {
     nodes: [TwoScale<'a, B>; INTEGRATED_COUNT],
@@ -236,6 +302,8 @@ pub struct IntegratedRgb<'a, B = ChannelBake> {
     diffuse: bool,
     /// Whether the surface has a diffraction lobe (σs > 0, b > 0).
     halo: bool,
+    /// The constants of `eval`'s f32 path, where it applies.
+    lanes: Option<Lanes>,
 }
 
 #[cfg(feature = "std")]
@@ -270,11 +338,13 @@ impl<'a, B: BorrowMut<ChannelBake>> IntegratedRgb<'a, B> {
         let colour = ColourBake::new(material, options.colour == ColourTerms::White);
         let diffuse = nodes.iter().any(|node| node.has_lobes().1);
         let halo = nodes[0].has_lobes().0;
+        let lanes = Lanes::new(&nodes, diffuse);
         IntegratedRgb {
             nodes,
             colour,
             diffuse,
             halo,
+            lanes,
         }
     }
 }
@@ -296,8 +366,16 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     #[doc(hidden)]
     pub fn visit_colour(&self, v: &mut dyn BakeVisitor) {
         v.array("wavelengths", &[INTEGRATED_COUNT], &INTEGRATED_WAVELENGTHS);
-        let surface = self.colour.surface.as_flattened().as_flattened();
-        v.array("surface", &[COLOUR_NODES, INTEGRATED_COUNT, 3], surface);
+        // Stored `[c][k]` per node; handed over `[k][c]`.
+        let surface: [[[f32; 3]; INTEGRATED_COUNT]; COLOUR_NODES] = self
+            .colour
+            .surface
+            .map(|row| core::array::from_fn(|k| row.map(|r| r[k])));
+        v.array(
+            "surface",
+            &[COLOUR_NODES, INTEGRATED_COUNT, 3],
+            surface.as_flattened().as_flattened(),
+        );
         v.array(
             "plain",
             &[INTEGRATED_COUNT, 3],
@@ -335,13 +413,124 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
     }
 
     /// ρ(i, o) per linear-sRGB channel (module documentation; C read at 4
-    /// of the wavelengths and interpolated at the others).
+    /// of the wavelengths and interpolated at the others). Conductors with
+    /// physical colour terms and the printed halo weight (every metal
+    /// preset) take an f32 path whose arithmetic over the 8 models
+    /// vectorises (`eval_lanes`: the same terms, e^x to 1e-7), the others
+    /// the terms in f64 (`eval_terms`).
     ///
     /// Mirrored in python/twoscale/drjit/models.py.
     pub fn eval(&self, i: [f32; 3], o: [f32; 3]) -> [f32; 3] {
         let Some(pair) = self.nodes[0].pair(i, o) else {
             return [0.0; 3];
         };
+        if let Some(lanes) = &self.lanes
+            && let Some(value) = self.eval_lanes(lanes, &pair)
+        {
+            return value;
+        }
+        self.eval_terms(&pair)
+    }
+
+    /// [`IntegratedRgb::eval`] in f32, one lane per model, with the models'
+    /// direction-bake rows gathered first, so that the arithmetic over the
+    /// 8 models vectorises: per model
+    /// `ρ_k = A_k F_k D G / (4 cos θi cos θo) + Q̄_k G (1 − A_k)/σrel,k² ·
+    /// (c−1) σs² b² / (2π λ_k²) · C_k` (HP17 24-33, as
+    /// [`TwoScale::surface_terms_with`]), `A_k = e^(−t)`,
+    /// `t = (4π cos θd/λ_k)² σrel,k²`, `(1 − e^(−t))/t` by its series to
+    /// `t⁴` below `t = 0.05` (truncation below 5e-10), Q̄ as
+    /// `QConstants::combine`, `e^x` by [`math::exp_lanef`]; then
+    /// `ρ_c = Σ_k ρ_k R_kc(cos θd)`. `None` where the halo needs C and C is
+    /// not baked (the T3a source).
+    #[inline(always)]
+    fn eval_lanes(&self, lanes: &Lanes, pair: &Pair) -> Option<[f32; 3]> {
+        const N: usize = INTEGRATED_COUNT;
+        let g = &pair.geometry;
+        let ln_c = if self.halo && pair.g > 0.0 {
+            Some(self.ln_conv(g)?)
+        } else {
+            None
+        };
+        // The rows at cos θi and cos θo and F at cos θd, per model.
+        let mut sigma = [0.0f32; N];
+        let mut f_d = [0.0f32; N];
+        let mut q_i = [[0.0f32; N]; 5];
+        let mut q_o = [[0.0f32; N]; 5];
+        for (k, node) in self.nodes.iter().enumerate() {
+            let bake = &node.bake().direction;
+            let (at_i, at_o) = (bake.at_cell(pair.cells[0]), bake.at_cell(pair.cells[1]));
+            let r_i = at_i.sigma_ratio() as f32;
+            sigma[k] = if lanes.symmetrised {
+                let r_o = at_o.sigma_ratio() as f32;
+                0.5 * (r_i * r_i + r_o * r_o)
+            } else {
+                r_i * r_i
+            };
+            f_d[k] = bake.fresnel_at(pair.cells[2]);
+            let (fi, fo) = (at_i.q_factors(), at_o.q_factors());
+            for m in 0..5 {
+                q_i[m][k] = fi[m] as f32;
+                q_o[m][k] = fo[m] as f32;
+            }
+        }
+        let mut conv = [0.0f32; N];
+        if let Some(ln) = ln_c {
+            let w = &CONV_LANES;
+            for k in 0..N {
+                let x = w[0][k] * ln[0] + w[1][k] * ln[1] + w[2][k] * ln[2] + w[3][k] * ln[3];
+                // c_of_ln's threshold: e^x is 0 in f32 below −103.3.
+                conv[k] = if x > -104.0 { math::exp_lanef(x) } else { 0.0 };
+            }
+        }
+        let (cos_i, cos_o) = (g.wi[2], g.wo[2]);
+        let specular = (pair.g / (4.0 * cos_i * cos_o) * pair.d) as f32;
+        let halo_g = pair.g as f32;
+        let cos_d_sq = (g.cos_d * g.cos_d) as f32;
+        // Q̄'s angles as QConstants::combine takes them.
+        let s_sq = pair.along * pair.along + pair.across * pair.across;
+        let (along, across, inv_s_sq) = if s_sq > 0.0 {
+            (pair.along as f32, pair.across as f32, (1.0 / s_sq) as f32)
+        } else {
+            (1.0, 0.0, 1.0)
+        };
+        let s_sq = s_sq as f32;
+        let mut rho = [0.0f32; N];
+        for k in 0..N {
+            let x = lanes.x_scale[k] * cos_d_sq;
+            let sigma_rel_sq = lanes.sigma_s_sq[k] * sigma[k];
+            let t = x * sigma_rel_sq;
+            let a = math::exp_lanef(-t);
+            let series = 1.0 - 0.5 * t * (1.0 - t / 3.0 * (1.0 - 0.25 * t * (1.0 - 0.2 * t)));
+            let one_minus_a_over = x * if t < 0.05 { series } else { (1.0 - a) / t };
+            // Q̄ (QConstants::combine).
+            let (ai, uir, uii, wir, wii) = (q_i[0][k], q_i[1][k], q_i[2][k], q_i[3][k], q_i[4][k]);
+            let (ao, uor, uoi, wor, woi) = (q_o[0][k], q_o[1][k], q_o[2][k], q_o[3][k], q_o[4][k]);
+            let [er, ei] = lanes.eta_sq[k];
+            let (uu_re, uu_im) = (uir * uor - uii * uoi, uir * uoi + uii * uor);
+            let (ww_re, ww_im) = (wir * wor - wii * woi, wir * woi + wii * wor);
+            let pp_re = uu_re * along - (er * ww_re - ei * ww_im) * s_sq;
+            let pp_im = uu_im * along - (er * ww_im + ei * ww_re) * s_sq;
+            let q = ai * ao * (along * along)
+                + (ai * (uor * uor + uoi * uoi) + (uir * uir + uii * uii) * ao) * (across * across)
+                + (pp_re * pp_re + pp_im * pp_im);
+            let q_bar = (lanes.half_e[k] * q * inv_s_sq).max(0.0);
+            let value = a * f_d[k] * specular
+                + q_bar * halo_g * lanes.halo_scale[k] * one_minus_a_over * conv[k];
+            rho[k] = if value.is_finite() { value } else { 0.0 };
+        }
+        let r = self.colour.surface_at(g.cos_d);
+        let mut out = [0.0f32; 3];
+        for k in 0..N {
+            for c in 0..3 {
+                out[c] += rho[k] * r[c][k];
+            }
+        }
+        Some(out.map(|x| if x.is_finite() && x > 0.0 { x } else { 0.0 }))
+    }
+
+    /// [`IntegratedRgb::eval`] term by term in f64 (every material).
+    fn eval_terms(&self, pair: &Pair) -> [f32; 3] {
         let g = &pair.geometry;
         let ln_c = if self.halo && pair.g > 0.0 {
             self.ln_conv(g)
@@ -361,7 +550,7 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
                 None => node.conv_at(g.sin_h, g.cos_h, (node.big_b * g.cos_d) as f32),
             };
             // `TwoScale::lobes` in f64, without rounding each lobe to f32.
-            let t = node.surface_terms_with(&pair, node.white(), conv);
+            let t = node.surface_terms_with(pair, node.white(), conv);
             let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
             let surface = finite(t.a_spec * t.rho_ct + t.diffraction);
             if self.diffuse {
@@ -372,11 +561,11 @@ impl<B: Borrow<ChannelBake>> IntegratedRgb<'_, B> {
                 );
                 for c in 0..3 {
                     out[c] +=
-                        surface * f64::from(r[k][c]) + base * f64::from(self.colour.plain[k][c]);
+                        surface * f64::from(r[c][k]) + base * f64::from(self.colour.plain[k][c]);
                 }
             } else {
                 for c in 0..3 {
-                    out[c] += surface * f64::from(r[k][c]);
+                    out[c] += surface * f64::from(r[c][k]);
                 }
             }
         }
@@ -436,4 +625,88 @@ pub enum RgbModel<'a, B = ChannelBake> {
     PaperWavelengths(super::Rgb<'a, B>),
     /// [`RgbMode::Integrated`](crate::material::RgbMode::Integrated).
     Integrated(IntegratedRgb<'a, B>),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::TableSet;
+    use crate::materials::SPECTRAL_PRESETS;
+
+    /// A direction of the upper hemisphere, uniform in `cos θ` (grazing
+    /// included) and φ.
+    fn direction(rng: &mut crate::test_rng::Lcg) -> [f32; 3] {
+        let (z, phi) = (
+            rng.next().max(1e-4),
+            2.0 * core::f64::consts::PI * rng.next(),
+        );
+        let s = (1.0 - z * z).sqrt();
+        [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
+    }
+
+    /// The f32 path is the f64 terms' sum: on every metal preset (which
+    /// takes it) and with σrel symmetrised, within 1e-5 relative per
+    /// channel where the channel exceeds 1e-6 of its peak, at 4000 pairs
+    /// (half of them around the mirror direction, where the halo is).
+    #[test]
+    fn lanes_equal_the_f64_terms() {
+        let set = TableSet::embedded();
+        let tables = set.brdf_tables();
+        let mut worst = (0.0f64, "");
+        let symmetrised = Options {
+            sigma_rel: SigmaRelMode::Symmetrised,
+            ..Options::default()
+        };
+        let mut lanes_taken = 0;
+        for preset in SPECTRAL_PRESETS {
+            for options in [Options::default(), symmetrised] {
+                let bakes = core::array::from_fn(|_| std::boxed::Box::new(ChannelBake::zeroed()));
+                let model = IntegratedRgb::new_in(bakes, &tables, &preset.material, options);
+                let Some(lanes) = &model.lanes else {
+                    continue;
+                };
+                lanes_taken += 1;
+                let mut rng = crate::test_rng::Lcg(43);
+                let mut values = std::vec::Vec::new();
+                for k in 0..4000 {
+                    let i = direction(&mut rng);
+                    let o = if k % 2 == 0 {
+                        direction(&mut rng)
+                    } else {
+                        let d = 0.3 * rng.next() as f32;
+                        let phi = 2.0 * core::f32::consts::PI * rng.next() as f32;
+                        let o = [-i[0] + d * phi.cos(), -i[1] + d * phi.sin(), i[2]];
+                        let n = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt();
+                        o.map(|x| x / n)
+                    };
+                    let Some(pair) = model.nodes[0].pair(i, o) else {
+                        continue;
+                    };
+                    let fast = model.eval_lanes(lanes, &pair).expect("C is baked");
+                    values.push((fast, model.eval_terms(&pair)));
+                }
+                let peak = values.iter().fold([0.0f32; 3], |m, (_, r)| {
+                    core::array::from_fn(|c| m[c].max(r[c]))
+                });
+                for (fast, reference) in &values {
+                    for c in 0..3 {
+                        let r = f64::from(reference[c]);
+                        if r > 1e-6 * f64::from(peak[c]) {
+                            let e = (f64::from(fast[c]) / r - 1.0).abs();
+                            if e > worst.0 {
+                                worst = (e, preset.name);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        std::eprintln!(
+            "lanes against f64 terms: worst {:.2e} ({})",
+            worst.0,
+            worst.1
+        );
+        assert!(lanes_taken >= 18, "{lanes_taken} models took the f32 path");
+        assert!(worst.0 <= 1e-5, "{worst:?}");
+    }
 }

@@ -26,6 +26,6 @@ fn stated_sizes_are_the_types() {
     assert_eq!(kb::<ColourBake>(), 6);
     assert_eq!(kb::<TwoScale<'static>>(), 141);
     assert_eq!(kb::<Rgb<'static>>(), 424);
-    assert_eq!(kb::<IntegratedRgb<'static>>(), 1136);
+    assert_eq!(kb::<IntegratedRgb<'static>>(), 1137);
     assert!(size_of::<TwoScale<'static, std::boxed::Box<ChannelBake>>>() < 400);
 }
