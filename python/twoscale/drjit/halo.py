@@ -28,39 +28,41 @@ class Halo:
     def _row_cell(self, wi):
         """`HaloBake::row_cell` at `u = B cos θi`: the row below (from the C
         bake's u axis, as its own look-up finds it) and the fraction
-        `(u − u_j)/(u_j+1 − u_j)` (f64)."""
+        `(u − u_j)/(u_j+1 − u_j)` ."""
         n_u = self.shapes["halo_u"][0]
-        u = dr.clip(self.d["big_b"] * wi.z, 0.0, self.halo_u_top)
+        u = dr.clip(self.f["big_b"] * wi.z, 0.0, self.halo_u_top)
         uf = mi.Float(u)
         position = ((log2_axis(1.0 + uf / self.s["conv_u0"]) + uf * self.f["conv_u_linear"])
                     * self.f["conv_u_scale"])
         j = self._at_node(
-            u, lambda j: dr.gather(mi.Float64, self.t["halo_u"], self._node_row(j, n_u)),
+            u, lambda j: dr.gather(mi.Float, self.t["halo_u"], self._node_row(j, n_u)),
             position, n_u)
         row = self._node_row(j, n_u)
-        u0 = dr.gather(mi.Float64, self.t["halo_u"], row)
-        inv_du = dr.gather(mi.Float64, self.t["halo_inv_du"], row)
+        u0 = dr.gather(mi.Float, self.t["halo_u"], row)
+        inv_du = dr.gather(mi.Float, self.t["halo_inv_du"], row)
         return row, dr.clip((u - u0) * inv_du, 0.0, 1.0)
 
     def _halo_zeta(self, row, k):
         n_s = self.shapes["halo_zeta"][1]
-        return mi.Float64(dr.gather(mi.Float, self.t["halo_zeta"], row * n_s + k))
+        return dr.gather(mi.Float, self.t["halo_zeta"], row * n_s + k)
 
-    def _halo_cum(self, row, k):
+    def _halo_cum(self, row, k, tail=False):
+        """Row `row`'s cumulative mass at node `k`, or with `tail` (a mask)
+        the mass above it (`lookups.sampler_tables`)."""
         n_s = self.shapes["halo_zeta"][1]
-        return dr.gather(mi.Float64, self.t["halo_cum"], row * n_s + k)
+        return dr.gather(mi.Float, self.t["halo_cum"], row * (2 * n_s) + (dr.select(tail, n_s, 0) if isinstance(tail, mi.Bool) else 0) + k)
 
     def _halo_coef(self, row, k):
-        """`[start, slope]` of row `row`'s cell `k` (f64)."""
+        """`[start, slope]` of row `row`'s cell `k` ."""
         n_s = self.shapes["halo_zeta"][1]
         c = dr.gather(mi.Vector2f, self.t["halo_coef"], row * n_s + k)
         column = self.columns["halo_coef"]
-        return mi.Float64(c[column["start"]]), mi.Float64(c[column["slope"]])
+        return c[column["start"]], c[column["slope"]]
 
     @staticmethod
     def _azimuth(sin_i, cos_i, sin_h, cos_h):
         """`halo::Azimuth::new`: `(H, [A₂, A₁, A₀], F(H))` of the azimuth law
-        `∝ (i·h)(cos θo)₊` and whether it exists (f64); `F(H)` from
+        `∝ (i·h)(cos θo)₊` and whether it exists; `F(H)` from
         `x = cos H` without a sine or cosine."""
         a, b = sin_i * sin_h, cos_i * cos_h
         kappa = cos_i / (2.0 * cos_h)
@@ -94,25 +96,25 @@ class Halo:
         k = self._zeta_cell(row, z, sec_h, tan_h)
         start, slope = self._halo_coef(row, k)
         d = start + slope * (z - self._halo_zeta(row, k))
-        inv_total = dr.gather(mi.Float64, self.t["halo_inv_total"], row)
+        inv_total = dr.gather(mi.Float, self.t["halo_inv_total"], row)
         ok = z <= self._halo_zeta(row, n_s - 1)
         return dr.select(ok, dr.maximum(d, 0.0) * inv_total, 0.0)
 
     def halo_pdf(self, wi, sin_h, cos_h, cos_o):
-        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`, f64."""
+        """`HaloBake::pdf`: `Σ_j w_j p_j(ζ) cos θo / (4 N(θh))`."""
         sin_i = dr.minimum(dr.sqrt(wi.x * wi.x + wi.y * wi.y), 1.0)
         _, _, half, exists = self._azimuth(sin_i, wi.z, sin_h, cos_h)
         zeta = sin_h * sin_h / (1.0 + cos_h)
         j, t = self._row_cell(wi)
         # The C bake's θh axis variables (`HaloBake::pdf_zeta`).
-        sec_h = 1.0 / dr.maximum(mi.Float(cos_h), 1e-3)
-        tan_h = dr.clip(mi.Float(sin_h), 0.0, 1.0) * sec_h
+        sec_h = 1.0 / dr.maximum(cos_h, 1e-3)
+        tan_h = dr.clip(sin_h, 0.0, 1.0) * sec_h
         p = dr.select(t < 1.0, (1.0 - t) * self._row_pdf(j, zeta, sec_h, tan_h), 0.0)
         p += dr.select(t > 0.0, t * self._row_pdf(j + 1, zeta, sec_h, tan_h), 0.0)
         return dr.select(exists, p * dr.maximum(cos_o, 0.0) / (8.0 * half), 0.0)
 
     def halo_sample(self, wi, pick, along):
-        """`HaloBake::sample_h`: a half-vector (f64) and whether the row had mass."""
+        """`HaloBake::sample_h`: a half-vector and whether the row had mass."""
         below_one = float(np.float32(1.0) - np.finfo(np.float32).eps / np.float32(2.0))
         n_s = self.shapes["halo_zeta"][1]
         j, t = self._row_cell(wi)
@@ -121,14 +123,25 @@ class Halo:
         azimuth = dr.select(lower, pick / (1.0 - t), (pick - (1.0 - t)) / t)
         azimuth = dr.clip(azimuth, 0.0, below_one)
         total = self._halo_cum(row, n_s - 1)
-        target = along * total
-        # The row's guide (`guide::scan` in `HaloBake::sample_h`).
+        # From the row's end where `along ≥ ½` (`lookups.sampler_tables`):
+        # the last k with cum(k) ≤ along·total is the last with
+        # tail(k) ≥ (1 − along) total, compared as −tail(k) ≤ −(1 − along) total.
+        upper = along >= 0.5
+        target = dr.select(upper, -((1.0 - along) * total), along * total)
+        # The row's guide (`guide::scan` in `HaloBake::sample_h`), its top
+        # one cell higher (`guide_bin`).
         edges = self.shapes["halo_guide"][1]
         b = guide_bin(self.s, along)
         lo = mi.UInt32(dr.gather(mi.Float, self.t["halo_guide"], row * edges + b))
         hi = mi.UInt32(dr.gather(mi.Float, self.t["halo_guide"], row * edges + b + 1))
-        k = guide_scan(lo, hi, self._halo_scan_cells(), target, lambda k: self._halo_cum(row, k))
-        rest = dr.maximum(target - self._halo_cum(row, k), 0.0)
+        hi = dr.minimum(hi + 1, n_s - 2)
+
+        def signed_cum(k):
+            c = self._halo_cum(row, k, upper)
+            return dr.select(upper, -c, c)
+
+        k = guide_scan(lo, hi, self._halo_scan_cells(), target, signed_cum)
+        rest = dr.maximum(target - signed_cum(k), 0.0)
         start, slope = self._halo_coef(row, k)
         z0, z1 = self._halo_zeta(row, k), self._halo_zeta(row, k + 1)
         den = start + dr.sqrt(dr.maximum(start * start + 2.0 * slope * rest, 0.0))
@@ -145,7 +158,7 @@ class Halo:
         cos_phi_i = dr.select(has, wi.x / sin_i, 1.0)
         sin_phi_i = dr.select(has, wi.y / sin_i, 0.0)
         cp, sp = dr.cos(psi), dr.sin(psi)
-        h = mi.Vector3d(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
+        h = mi.Vector3f(sin_h * (cos_phi_i * cp - sin_phi_i * sp),
                         sin_h * (sin_phi_i * cp + cos_phi_i * sp), cos_h)
         return h, (total > 0.0) & exists
 
@@ -167,4 +180,4 @@ class Halo:
         return newton_in_bracket(
             lambda psi: Halo._azimuth_cdf(coef, psi) - target,
             lambda psi: (coef[0] * dr.cos(psi) + coef[1]) * dr.cos(psi) + coef[2],
-            psi, mi.Float64(big_h), NEWTON_TOL)
+            psi, big_h, NEWTON_TOL)

@@ -32,19 +32,32 @@ def lerp_gather(table, width, column, i, frac):
     return dr.fma(frac, b - a, a)
 
 
+def sampler_tables(bakes):
+    """`bakes` with the samplers' cumulative tables in the form the f32
+    draws read (computed in f64, then rounded once): ``halo_cum`` and
+    ``visible_cum`` as `[cum, total − cum]` along their last axis, so that a
+    draw with `u ≥ ½` measures its rest from the row's end (`(1 − u) total −
+    (total − cum_k)`, small numbers) and the difference it takes is exact
+    to f32 rounding of the cell's own mass, not of the row's total."""
+    out = dict(bakes)
+    for name in ("halo_cum", "visible_cum"):
+        cum = np.asarray(bakes[name], np.float64)
+        out[name] = np.concatenate([cum, cum[..., -1:] - cum], axis=-1)
+    return out
+
+
 def upload(values):
-    """A bake as a Dr.Jit array (``mi.Float``, or ``mi.Float64`` for f64:
-    the samplers' cumulative tables, read by visible.py and halo.py only)
+    """A bake as an f32 Dr.Jit array (``mi.Float``; f64 tables rounded once)
     over a copy of `values` aligned to 64 bytes. Dr.Jit maps a NumPy
     array's memory rather than copying it, and gathers a packet
     (:func:`gather4`) as one load only from an aligned table: elsewhere it
     falls back to four gathers."""
-    values = np.ascontiguousarray(values).ravel()
+    values = np.ascontiguousarray(values, dtype=np.float32).ravel()
     buf = np.empty(values.nbytes + 64, np.uint8)
     start = -buf.ctypes.data % 64
     out = buf[start:start + values.nbytes].view(values.dtype)
     out[:] = values
-    return (mi.Float64 if values.dtype == np.float64 else mi.Float)(out)
+    return mi.Float(out)
 
 
 def gather4(table, k):
@@ -90,6 +103,7 @@ class Bakes:
     columns by name (``columns``: array name → column name → index)."""
 
     def __init__(self, bakes):
+        bakes = sampler_tables(bakes)
         self.columns = {name: {c: k for k, c in enumerate(names)}
                         for name, names in bakes["columns"].items()}
         self.s = {k: (v if isinstance(v, str) else float(v)) for k, v in bakes.items()
@@ -104,8 +118,8 @@ class Bakes:
         # (`VisibleSlopeBake::x_node`, `p_node`), and the last node's mass
         # and moment (`Φ` of the whole table), as constants.
         rows, p2 = bakes["visible_rows"], bakes["visible_p2"]
-        self.t["visible_x"] = mi.Float64(np.concatenate([-rows[:0:-1], rows]))
-        self.t["visible_px"] = mi.Float64(np.concatenate([p2[:0:-1], p2]))
+        self.t["visible_x"] = upload(np.concatenate([-rows[:0:-1], rows]))
+        self.t["visible_px"] = upload(np.concatenate([p2[:0:-1], p2]))
         s["visible_mass_end"] = float(bakes["visible_mass"][-1])
         s["visible_moment_end"] = float(bakes["visible_moment"][-1])
         s["visible_h_end"] = float(rows[-1] - rows[-2])
@@ -115,8 +129,8 @@ class Bakes:
         f_dr = s["f_dr_int"]
         s["base_inv_n_sq"] = 1.0 / (n * n)
         s["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
-        # f32 constants; the f64 ones (`d`) are the samplers' (visible.py, halo.py) only.
-        self.f, self.d = Opaque(s, mi.Float), Opaque(s, mi.Float64)
+        # f32 constants (the samplers' too: visible.py, halo.py).
+        self.f = Opaque(s, mi.Float)
         # ln C as overlapping packets: packet j holds nodes j … j + 3 of the
         # flattened grid (so that a Catmull–Rom row is one packet gather).
         ln_c = np.ascontiguousarray(bakes["conv_ln_c"], dtype=np.float32).ravel()

@@ -23,15 +23,12 @@ def log2_axis(x):
     return exponent + m * (_AXIS_D0 + m * (_AXIS_C2 + m * _AXIS_C3))
 
 
-#: The Newton solves' stopping step (relative to `|x0| + τmax` in the
-#: visible sampler's cell, in radians for the halo's azimuth). The
-#: runtime stops at 1e-13 (visible) and 1e-12 (halo), which sits at or below
-#: the f64 noise of the residuals: where it does, Newton's step never gets
-#: that small, and the lane bisects in the noise band for 20–30 more steps
-#: (≈40% of the visible sampler's lanes). Once a step is ≤ 1e-9, Newton's
-#: error after it is ~1e-18 (quadratic convergence), so stopping there gives
-#: the runtime's root to f64 noise, far below the f32 direction returned.
-NEWTON_TOL = 1e-9
+#: The Newton solves' stopping step, f32-sized: four f32 ulps of 1
+#: (relative to `|x0| + τmax` in the visible sampler's cell, in radians for
+#: the halo's azimuth). The residuals are f32, so a step below a few ulps of
+#: the root is rounding noise; once a step is this small, Newton's error
+#: after it (quadratic convergence) is far below the f32 direction returned.
+NEWTON_TOL = 4.0 * float(np.finfo(np.float32).eps)
 
 
 def newton_in_bracket(residual, slope, t, hi, tol, curvature=None):

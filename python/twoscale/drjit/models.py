@@ -13,7 +13,7 @@ import numpy as np
 import twoscale
 
 from .lobes import Channel, draw, exp_and_one_minus_over
-from .lookups import c_of_ln, cell_at, gather4, upload
+from .lookups import c_of_ln, cell_at, gather4, sampler_tables, upload
 from .math import finite_or_zero
 
 
@@ -212,8 +212,9 @@ class NodeChannel(Channel):
             raise ValueError(f"twoscale: the spectral models differ in {clash}")
         super().__init__({k: (v[0] if k in per_node else v) for k, v in models.items()})
         self.specialise(models)
-        stacked = {k: models[k] for k in per_node}
-        stacked.update({k: np.stack([models[k]] * count) for k in self.ROWS if k not in per_node})
+        tables = sampler_tables(models)
+        stacked = {k: tables[k] for k in per_node}
+        stacked.update({k: np.stack([tables[k]] * count) for k in self.ROWS if k not in per_node})
         arrays = {k: v for k, v in stacked.items() if np.ndim(v) > 1}
         for name, v in arrays.items():
             self.t[name] = upload(v)
@@ -230,7 +231,6 @@ class NodeChannel(Channel):
             scalars["base_inv_n_sq"] = 1.0 / (n * n)
             scalars["base_a_f"] = (1.0 - f_dr) / (1.0 + f_dr)
         self.node_f = {k: mi.Float(v) for k, v in scalars.items()}
-        self.node_d = {k: mi.Float64(v) for k, v in scalars.items()}
         self.halo_u_nodes = self.shapes["halo_u"][0]
 
     def at(self, k):
@@ -238,9 +238,8 @@ class NodeChannel(Channel):
         view = copy.copy(self)
         view.k = k
         view.f = NodeScalars(self.f, self.node_f, mi.Float, k)
-        view.d = NodeScalars(self.d, self.node_d, mi.Float64, k)
         n_u = self.halo_u_nodes
-        view.halo_u_top = dr.gather(mi.Float64, self.t["halo_u"], view._node_row(n_u - 1, n_u))
+        view.halo_u_top = dr.gather(mi.Float, self.t["halo_u"], view._node_row(n_u - 1, n_u))
         return view
 
     def _node_row(self, i, n):

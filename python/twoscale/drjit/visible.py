@@ -11,32 +11,41 @@ from .math import NEWTON_TOL, log2_axis, newton_in_bracket
 
 
 def guide_bin(s, u):
-    """`guide::bin` of `u` (f64) on the guide axis of the constants `s`
-    (`guide_octaves`, `guide_linear`): `guide::position`, `e + f + octaves`
-    (`min(u, 1 − u) = 2^e (1 + f)`, floored at 0) plus `linear · min(u, 1 − u)`,
-    mirrored about `u = ½`. In f64: the bin must be the one whose edges
-    bracket `u` exactly (an f32 position could put `u` one bin off near an
-    edge, and its quantile outside the bracket)."""
+    """`guide::bin` of `u` on the guide axis of the constants `s`
+    (`guide_octaves`, `guide_linear`), in f32: `guide::position`, `e + f +
+    octaves` (`min(u, 1 − u) = 2^e (1 + f)`, floored at 0) plus `linear ·
+    min(u, 1 − u)`, mirrored about `u = ½` (`1 − u` is exact for `u ≥ ½`).
+    The f32 position is within a few ulps (< 2⁻¹⁰) of the exact one; it is
+    lowered by 2⁻¹⁰ before the floor, so the bin is the exact one or the
+    one below, and a bracket read from it takes one more cell at its top
+    (:func:`guide_scan`'s `hi + 1`)."""
     octaves, linear = s["guide_octaves"], s["guide_linear"]
     half_pos = octaves - 1.0 + 0.5 * linear
     bins = int(2 * half_pos)
-    u = mi.Float64(u)
+    u = mi.Float(u)
     lower = u < 0.5
     m = dr.maximum(dr.select(lower, u, 1.0 - u), 0.0)
-    bits = dr.reinterpret_array(mi.UInt64, m)
-    exponent = mi.Float64(mi.Int64((bits >> 52) & 0x7FF) - 1023)
-    frac = dr.reinterpret_array(mi.Float64, (bits & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000) - 1.0
-    half = dr.maximum(exponent + frac + octaves, 0.0) + linear * m
-    position = dr.select(lower, half, 2.0 * half_pos - half)
+    half = dr.maximum(log2_axis_exact(m) + octaves, 0.0) + linear * m
+    position = dr.select(lower, half, 2.0 * half_pos - half) - 2.0 ** -10
     return mi.UInt32(dr.clip(position, 0.0, float(bins - 1)))
 
 
+def log2_axis_exact(m):
+    """`e + f` for `m = 2^e (1 + f)` (f32 bits; `m = 0` gives −127)."""
+    bits = dr.reinterpret_array(mi.UInt32, m)
+    exponent = mi.Float(mi.Int32((bits >> 23) & 0xFF) - 127)
+    frac = dr.reinterpret_array(mi.Float, (bits & 0x007FFFFF) | 0x3F800000) - 1.0
+    return exponent + frac
+
+
 def guide_scan(lo, hi, cells, target, cum):
-    """`guide::scan` with a fixed `cells` comparisons (the widest bracket
-    of the guide): `lo` plus the count of `k ∈ (lo, hi]` with `cum(k) ≤
-    target`, gathers that do not wait on one another."""
+    """`guide::scan` with a fixed `cells + 1` comparisons (the widest
+    bracket of the guide, and the cell above it that :func:`guide_bin`'s
+    lowered bin may need; the caller extends `hi` by one): `lo` plus the
+    count of `k ∈ (lo, hi]` with `cum(k) ≤ target`, gathers that do not
+    wait on one another."""
     j = mi.UInt32(lo)
-    for step in range(1, cells + 1):
+    for step in range(1, cells + 2):
         k = dr.minimum(lo + step, hi)
         j += dr.select((lo + step <= hi) & (cum(k) <= target), 1, 0)
     return j
@@ -47,7 +56,7 @@ class Visible:
     ``visible_*`` tables (a mixin of :class:`~twoscale.drjit.lobes.Channel`)."""
 
     def _visible_node(self, name, k):
-        return dr.gather(mi.Float64, self.t[name], k)
+        return dr.gather(mi.Float, self.t[name], k)
 
     def _visible_guide(self, name, k):
         return mi.UInt32(dr.gather(mi.Float, self.t[name], k))
@@ -99,11 +108,11 @@ class Visible:
                 - sn * self._visible_node("visible_moment", j))
 
     def _visible_incidence(self, wi):
-        """`VisibleSlopeBake::incidence` of the unit `wi` (f64, `wi.z > 0`):
+        """`VisibleSlopeBake::incidence` of the unit `wi` (`wi.z > 0`):
         the stretched incidence `c, s, |i'|`, its unit tangential direction,
         the last cell `j_end` the visible marginal reaches, the visible
         length `τ_end` of it and `N_tab`."""
-        beta, r_max = self.d["visible_beta"], self.d["visible_r_max"]
+        beta, r_max = self.f["visible_beta"], self.f["visible_r_max"]
         rows_n = self.shapes["visible_rows"][0]
         tangential = dr.sqrt(wi.x * wi.x + wi.y * wi.y)
         bt = beta * tangential
@@ -120,9 +129,9 @@ class Visible:
         p0 = self._visible_node("visible_p2", i_mu)
         k = (self._visible_node("visible_p2", i_mu + 1) - p0) / (x1 - x0)
         j_mu = rows_n - 1 + i_mu
-        phi_end = c * self.d["visible_mass_end"] - sn * self.d["visible_moment_end"]
+        phi_end = c * self.f["visible_mass_end"] - sn * self.f["visible_moment_end"]
         j_end = dr.select(reaches, j_mu, mi.UInt32(2 * rows_n - 3))
-        tau_end = dr.select(reaches, mu - x0, self.d["visible_h_end"])
+        tau_end = dr.select(reaches, mu - x0, self.f["visible_h_end"])
         norm = dr.select(reaches, self._visible_phi(c, sn, j_mu)
                          + self._visible_cell_integral(c, sn, x0, p0, k, mu - x0), phi_end)
         # `VisibleSlopeBake::guide_incidence`: μ's row cell, or beyond r_max
@@ -134,8 +143,8 @@ class Visible:
                                      tau_end=tau_end, norm=norm, guide_a=guide_a)
 
     def visible_pdf(self, wi, wo):
-        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density, f64."""
-        beta, r_max = self.d["visible_beta"], self.d["visible_r_max"]
+        """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density."""
+        beta, r_max = self.f["visible_beta"], self.f["visible_r_max"]
         cols_n = self.shapes["visible_cols"][0]
         inc = self._visible_incidence(wi)
         c, sn, t0, t1 = inc.c, inc.sn, inc.t0, inc.t1
@@ -154,14 +163,15 @@ class Visible:
             return a0 + lam * (self._visible_node(name, k1) - a0)
 
         def dens(k):
-            d0 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + k))
-            d1 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + k))
+            d0 = dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + k)
+            d1 = dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + k)
             return d0 + lam * (d1 - d0)
 
         p2 = blend("visible_p2", i, i + 1)
         kk, tt, _, _ = self._visible_locate(dr.abs(y), "visible_cols", self.f["visible_col_scale"])
         g0, g1 = dens(kk), dens(kk + 1)
-        total = blend("visible_cum", i * cols_n + cols_n - 1, (i + 1) * cols_n + cols_n - 1)
+        total = blend("visible_cum", i * (2 * cols_n) + cols_n - 1,
+                      (i + 1) * (2 * cols_n) + cols_n - 1)
         g = (g0 + tt * (g1 - g0)) / total
         # 1/cos⁴θh = (1 + |slope|²)² with the unstretched slope β (sx, sy).
         slope_sq = beta * beta * (sx * sx + sy * sy)
@@ -171,8 +181,8 @@ class Visible:
 
     def visible_sample(self, wi, u0, u1):
         """`VisibleSlopeBake::sample`: a visible EPD normal for the unit `wi`
-        (f64) from two uniforms, and whether the tables gave mass."""
-        beta = self.d["visible_beta"]
+        from two uniforms, and whether the tables gave mass."""
+        beta = self.f["visible_beta"]
         cols_n = self.shapes["visible_cols"][0]
         inc = self._visible_incidence(wi)
         c, sn = inc.c, inc.sn
@@ -185,6 +195,7 @@ class Visible:
         hi = dr.minimum(self._visible_guide("visible_marginal_guide",
                                             (inc.guide_a + 1) * edges + b + 1), inc.j_end)
         lo = dr.minimum(self._visible_guide("visible_marginal_guide", inc.guide_a * edges + b), hi)
+        hi = dr.minimum(hi + 1, inc.j_end)  # `guide_bin`'s bin may be the one below
         j = guide_scan(lo, hi, scan_marginal, target, lambda j: self._visible_phi(c, sn, j))
         x0, p0 = self._visible_node("visible_x", j), self._visible_node("visible_px", j)
         x1 = self._visible_node("visible_x", j + 1)
@@ -201,28 +212,40 @@ class Visible:
         a0, a1 = dr.select(negative, -x1, x0), dr.select(negative, -x0, x1)
         lam = dr.clip((dr.abs(x) - a0) / (a1 - a0), 0.0, 1.0)
 
-        def cum(col):
-            a0 = self._visible_node("visible_cum", i * cols_n + col)
-            return a0 + lam * (self._visible_node("visible_cum", (i + 1) * cols_n + col) - a0)
+        # From the row's end where |2u − 1| ≥ ½ (`lookups.sampler_tables`):
+        # the last column with cum ≤ a·total is the last with
+        # tail ≥ (1 − a) total, compared as −tail ≤ −(1 − a) total.
+        a = dr.abs(2.0 * u1 - 1.0)
+        upper = a >= 0.5
+        side = dr.select(upper, cols_n, 0)
+
+        def signed_cum(col):
+            a0 = self._visible_node("visible_cum", i * (2 * cols_n) + side + col)
+            a1 = self._visible_node("visible_cum", (i + 1) * (2 * cols_n) + side + col)
+            c = a0 + lam * (a1 - a0)
+            return dr.select(upper, -c, c)
 
         def dens(col):
-            d0 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + col))
-            d1 = mi.Float64(dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + col))
+            d0 = dr.gather(mi.Float, self.t["visible_dens"], i * cols_n + col)
+            d1 = dr.gather(mi.Float, self.t["visible_dens"], (i + 1) * cols_n + col)
             return d0 + lam * (d1 - d0)
 
         signed = 2.0 * u1 - 1.0
-        q = dr.abs(signed) * cum(cols_n - 1)
-        # `VisibleSlopeBake::conditional_bracket`: between the rows' own cells.
-        bq = guide_bin(self.s, dr.abs(signed))
+        total = dr.abs(signed_cum(dr.select(upper, 0, cols_n - 1)))
+        q = dr.select(upper, -((1.0 - a) * total), a * total)
+        # `VisibleSlopeBake::conditional_bracket`: between the rows' own
+        # cells, its top one cell higher (`guide_bin`).
+        bq = guide_bin(self.s, a)
         gi = [self._visible_guide("visible_conditional_guide", i * edges + bq + d) for d in (0, 1)]
         gn = [self._visible_guide("visible_conditional_guide", (i + 1) * edges + bq + d)
               for d in (0, 1)]
-        kk = guide_scan(dr.minimum(gi[0], gn[0]), dr.maximum(gi[1], gn[1]), scan_conditional,
-                        q, cum)
+        kk = guide_scan(dr.minimum(gi[0], gn[0]),
+                        dr.minimum(dr.maximum(gi[1], gn[1]) + 1, cols_n - 2),
+                        scan_conditional, q, signed_cum)
         y0 = self._visible_node("visible_cols", kk)
         w = self._visible_node("visible_cols", kk + 1) - y0
         g0, g1 = dens(kk), dens(kk + 1)
-        r = dr.maximum(q - cum(kk), 0.0)
+        r = dr.maximum(q - signed_cum(kk), 0.0)
         # (g1 − g0) w τ²/2 + g0 w τ = r, the root in [0, 1] without cancellation.
         b = g0 * w
         disc = dr.maximum(b * b + 2.0 * (g1 - g0) * w * r, 0.0)
@@ -233,7 +256,7 @@ class Visible:
         sx = beta * (x * inc.t0 - y * inc.t1)
         sy = beta * (x * inc.t1 + y * inc.t0)
         inv = 1.0 / dr.sqrt(1.0 + sx * sx + sy * sy)
-        return mi.Vector3d(-sx * inv, -sy * inv, inv), inc.norm > 0.0
+        return mi.Vector3f(-sx * inv, -sy * inv, inv), inc.norm > 0.0
 
     @staticmethod
     def _solve_cell(c, sn, x0, p0, k, tau_max, rest):
@@ -254,4 +277,4 @@ class Visible:
         tol = NEWTON_TOL * (dr.abs(x0) + tau_max)
         return newton_in_bracket(
             lambda t: Visible._visible_cell_integral(c, sn, x0, p0, k, t) - rest, density,
-            t, mi.Float64(tau_max), tol, lambda t: k * (a - sn * t) - sn * (p0 + k * t))
+            t, tau_max, tol, lambda t: k * (a - sn * t) - sn * (p0 + k * t))
