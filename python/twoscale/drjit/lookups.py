@@ -35,14 +35,21 @@ def lerp_gather(table, width, column, i, frac):
 def sampler_tables(bakes):
     """`bakes` with the samplers' cumulative tables in the form the f32
     draws read (computed in f64, then rounded once): ``halo_cum`` and
-    ``visible_cum`` as `[cum, total − cum]` along their last axis, so that a
-    draw with `u ≥ ½` measures its rest from the row's end (`(1 − u) total −
-    (total − cum_k)`, small numbers) and the difference it takes is exact
-    to f32 rounding of the cell's own mass, not of the row's total."""
+    ``visible_cum`` (and the visible marginal's ``visible_mass``,
+    ``visible_moment``) as `[cum, total − cum]` along their last axis, so
+    that a draw with `u ≥ ½` measures its rest from the end (`(total −
+    cum_k) − (1 − u) total`, small numbers near the end): the difference it
+    takes has the f32 rounding of the mass beyond the cell, not of the
+    total."""
     out = dict(bakes)
-    for name in ("halo_cum", "visible_cum"):
+    for name in ("halo_cum", "visible_cum", "visible_mass", "visible_moment"):
         cum = np.asarray(bakes[name], np.float64)
         out[name] = np.concatenate([cum, cum[..., -1:] - cum], axis=-1)
+    # `Φ` of the whole table, and from the last cell's left node to the end.
+    mass, moment = np.asarray(bakes["visible_mass"]), np.asarray(bakes["visible_moment"])
+    out["visible_mass_end"], out["visible_moment_end"] = float(mass[-1]), float(moment[-1])
+    out["visible_mass_last"] = float(mass[-1] - mass[-2])
+    out["visible_moment_last"] = float(moment[-1] - moment[-2])
     return out
 
 
@@ -115,13 +122,10 @@ class Bakes:
         self.halo_u_top = float(bakes["halo_u"][-1])
         s["visible_r_max"] = self.r_max
         # The marginal's x̃ nodes −r_max … 0 … r_max and P2_tab there
-        # (`VisibleSlopeBake::x_node`, `p_node`), and the last node's mass
-        # and moment (`Φ` of the whole table), as constants.
+        # (`VisibleSlopeBake::x_node`, `p_node`).
         rows, p2 = bakes["visible_rows"], bakes["visible_p2"]
         self.t["visible_x"] = upload(np.concatenate([-rows[:0:-1], rows]))
         self.t["visible_px"] = upload(np.concatenate([p2[:0:-1], p2]))
-        s["visible_mass_end"] = float(bakes["visible_mass"][-1])
-        s["visible_moment_end"] = float(bakes["visible_moment"][-1])
         s["visible_h_end"] = float(rows[-1] - rows[-2])
         # Constants of the base layer (`TwoScale::base_value`; the albedo
         # and k_d are the plugin's parameters, `Model.params`).

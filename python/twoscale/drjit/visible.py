@@ -102,10 +102,13 @@ class Visible:
         a = c - sn * x0
         return tau * (a * p0 + tau * (0.5 * (a * k - sn * p0) - tau * (sn * k / 3.0)))
 
-    def _visible_phi(self, c, sn, j):
-        """`Φ` at x̃ node `j`: `c ∫P2_tab − s ∫x̃ P2_tab` from `−r_max`."""
-        return (c * self._visible_node("visible_mass", j)
-                - sn * self._visible_node("visible_moment", j))
+    def _visible_phi(self, c, sn, j, tail=None):
+        """`Φ` at x̃ node `j`: `c ∫P2_tab − s ∫x̃ P2_tab` from `−r_max`, or
+        where the mask `tail` is set the same integrals from `j` to `r_max`
+        (`lookups.sampler_tables`)."""
+        side = 0 if tail is None else dr.select(tail, self.shapes["visible_mass"][0] // 2, 0)
+        return (c * self._visible_node("visible_mass", side + j)
+                - sn * self._visible_node("visible_moment", side + j))
 
     def _visible_incidence(self, wi):
         """`VisibleSlopeBake::incidence` of the unit `wi` (`wi.z > 0`):
@@ -132,15 +135,21 @@ class Visible:
         phi_end = c * self.f["visible_mass_end"] - sn * self.f["visible_moment_end"]
         j_end = dr.select(reaches, j_mu, mi.UInt32(2 * rows_n - 3))
         tau_end = dr.select(reaches, mu - x0, self.f["visible_h_end"])
-        norm = dr.select(reaches, self._visible_phi(c, sn, j_mu)
-                         + self._visible_cell_integral(c, sn, x0, p0, k, mu - x0), phi_end)
+        # The marginal's mass in j_end's cell, and the f32 offset `base` that
+        # turns the tables' tails into tails of the marginal: `norm − Φ_j =
+        # tail_j − base` (`visible_sample` from the end).
+        last = self._visible_cell_integral(c, sn, x0, p0, k, mu - x0)
+        last = dr.select(reaches, last, c * self.f["visible_mass_last"]
+                         - sn * self.f["visible_moment_last"])
+        norm = dr.select(reaches, self._visible_phi(c, sn, j_mu) + last, phi_end)
         # `VisibleSlopeBake::guide_incidence`: μ's row cell, or beyond r_max
         # the cell of r_max/μ among the guide's tail nodes.
         tail = self.shapes["visible_marginal_guide"][0] - rows_n
         k_tail = mi.UInt32(dr.clip((1.0 - sn * r_max / c) * tail, 0.0, float(tail - 1)))
         guide_a = dr.select(reaches, i_mu, rows_n - 1 + k_tail)
         return types.SimpleNamespace(c=c, sn=sn, length=length, t0=t0, t1=t1, j_end=j_end,
-                                     tau_end=tau_end, norm=norm, guide_a=guide_a)
+                                     tau_end=tau_end, norm=norm, guide_a=guide_a,
+                                     last=last)
 
     def visible_pdf(self, wi, wo):
         """`VisibleSlopeBake::pdf`: the specular lobe's solid-angle density."""
@@ -186,7 +195,17 @@ class Visible:
         cols_n = self.shapes["visible_cols"][0]
         inc = self._visible_incidence(wi)
         c, sn = inc.c, inc.sn
-        target = u0 * inc.norm
+        # From the end where `u0 ≥ ½`: the last j with Φ_j ≤ u0 N is the
+        # last with `tail_j − base ≥ (1 − u0) N` (`_visible_phi`'s tails,
+        # `base = tail_{j_end} − last`), compared as `−tail_j ≤ −((1 − u0) N + base)`.
+        upper = u0 >= 0.5
+        base = self._visible_phi(c, sn, inc.j_end, mi.Bool(True)) - inc.last
+        target = dr.select(upper, -((1.0 - u0) * inc.norm + base), u0 * inc.norm)
+
+        def signed_phi(j):
+            phi = self._visible_phi(c, sn, j, upper)
+            return dr.select(upper, -phi, phi)
+
         # The last node j ≤ j_end with Φ_j ≤ target (Φ_0 = 0), in the
         # guide's bracket (`VisibleSlopeBake::marginal_bracket`).
         edges = self.shapes["visible_marginal_guide"][1]
@@ -196,13 +215,13 @@ class Visible:
                                             (inc.guide_a + 1) * edges + b + 1), inc.j_end)
         lo = dr.minimum(self._visible_guide("visible_marginal_guide", inc.guide_a * edges + b), hi)
         hi = dr.minimum(hi + 1, inc.j_end)  # `guide_bin`'s bin may be the one below
-        j = guide_scan(lo, hi, scan_marginal, target, lambda j: self._visible_phi(c, sn, j))
+        j = guide_scan(lo, hi, scan_marginal, target, signed_phi)
         x0, p0 = self._visible_node("visible_x", j), self._visible_node("visible_px", j)
         x1 = self._visible_node("visible_x", j + 1)
         h = x1 - x0
         k = (self._visible_node("visible_px", j + 1) - p0) / h
         tau_max = dr.select(j == inc.j_end, inc.tau_end, h)
-        rest = target - self._visible_phi(c, sn, j)
+        rest = target - signed_phi(j)
         x = x0 + self._solve_cell(c, sn, x0, p0, k, tau_max, rest)
         # The conditional at |x̃|: its row is the cell j itself, mirrored
         # where x̃ < 0 (`VisibleSlopeBake::row` of |x̃|, but without locating).
