@@ -31,11 +31,12 @@ a node axis, the two models around each of the path's four wavelengths
 interpolated in λ, with F(θd) at λ from the runtime's table; ``pdf`` and ``sample``
 those of the sampler model, every other one, nearest the hero wavelength).
 
-**Precision.** f32 (``mi.Float``), as Mitsuba's BSDFs: the geometry,
-the lobes, the lobe weights, ``pdf``'s mixture and the draws; only the
-samplers' own arithmetic (:mod:`~twoscale.drjit.visible`,
-:mod:`~twoscale.drjit.halo`) is still f64, cast to f32 at their boundary
-(:mod:`twoscale.drjit.ir` counts each kernel's f64 operations). The port
+**Precision.** f32 (``mi.Float``) throughout, as Mitsuba's BSDFs: the
+geometry, the lobes, the lobe weights, ``pdf``'s mixture and the samplers
+(:mod:`~twoscale.drjit.visible`, :mod:`~twoscale.drjit.halo`, their
+cumulative tables read from the end where the uniform is ≥ ½,
+:func:`~twoscale.drjit.lookups.sampler_tables`); no kernel has an f64
+operation (:mod:`twoscale.drjit.ir` counts them). The port
 agrees with the runtime in distribution, not per uniform
 (docs/design/mitsuba-drjit.md).
 

@@ -50,10 +50,11 @@ class Halo:
         """Row `row`'s cumulative mass at node `k`, or with `tail` (a mask)
         the mass above it (`lookups.sampler_tables`)."""
         n_s = self.shapes["halo_zeta"][1]
-        return dr.gather(mi.Float, self.t["halo_cum"], row * (2 * n_s) + (dr.select(tail, n_s, 0) if isinstance(tail, mi.Bool) else 0) + k)
+        side = dr.select(tail, n_s, 0) if isinstance(tail, mi.Bool) else 0
+        return dr.gather(mi.Float, self.t["halo_cum"], row * (2 * n_s) + side + k)
 
     def _halo_coef(self, row, k):
-        """`[start, slope]` of row `row`'s cell `k` ."""
+        """`[start, slope]` of row `row`'s cell `k`."""
         n_s = self.shapes["halo_zeta"][1]
         c = dr.gather(mi.Vector2f, self.t["halo_coef"], row * n_s + k)
         column = self.columns["halo_coef"]

@@ -79,7 +79,7 @@ class Visible:
     def _visible_locate(self, a, name, scale):
         """`visible::locate`: the cell `[a0, a1]` of the nodes `name` that
         holds `a ≥ 0` (from its axis position, corrected by one node where
-        the f32 axis and the f64 nodes disagree), its index and the fraction
+        the axis position and the nodes disagree), its index and the fraction
         in it. The four nodes around the axis position are gathered at once,
         so the correction costs no second dependent gather."""
         n = self.shapes[name][0]
