@@ -114,3 +114,29 @@ def test_halo_row_inverts_its_table(theta):
     law = cum[k] + coef[k, columns["start"]] * d + 0.5 * coef[k, columns["slope"]] * d * d
     err = (np.abs(law - along * cum[-1]) / np.diff(cum)[k])[ok]
     assert err.max() <= 1e-4, (float(np.quantile(err, 0.99)), float(err.max()))
+
+
+def test_guide_bin_is_the_exact_bin_or_the_one_below():
+    """`visible.guide_bin` in f32 against `guide::position` in f64 (`e + f +
+    octaves + linear·m`, mirrored): the exact bin, or the one below within
+    2⁻⁹ above a bin's edge (the brackets take one more cell at their top for
+    it), never the one above."""
+    from twoscale.drjit.visible import guide_bin
+
+    bakes = MATERIALS["beckmann-limit"]().bakes()[0]
+    s = {k: float(bakes[k]) for k in ("guide_octaves", "guide_linear")}
+    rng = np.random.default_rng(11)
+    u = np.concatenate([rng.random(200_000), 10.0 ** rng.uniform(-12, 0, 100_000),
+                        1.0 - 10.0 ** rng.uniform(-7, -0.31, 100_000)]).astype(np.float32)
+    got = np.asarray(guide_bin(s, mi.Float(u)), np.int64)
+    u64 = u.astype(np.float64)
+    m = np.where(u64 < 0.5, u64, 1.0 - u64)
+    mant, exp = np.frexp(m)  # m = mant 2^exp, mant ∈ [½, 1): e = exp − 1, f = 2 mant − 1
+    half_pos = s["guide_octaves"] - 1.0 + 0.5 * s["guide_linear"]
+    half = (np.maximum(exp - 1.0 + (2.0 * mant - 1.0) + s["guide_octaves"], 0.0)
+            + s["guide_linear"] * m)
+    position = np.where(u64 < 0.5, half, 2.0 * half_pos - half)
+    exact = np.clip(np.floor(position), 0, int(2 * half_pos) - 1).astype(np.int64)
+    assert np.all((got == exact) | (got == exact - 1))
+    inside = position - np.floor(position) >= 2.0 ** -9
+    assert np.all(got[inside] == exact[inside])
