@@ -504,6 +504,27 @@ mod tests {
     use crate::TableSet;
     use crate::test_rng::Lcg;
 
+    /// The test materials `(c, β, p, B)`: HP17's gold, narrow and wide
+    /// lobes, a long halo and p ≠ 1.
+    const MATERIALS: &[(f32, f32, f32, f32)] = &[
+        (2.0, 0.0598, 1.0, 9.2),
+        (1.6, 0.1, 1.0, 5.5),
+        (2.0, 0.01, 1.0, 1.8),
+        (2.0, 0.5, 1.0, 36.0),
+        (2.5, 0.35, 1.5, 12.0),
+    ];
+
+    /// `halo`'s rows for one of [`MATERIALS`] with a positive weight that
+    /// varies with all three cosines (the identities under test hold for
+    /// whatever density the rows carry).
+    fn init_test_rows(halo: &mut HaloBake, set: &TableSet, c: f32, beta: f32, p: f32, big_b: f32) {
+        let slice = set.convolution.slice(c, beta, p).unwrap();
+        let conv = ConvBake::new(&slice, big_b, beta, p).unwrap();
+        halo.init(&conv, &|cos_i, cos_d, cos_o, _, _| {
+            (0.5 + cos_i) * cos_d * (0.2 + cos_o.max(0.0))
+        });
+    }
+
     fn reflect(wi: [f64; 3], h: [f64; 3]) -> [f64; 3] {
         let k = 2.0 * (wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2]);
         [k * h[0] - wi[0], k * h[1] - wi[1], k * h[2] - wi[2]]
@@ -541,20 +562,8 @@ mod tests {
         let (mut errors_o, mut errors_h) = (std::vec::Vec::new(), std::vec::Vec::new());
         let mut worst = (0.0f64, 0.0f32, 0.0f32, 0.0f64);
         let mut halo = HaloBake::new_zeroed();
-        for &(c, beta, p, big_b) in &[
-            (2.0f32, 0.0598f32, 1.0f32, 9.2f32),
-            (1.6, 0.1, 1.0, 5.5),
-            (2.0, 0.01, 1.0, 1.8),
-            (2.0, 0.5, 1.0, 36.0),
-            (2.5, 0.35, 1.5, 12.0),
-        ] {
-            let slice = set.convolution.slice(c, beta, p).unwrap();
-            let conv = ConvBake::new(&slice, big_b, beta, p).unwrap();
-            // Any positive weight: the identity holds for the density the
-            // rows carry; this one varies with all three cosines.
-            halo.init(&conv, &|cos_i, cos_d, cos_o, _, _| {
-                (0.5 + cos_i) * cos_d * (0.2 + cos_o.max(0.0))
-            });
+        for &(c, beta, p, big_b) in MATERIALS {
+            init_test_rows(&mut halo, &set, c, beta, p, big_b);
             for theta in [0.0f64, 30.0, 60.0, 80.0, 85.0] {
                 let (s, co) = (theta.to_radians().sin(), theta.to_radians().cos());
                 let wi = [s * 0.7f64.cos(), s * 0.7f64.sin(), co];
@@ -632,18 +641,8 @@ mod tests {
         let mut rng = Lcg(31);
         let mut halo = HaloBake::new_zeroed();
         let mut widest = 0u8;
-        for &(c, beta, p, big_b) in &[
-            (2.0f32, 0.0598f32, 1.0f32, 9.2f32),
-            (1.6, 0.1, 1.0, 5.5),
-            (2.0, 0.01, 1.0, 1.8),
-            (2.0, 0.5, 1.0, 36.0),
-            (2.5, 0.35, 1.5, 12.0),
-        ] {
-            let slice = set.convolution.slice(c, beta, p).unwrap();
-            let conv = ConvBake::new(&slice, big_b, beta, p).unwrap();
-            halo.init(&conv, &|cos_i, cos_d, cos_o, _, _| {
-                (0.5 + cos_i) * cos_d * (0.2 + cos_o.max(0.0))
-            });
+        for &(c, beta, p, big_b) in MATERIALS {
+            init_test_rows(&mut halo, &set, c, beta, p, big_b);
             for g in &halo.guide {
                 for b in 0..guide::BINS {
                     widest = widest.max(g[b + 1] - g[b]);
