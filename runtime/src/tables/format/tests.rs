@@ -1,7 +1,6 @@
 //! Unit tests of the parent module.
 
 use super::*;
-use core::mem::offset_of;
 
 /// Quantising a node's decoded values gives back its bits (the
 /// exporters' round trip), on 20 000 random nodes shaped like T3's
@@ -71,7 +70,7 @@ fn every_descriptor_is_consistent() {
 fn a_table_with_another_kernel_is_refused() {
     let t3 = embedded_bytes(TableId::Convolution).unwrap_or(&[]);
     let mut file = aligned_copy(t3);
-    let at = offset_of!(Header, kernel);
+    let at = core::mem::offset_of!(Header, kernel);
     file.bytes_mut()[at..at + 4].copy_from_slice(&(Kernel::Multilinear as u32).to_le_bytes());
     let sum = checksum(file.bytes());
     file.bytes_mut()[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
